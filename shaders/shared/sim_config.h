@@ -1,0 +1,58 @@
+// Compile-time knobs shared by the shaders and the C++ side.
+#ifndef SIM_CONFIG_H
+#define SIM_CONFIG_H
+
+// Workgroup size for per-particle passes (integrate, floor, normals, hash, pick)
+#define SIM_WG_PARTICLES 64
+// Workgroup size for constraint projection (one thread per constraint of a colour)
+#define SIM_WG_PROJECT 64
+// Workgroup size for collision gathering (one thread per particle)
+#define SIM_WG_COLLIDE 64
+// Workgroup size for tear marking and compaction (one thread per constraint or triangle)
+#define SIM_WG_TEAR 64
+// Workgroup size of the block scan; each thread scans SIM_SCAN_PER_THREAD elements
+#define SIM_WG_SCAN 256
+// Elements scanned per thread in the block scan
+#define SIM_SCAN_PER_THREAD 4
+// Largest number of substeps per tick (per-substep inputs are arrays of this size)
+#define SIM_MAX_SUBSTEPS 32
+// Largest number of constraint colours
+#define SIM_MAX_COLORS 64
+// Frames the animated reset takes to bring the sheet back to its start
+#define SIM_RESET_FRAMES 30
+// Sentinel particle index: nothing grabbed, nothing picked
+#define SIM_NONE 0xFFFFFFFFu
+
+// Constraint kinds (low two bits of Constraint.kind_id; the original id sits above them)
+#define SIM_KIND_STRUCTURAL 0u
+#define SIM_KIND_SHEAR 1u
+#define SIM_KIND_BEND 2u
+#define SIM_KIND_TRIBEND 3u
+#define SIM_KIND_BITS 2u
+#define SIM_KIND_MASK 3u
+
+// Descriptor bindings of the simulation set (one set, shared by every sim pass)
+#define SIM_BIND_UNIFORMS 0
+#define SIM_BIND_POS 1
+#define SIM_BIND_PREV 2
+#define SIM_BIND_REST 3
+#define SIM_BIND_UV 4
+#define SIM_BIND_NORMAL 5
+#define SIM_BIND_CONSTRAINTS 6
+#define SIM_BIND_COLOR_RANGES 7
+#define SIM_BIND_ADJ_OFFSETS 8
+#define SIM_BIND_ADJ_LIST 9
+#define SIM_BIND_CELL_COUNT 10
+#define SIM_BIND_CELL_START 11
+#define SIM_BIND_CELL_PARTICLES 12
+#define SIM_BIND_PARTICLE_CELL 13
+#define SIM_BIND_DELTA 14
+#define SIM_BIND_TORN 15
+#define SIM_BIND_TRIANGLES 16
+#define SIM_BIND_TRI_EDGES 17
+#define SIM_BIND_COUNTERS 18
+#define SIM_BIND_SCRATCH 19
+#define SIM_BIND_PICK 20
+#define SIM_BIND_RESET_FROM 21
+
+#endif

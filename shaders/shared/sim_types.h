@@ -1,0 +1,85 @@
+// GPU-visible structs shared by GLSL and C++ (4-byte scalars and vec4/uvec4 only).
+// In C++ this file is included inside `namespace shaderio { using namespace glm; }`.
+#ifndef SIM_TYPES_H
+#define SIM_TYPES_H
+#include "prelude.h"
+#include "sim_config.h"
+
+/// A distance constraint between particles a and b.
+/// kind_id = (original id << SIM_KIND_BITS) | kind; the original id indexes `torn`.
+struct Constraint {
+  uint a;
+  uint b;
+  float rest;
+  uint kind_id;
+};
+
+/// Per-tick inputs of the simulation (one uniform buffer, std140 == C++ layout).
+struct SimUniforms {
+  uint particle_count;   // N
+  uint cols;             // grid width
+  uint rows;             // grid height
+  uint substeps;         // substeps per tick (<= SIM_MAX_SUBSTEPS)
+
+  uint constraint_count; // original constraint count (size of `torn`)
+  uint triangle_count;   // original triangle count
+  uint hash_mask;        // hash table size - 1 (table size is a power of two >= 2N)
+  uint color_count;      // number of colours
+
+  float dt;              // substep length in seconds
+  float damping;         // Verlet velocity factor per substep
+  float gravity;         // magnitude, pointing -Y
+  float floor_y;         // ground height
+
+  float restitution;     // normal velocity kept on floor contact
+  float friction;        // tangential velocity removed on floor contact
+  float collision_radius; // repulsion distance (1.2 x spacing)
+  float inv_cell;        // 1 / hash cell size
+
+  float collision_stiffness; // fraction of the overlap corrected per substep
+  float tear_factor;     // tear beyond tear_factor x rest; 0 disables tearing
+  uint tear_kinds;       // bit k set: constraints of kind k may tear
+  uint flags;            // SIM_FLAG_*
+
+  vec4 stiffness;        // projection stiffness per kind (structural, shear, bend, tri-bend)
+
+  uint grab_index;       // grabbed particle or SIM_NONE
+  uint reset_active;     // 1 while the animated reset runs (physics passes are skipped)
+  float reset_alpha;     // reset interpolation factor of this frame, 0..1
+  uint iterations;       // constraint iterations per substep
+
+  vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
+  vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet
+  vec4 grab_target[SIM_MAX_SUBSTEPS]; // grabbed particle position at each substep; w = 1 while held
+  vec4 grab_prev[SIM_MAX_SUBSTEPS];   // its previous position (equal to target: zero velocity)
+};
+
+// SimUniforms.flags bits
+#define SIM_FLAG_COLLISION 1u
+#define SIM_FLAG_PINS 2u
+
+/// Push constants of every simulation dispatch.
+struct SimPush {
+  uint first;   // first element (constraint of a colour range, particle, ...)
+  uint count;   // element count of this dispatch
+  uint substep; // substep index inside the tick
+  uint color;   // colour index for projection and compaction
+};
+
+/// GPU counters: tear bookkeeping and indirect arguments (one storage buffer).
+struct Counters {
+  uint torn_total;     // constraints torn since the last reset
+  uint torn_new;       // constraints marked in the current substep
+  uint triangle_count; // live triangles
+  uint pad0;
+  uvec4 compact_dispatch; // indirect dispatch for compaction (x = 0 when nothing tore)
+  uvec4 draw_args;        // indirect draw: vertexCount, instanceCount, firstVertex, firstInstance
+};
+
+/// Result of a pick: nearest particle to a ray (8 bytes read back).
+struct PickResult {
+  uint index; // particle or SIM_NONE
+  float t;    // ray parameter of the point nearest to the particle
+};
+
+#endif

@@ -1,0 +1,120 @@
+// Per-particle and per-constraint maths, called by the GLSL main()s and the C++ reference alike.
+// Functions take values and return values (no inout) so that one body compiles as both.
+#ifndef SIM_XPBD_H
+#define SIM_XPBD_H
+#include "sim_types.h"
+
+/// Position and previous position of one particle.
+struct VerletState {
+  vec4 pos;
+  vec4 prev;
+};
+
+/// Position corrections of the two ends of a constraint.
+struct PairDelta {
+  vec3 da;
+  vec3 db;
+};
+
+/// Inverse mass of a particle this substep: 0 when pinned (and pins are on) or held by a grab.
+SIM_INLINE float inverseMass(vec4 rest, bool held, uint flags) {
+  bool pinned = (flags & SIM_FLAG_PINS) != 0u && rest.w > 0.5f;
+  return (pinned || held) ? 0.0f : 1.0f;
+}
+
+/// External acceleration of a free particle: gravity plus wind (uniform and twisting across u).
+SIM_INLINE vec3 externalAccel(float gravity, vec4 wind, vec4 wind_twist, float u) {
+  return vec3(0.0f, -gravity, 0.0f) + vec3(wind) + vec3(wind_twist) * (u - 0.5f);
+}
+
+/// Damped Verlet step: x' = x + (x - x_prev) * damping + a * dt^2; x_prev' = x.
+SIM_INLINE VerletState verletStep(vec4 pos, vec4 prev, vec3 accel, float damping, float dt2, float w) {
+  VerletState s;
+  vec3 p = vec3(pos);
+  if (w > 0.0f) {
+    vec3 v = (p - vec3(prev)) * damping;
+    s.pos = vec4(p + v + accel * dt2, w);
+  } else {
+    s.pos = vec4(p, w);
+  }
+  s.prev = vec4(p, w);
+  return s;
+}
+
+/// Projects one distance constraint; corrections are weighted by inverse mass (pos.w).
+SIM_INLINE PairDelta solveDistance(vec4 pa, vec4 pb, float rest, float stiffness) {
+  PairDelta r;
+  r.da = vec3(0.0f);
+  r.db = vec3(0.0f);
+  float wsum = pa.w + pb.w;
+  vec3 d = vec3(pb) - vec3(pa);
+  float len = sqrt(dot(d, d));
+  if (wsum > 0.0f && len > 1e-9f) {
+    float s = stiffness * (len - rest) / (len * wsum);
+    r.da = d * (s * pa.w);
+    r.db = d * (-s * pb.w);
+  }
+  return r;
+}
+
+/// Integer cell of a position in the spatial hash.
+SIM_INLINE ivec3 cellOf(vec3 p, float inv_cell) {
+  return ivec3(floor(p * inv_cell));
+}
+
+/// Hash bucket of a cell.
+SIM_INLINE uint hashCell(ivec3 c, uint mask) {
+  uint h = (uint(c.x) * 73856093u) ^ (uint(c.y) * 19349663u) ^ (uint(c.z) * 83492791u);
+  return h & mask;
+}
+
+/// Repulsion of particle i away from j when closer than radius (half the overlap, scaled).
+SIM_INLINE vec3 repulsion(vec3 pi, vec3 pj, float radius, float stiffness) {
+  vec3 d = pi - pj;
+  float d2 = dot(d, d);
+  vec3 r = vec3(0.0f);
+  if (d2 < radius * radius && d2 > 1e-12f) {
+    float len = sqrt(d2);
+    r = d * (stiffness * 0.5f * (radius - len) / len);
+  }
+  return r;
+}
+
+/// Ground contact: clamp to the floor, reflect normal velocity with restitution, apply friction.
+SIM_INLINE VerletState floorContact(vec4 pos, vec4 prev, float floor_y, float restitution, float friction) {
+  VerletState s;
+  s.pos = pos;
+  s.prev = prev;
+  if (pos.y < floor_y) {
+    float vy = min(pos.y - prev.y, 0.0f);
+    float keep = 1.0f - friction;
+    s.pos.y = floor_y;
+    s.prev.y = floor_y + vy * restitution;
+    s.prev.x = pos.x - (pos.x - prev.x) * keep;
+    s.prev.z = pos.z - (pos.z - prev.z) * keep;
+  }
+  return s;
+}
+
+/// True when a constraint of this kind is stretched beyond tear_factor x rest.
+SIM_INLINE bool shouldTear(vec4 pa, vec4 pb, float rest, uint kind, float tear_factor, uint tear_kinds) {
+  bool tearable = tear_factor > 0.0f && (tear_kinds & (1u << kind)) != 0u;
+  vec3 d = vec3(pb) - vec3(pa);
+  return tearable && sqrt(dot(d, d)) > rest * tear_factor;
+}
+
+/// Smooth normal of grid particle (i, j) from central differences of its neighbours.
+SIM_INLINE vec3 gridNormal(vec3 left, vec3 right, vec3 up, vec3 down) {
+  vec3 n = cross(right - left, up - down);
+  float l2 = dot(n, n);
+  return l2 > 1e-20f ? n / sqrt(l2) : vec3(0.0f, 0.0f, 1.0f);
+}
+
+/// Squared distance from point p to the ray o + t d (|d| = 1), and t; t < 0 gives a huge distance.
+SIM_INLINE vec2 rayPointDistance2(vec3 o, vec3 d, vec3 p) {
+  float t = dot(p - o, d);
+  vec3 q = o + d * t - p;
+  return vec2(t < 0.0f ? 3.0e38f : dot(q, q), t);
+}
+
+#endif

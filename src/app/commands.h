@@ -1,0 +1,55 @@
+#pragma once
+/// The subcommands of `tender`, each in its own file; main.cpp parses the command line.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/params.h"
+#include "core/solver.h"
+
+namespace tender {
+
+/// Exit status of every bad-input error (with one line on stderr).
+constexpr int kExitBadInput = 2;
+
+/// Options every program shares.
+struct CommonOptions {
+  std::string preset = "tender";
+  std::vector<std::string> sets;  ///< key=value overrides
+  std::string backend = "gpu";    ///< cpu or gpu
+  int device = -1;                ///< Vulkan device index, -1 = best
+  bool validation = false;        ///< VK_LAYER_KHRONOS_validation
+  std::string script;             ///< input script to replay
+  SimParams params;               ///< resolved preset + overrides
+};
+
+struct SimOptions {
+  uint64_t ticks = 120;
+  std::string stats, out;
+};
+
+struct RenderOptions {
+  uint64_t ticks = 0;
+  std::string out = "tender.png";
+  uint32_t width = 1280, height = 720;
+};
+
+struct DemoOptions {
+  std::string record, replay;
+  bool vsync = true;
+  float ui_scale = 0.0f; ///< 0 = the window's content scale
+  uint32_t width = 1280, height = 720;
+};
+
+/// Prints "tender: error: <message>" and returns kExitBadInput.
+int fail(const std::string& message);
+
+/// Creates the chosen backend; on failure prints one line and sets `status` to kExitBadInput.
+std::unique_ptr<Solver> createSolver(const CommonOptions& o, int& status);
+
+int runSim(const CommonOptions& common, const SimOptions& o);
+int runDevices(const CommonOptions& common);
+int runRender(const CommonOptions& common, const RenderOptions& o);
+int runDemo(const CommonOptions& common, const DemoOptions& o);
+
+} // namespace tender

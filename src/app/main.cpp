@@ -1,0 +1,114 @@
+// tender: receipt paper physics. The interactive demo, and headless `sim`, `render`, `devices`.
+#include <cstdio>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.h"
+
+namespace tender {
+
+int fail(const std::string& message) {
+  std::fprintf(stderr, "tender: error: %s\n", message.c_str());
+  return kExitBadInput;
+}
+
+namespace {
+
+void addCommon(CLI::App& app, CommonOptions& o, bool with_backend) {
+  app.add_option("--preset", o.preset, "tender, crumple, tender-low or crumple-low")->capture_default_str();
+  app.add_option("--set", o.sets, "override a parameter: key=value (repeatable; see the key list below)");
+  if (with_backend) app.add_option("--backend", o.backend, "cpu or gpu")->capture_default_str();
+  app.add_option("--device", o.device, "Vulkan device index (see `tender devices`)");
+  app.add_flag("--validation", o.validation, "enable VK_LAYER_KHRONOS_validation");
+}
+
+std::string keyList() {
+  std::string s = "Parameter keys for --set:\n";
+  for (auto& k : paramKeys()) {
+    char line[160];
+    std::snprintf(line, sizeof(line), "  %-20s %s\n", k.key.c_str(), k.help.c_str());
+    s += line;
+  }
+  return s;
+}
+
+// Resolves the preset and the overrides; returns an error message.
+std::optional<std::string> resolve(CommonOptions& o) {
+  auto p = presetParams(o.preset);
+  if (!p) {
+    std::string names;
+    for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
+    return "unknown preset '" + o.preset + "' (one of " + names + ")";
+  }
+  for (auto& s : o.sets)
+    if (auto err = applyOverride(*p, s)) return *err;
+  if (auto err = validate(*p)) return *err;
+  if (o.backend != "cpu" && o.backend != "gpu") return "unknown backend '" + o.backend + "' (cpu or gpu)";
+  o.params = *p;
+  return std::nullopt;
+}
+
+} // namespace
+} // namespace tender
+
+int main(int argc, char** argv) {
+  using namespace tender;
+  CLI::App app{"Tender: a sheet of receipt paper to grab, crumple, fold, toss and tear."};
+  app.set_version_flag("--version", std::string("tender ") + TENDER_VERSION);
+  app.footer(keyList());
+  app.require_subcommand(0, 1);
+
+  CommonOptions common;
+  DemoOptions demo;
+  addCommon(app, common, true);
+  app.add_option("--record", demo.record, "write this session's input as an input script");
+  app.add_option("--replay", demo.replay, "play an input script back");
+  app.add_option("--vsync", demo.vsync, "on or off")->transform(CLI::Transformer({{"on", "1"}, {"off", "0"}}));
+  app.add_option("--ui-scale", demo.ui_scale, "HUD scale (default: the window's content scale)")
+      ->check(CLI::Range(0.25f, 8.0f));
+  app.add_option("--width", demo.width, "window width")->check(CLI::Range(64u, 16384u));
+  app.add_option("--height", demo.height, "window height")->check(CLI::Range(64u, 16384u));
+
+  SimOptions sim;
+  CLI::App* sim_cmd = app.add_subcommand("sim", "run a preset headless and write stats and state");
+  addCommon(*sim_cmd, common, true);
+  sim_cmd->add_option("--ticks", sim.ticks, "ticks to run")->check(CLI::Range(uint64_t(0), uint64_t(100000000)));
+  sim_cmd->add_option("--script", common.script, "input script to replay");
+  sim_cmd->add_option("--stats", sim.stats, "write stats JSON here");
+  sim_cmd->add_option("--out", sim.out, "write the final state as PLY here");
+
+  RenderOptions render;
+  CLI::App* render_cmd = app.add_subcommand("render", "render a preset offscreen to a PNG");
+  addCommon(*render_cmd, common, true);
+  render_cmd->add_option("--ticks", render.ticks, "ticks to run before rendering")
+      ->check(CLI::Range(uint64_t(0), uint64_t(100000000)));
+  render_cmd->add_option("--script", common.script, "input script to replay");
+  render_cmd->add_option("--out", render.out, "PNG to write")->capture_default_str();
+  render_cmd->add_option("--width", render.width, "image width")->check(CLI::Range(16u, 16384u));
+  render_cmd->add_option("--height", render.height, "image height")->check(CLI::Range(16u, 16384u));
+
+  CLI::App* devices_cmd = app.add_subcommand("devices", "list the Vulkan devices");
+  addCommon(*devices_cmd, common, false);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    return fail(e.what());
+  }
+  if (*devices_cmd) return runDevices(common);
+  if (auto err = resolve(common)) return fail(*err);
+  try {
+    if (*sim_cmd) return runSim(common, sim);
+    if (*render_cmd) return runRender(common, render);
+    return runDemo(common, demo);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tender: error: %s\n", e.what());
+    return 1;
+  }
+}

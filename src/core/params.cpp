@@ -1,0 +1,225 @@
+#include "params.h"
+
+#include <charconv>
+#include <cmath>
+#include <functional>
+#include <unistd.h>
+
+#include "sim_config.h"
+
+namespace tender {
+namespace {
+
+struct Param {
+  ParamInfo info;
+  std::function<std::optional<std::string>(SimParams&, const std::string&)> set;
+  std::function<std::string(const SimParams&)> get;
+};
+
+std::optional<std::string> parseFloat(const std::string& s, float lo, float hi, float& out) {
+  float v = 0.0f;
+  const char* end = s.data() + s.size();
+  auto [ptr, ec] = std::from_chars(s.data(), end, v);
+  if (s.empty() || ec != std::errc() || ptr != end || !std::isfinite(v))
+    return "'" + s + "' is not a number";
+  if (v < lo || v > hi) {
+    char buf[128];
+    snprintf(buf, sizeof(buf), "%s is out of range [%g, %g]", s.c_str(), double(lo), double(hi));
+    return std::string(buf);
+  }
+  out = v;
+  return std::nullopt;
+}
+
+std::optional<std::string> parseUint(const std::string& s, uint32_t lo, uint32_t hi, uint32_t& out) {
+  uint64_t v = 0;
+  const char* end = s.data() + s.size();
+  auto [ptr, ec] = std::from_chars(s.data(), end, v);
+  if (s.empty() || ptr != end || (ec != std::errc() && ec != std::errc::result_out_of_range))
+    return "'" + s + "' is not a whole number";
+  if (ec == std::errc::result_out_of_range || v < lo || v > hi)
+    return s + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  out = uint32_t(v);
+  return std::nullopt;
+}
+
+std::optional<std::string> parseBool(const std::string& s, bool& out) {
+  if (s == "on" || s == "true" || s == "1") return out = true, std::nullopt;
+  if (s == "off" || s == "false" || s == "0") return out = false, std::nullopt;
+  return "'" + s + "' is not on/off";
+}
+
+std::string fmt(float v) {
+  char buf[32];
+  snprintf(buf, sizeof(buf), "%g", double(v));
+  return buf;
+}
+
+// Limits of the sheet size: a 16384-wide grid or 2^24 particles at most.
+constexpr uint32_t kMaxSide = 16384;
+
+Param floatParam(const char* key, float SimParams::*m, float lo, float hi, const char* help) {
+  return {{key, help},
+          [m, lo, hi](SimParams& p, const std::string& v) { return parseFloat(v, lo, hi, p.*m); },
+          [m](const SimParams& p) { return fmt(p.*m); }};
+}
+Param uintParam(const char* key, uint32_t SimParams::*m, uint32_t lo, uint32_t hi, const char* help) {
+  return {{key, help},
+          [m, lo, hi](SimParams& p, const std::string& v) { return parseUint(v, lo, hi, p.*m); },
+          [m](const SimParams& p) { return std::to_string(p.*m); }};
+}
+Param boolParam(const char* key, bool SimParams::*m, const char* help) {
+  return {{key, help}, [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); },
+          [m](const SimParams& p) { return std::string(p.*m ? "on" : "off"); }};
+}
+template <typename E>
+Param enumParam(const char* key, E SimParams::*m, std::vector<std::pair<std::string, E>> names, const char* help) {
+  return {{key, help},
+          [m, names](SimParams& p, const std::string& v) -> std::optional<std::string> {
+            std::string all;
+            for (auto& [n, e] : names) {
+              if (n == v) return p.*m = e, std::nullopt;
+              all += (all.empty() ? "" : ", ") + n;
+            }
+            return "'" + v + "' is not one of " + all;
+          },
+          [m, names](const SimParams& p) {
+            for (auto& [n, e] : names)
+              if (e == p.*m) return n;
+            return std::string("?");
+          }};
+}
+
+const std::vector<Param>& params() {
+  static const std::vector<Param> table = {
+      uintParam("cols", &SimParams::cols, 1, kMaxSide, "particles across"),
+      uintParam("rows", &SimParams::rows, 1, kMaxSide, "particles down"),
+      floatParam("spacing", &SimParams::spacing, 1e-3f, 10.0f, "rest distance between neighbours"),
+      enumParam("pins", &SimParams::pins,
+                {{"top3", PinMode::Top3}, {"corners", PinMode::Corners}, {"none", PinMode::None}},
+                "pinned particles: top3, corners, none"),
+      floatParam("top_y", &SimParams::top_y, -1000.0f, 1000.0f, "y of the top edge (0: centre on y = 1)"),
+      boolParam("shear", &SimParams::shear, "diagonal constraints"),
+      boolParam("bend", &SimParams::bend, "skip-one bend constraints"),
+      boolParam("tri_bend", &SimParams::tri_bend, "bending across adjacent triangles"),
+      floatParam("tick_hz", &SimParams::tick_hz, 1.0f, 10000.0f, "fixed ticks per second"),
+      uintParam("substeps", &SimParams::substeps, 1, SIM_MAX_SUBSTEPS, "substeps per tick"),
+      uintParam("iterations", &SimParams::iterations, 1, 256, "constraint iterations per substep"),
+      floatParam("max_frame_dt", &SimParams::max_frame_dt, 1e-3f, 1.0f, "frame dt clamp (s)"),
+      floatParam("gravity", &SimParams::gravity, 0.0f, 1000.0f, "gravity magnitude, pointing -Y"),
+      floatParam("damping", &SimParams::damping, 0.0f, 1.0f, "velocity factor per substep"),
+      boolParam("wind", &SimParams::wind, "wind on at start"),
+      enumParam("wind_kind", &SimParams::wind_kind,
+                {{"sinusoid", WindKind::Sinusoid}, {"noise", WindKind::Noise}}, "wind model: sinusoid, noise"),
+      floatParam("wind_strength", &SimParams::wind_strength, 0.0f, 100.0f, "wind multiplier"),
+      floatParam("wind_scale", &SimParams::wind_scale, 0.0f, 1000.0f, "wind acceleration at strength 1"),
+      floatParam("stiffness", &SimParams::stiffness, 0.0f, 1.0f, "structural and shear stiffness"),
+      floatParam("bend_stiffness", &SimParams::bend_stiffness, 0.0f, 1.0f, "bend stiffness"),
+      floatParam("tear_factor", &SimParams::tear_factor, 0.0f, 100.0f, "tear beyond factor x rest; 0: never"),
+      boolParam("tear_structural", &SimParams::tear_structural, "structural constraints may tear"),
+      boolParam("tear_shear", &SimParams::tear_shear, "shear constraints may tear"),
+      boolParam("tear_bend", &SimParams::tear_bend, "bend constraints may tear"),
+      boolParam("collision", &SimParams::collision, "self-collision"),
+      floatParam("cell_size", &SimParams::cell_size, 1e-3f, 100.0f, "spatial hash cell size"),
+      floatParam("collision_factor", &SimParams::collision_factor, 0.0f, 10.0f,
+                 "repulsion radius as a multiple of spacing"),
+      floatParam("collision_stiffness", &SimParams::collision_stiffness, 0.0f, 1.0f, "repulsion strength"),
+      floatParam("floor_y", &SimParams::floor_y, -1e4f, 1e4f, "ground height"),
+      floatParam("restitution", &SimParams::restitution, 0.0f, 1.0f, "bounce off the ground"),
+      floatParam("friction", &SimParams::friction, 0.0f, 1.0f, "ground friction"),
+      enumParam("release", &SimParams::release,
+                {{"zero", ReleaseMode::ZeroVelocity}, {"drag", ReleaseMode::DragVelocity}},
+                "velocity on release: zero, drag"),
+      floatParam("grab_radius", &SimParams::grab_radius, 0.0f, 100.0f, "pick radius around the ray"),
+  };
+  return table;
+}
+
+} // namespace
+
+std::vector<std::string> presetNames() { return {"tender", "crumple", "tender-low", "crumple-low"}; }
+
+std::optional<SimParams> presetParams(const std::string& name) {
+  SimParams p; // defaults are the `tender` preset
+  if (name == "tender" || name == "tender-low") {
+    if (name == "tender-low") p.cols = 24, p.rows = 36, p.spacing = 0.18f * 31.0f / 23.0f;
+  } else if (name == "crumple" || name == "crumple-low") {
+    p.cols = 40;
+    p.rows = 60;
+    p.spacing = 0.15f;
+    p.pins = PinMode::Corners;
+    p.tick_hz = 60.0f;
+    p.substeps = 8;
+    p.iterations = 4;
+    p.gravity = 0.5f;
+    p.damping = 0.995f;
+    p.wind = false;
+    p.wind_kind = WindKind::Noise;
+    p.wind_scale = 0.15f;
+    p.bend = false;
+    p.tri_bend = true;
+    p.bend_stiffness = 0.8f;
+    p.cell_size = 0.375f; // 2.5 x spacing, as in `tender`
+    p.floor_y = -10.0f;
+    p.restitution = 0.3f;
+    p.friction = 0.3f;
+    p.release = ReleaseMode::DragVelocity;
+    if (name == "crumple-low") p.cols = 30, p.rows = 45, p.spacing = 0.15f * 39.0f / 29.0f, p.cell_size = 2.5f * p.spacing;
+  } else {
+    return std::nullopt;
+  }
+  p.preset = name;
+  return p;
+}
+
+const std::vector<ParamInfo>& paramKeys() {
+  static const std::vector<ParamInfo> keys = [] {
+    std::vector<ParamInfo> k;
+    for (auto& p : params()) k.push_back(p.info);
+    return k;
+  }();
+  return keys;
+}
+
+std::optional<std::string> applyOverride(SimParams& p, const std::string& assignment) {
+  auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0) return "expected key=value, got '" + assignment + "'";
+  std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
+  for (auto& param : params())
+    if (param.info.key == key) {
+      if (auto err = param.set(p, value)) return key + ": " + *err;
+      return std::nullopt;
+    }
+  return "unknown parameter '" + key + "' (see --help for the keys)";
+}
+
+std::string paramValue(const SimParams& p, const std::string& key) {
+  for (auto& param : params())
+    if (param.info.key == key) return param.get(p);
+  return "";
+}
+
+uint64_t estimateSheetBytes(const SimParams& p) {
+  uint64_t n = uint64_t(p.cols) * p.rows;
+  // Particle arrays (pos, prev, rest, normal, delta, reset source, uv, hash, adjacency) and
+  // up to 8 constraints per particle in three copies (live, pristine, scratch), both solvers' worth.
+  uint64_t per_particle = 6 * 16 + 8 + 4 * 16 + 16 * 4 + 8 * 16 * 3 + 2 * 16 * 2;
+  return n * per_particle;
+}
+
+std::optional<std::string> validate(const SimParams& p) {
+  uint64_t n = uint64_t(p.cols) * p.rows;
+  if (n == 0) return "the grid has no particles";
+  if (n > (1u << 24)) return "a grid of " + std::to_string(n) + " particles is too large (at most 16777216)";
+  uint64_t need = estimateSheetBytes(p);
+  long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  if (pages > 0 && page > 0 && need > uint64_t(pages) * uint64_t(page) / 2)
+    return "a grid of " + std::to_string(n) + " particles needs about " + std::to_string(need >> 20) +
+           " MiB, more than this machine can hold";
+  if (p.substeps > SIM_MAX_SUBSTEPS) return "substeps is at most " + std::to_string(SIM_MAX_SUBSTEPS);
+  if (p.collision && p.collisionRadius() > p.cell_size)
+    return "collision radius (" + fmt(p.collisionRadius()) + ") must not exceed cell_size (" + fmt(p.cell_size) + ")";
+  return std::nullopt;
+}
+
+} // namespace tender

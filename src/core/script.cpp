@@ -1,0 +1,128 @@
+#include "script.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace tender {
+namespace {
+
+bool readToggle(std::istringstream& in, Toggle& t) {
+  std::string w;
+  if (!(in >> w)) return false;
+  if (w == "on") t = Toggle::On;
+  else if (w == "off") t = Toggle::Off;
+  else if (w == "toggle") t = Toggle::Flip;
+  else return false;
+  return true;
+}
+
+bool readVec(std::istringstream& in, glm::vec3& v) {
+  for (int k = 0; k < 3; ++k) {
+    std::string w;
+    if (!(in >> w)) return false;
+    char* end = nullptr;
+    double d = std::strtod(w.c_str(), &end);
+    if (end == w.c_str() || *end != 0 || !std::isfinite(d)) return false;
+    v[k] = float(d);
+  }
+  return true;
+}
+
+const char* toggleName(Toggle t) { return t == Toggle::On ? "on" : t == Toggle::Off ? "off" : "toggle"; }
+
+} // namespace
+
+std::optional<InputScript> parseScript(const std::string& text, std::string& error) {
+  InputScript script;
+  std::istringstream lines(text);
+  std::string line;
+  int number = 0;
+  uint64_t last_tick = 0;
+  while (std::getline(lines, line)) {
+    ++number;
+    auto hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    std::istringstream in(line);
+    std::string tick_word, verb;
+    if (!(in >> tick_word)) continue; // blank or comment
+    auto fail = [&](const std::string& what) {
+      error = "line " + std::to_string(number) + ": " + what;
+      return std::nullopt;
+    };
+    char* end = nullptr;
+    unsigned long long tick = std::strtoull(tick_word.c_str(), &end, 10);
+    if (tick_word[0] == '-' || *end != 0) return fail("expected a tick number, got '" + tick_word + "'");
+    if (tick < last_tick) return fail("tick " + tick_word + " comes before an earlier line's tick");
+    last_tick = tick;
+    if (!(in >> verb)) return fail("missing event after the tick");
+    ScriptEvent e;
+    e.tick = tick;
+    if (verb == "grab") {
+      std::string how;
+      in >> how;
+      if (how == "particle") {
+        long long i = -1;
+        if (!(in >> i) || i < 0 || i > 0xFFFFFFFELL) return fail("grab particle needs a particle index");
+        e.kind = EventKind::GrabParticle;
+        e.particle = uint32_t(i);
+      } else if (how == "ray") {
+        e.kind = EventKind::GrabRay;
+        if (!readVec(in, e.a) || !readVec(in, e.b)) return fail("grab ray needs 6 numbers: origin and direction");
+        if (glm::dot(e.b, e.b) < 1e-12f) return fail("grab ray direction is zero");
+      } else {
+        return fail("grab needs 'particle <index>' or 'ray <ox oy oz dx dy dz>'");
+      }
+    } else if (verb == "move") {
+      e.kind = EventKind::Move;
+      if (!readVec(in, e.a)) return fail("move needs 3 numbers");
+    } else if (verb == "release") {
+      e.kind = EventKind::Release;
+    } else if (verb == "wind" || verb == "pins" || verb == "pause") {
+      e.kind = verb == "wind" ? EventKind::Wind : verb == "pins" ? EventKind::Pins : EventKind::Pause;
+      if (!readToggle(in, e.toggle)) return fail(verb + " needs on, off or toggle");
+    } else if (verb == "reset") {
+      e.kind = EventKind::Reset;
+    } else {
+      return fail("unknown event '" + verb + "'");
+    }
+    std::string extra;
+    if (in >> extra) return fail("unexpected '" + extra + "' at the end of the line");
+    script.events.push_back(e);
+  }
+  return script;
+}
+
+std::optional<InputScript> loadScript(const std::string& path, std::string& error) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) {
+    error = "cannot read script '" + path + "'";
+    return std::nullopt;
+  }
+  std::stringstream ss;
+  ss << f.rdbuf();
+  auto s = parseScript(ss.str(), error);
+  if (!s) error = path + ": " + error;
+  return s;
+}
+
+std::string formatEvent(const ScriptEvent& e) {
+  std::ostringstream o;
+  o.precision(9);
+  o << e.tick << ' ';
+  switch (e.kind) {
+  case EventKind::GrabParticle: o << "grab particle " << e.particle; break;
+  case EventKind::GrabRay:
+    o << "grab ray " << e.a.x << ' ' << e.a.y << ' ' << e.a.z << ' ' << e.b.x << ' ' << e.b.y << ' ' << e.b.z;
+    break;
+  case EventKind::Move: o << "move " << e.a.x << ' ' << e.a.y << ' ' << e.a.z; break;
+  case EventKind::Release: o << "release"; break;
+  case EventKind::Wind: o << "wind " << toggleName(e.toggle); break;
+  case EventKind::Pins: o << "pins " << toggleName(e.toggle); break;
+  case EventKind::Pause: o << "pause " << toggleName(e.toggle); break;
+  case EventKind::Reset: o << "reset"; break;
+  }
+  return o.str();
+}
+
+} // namespace tender

@@ -1,0 +1,50 @@
+#pragma once
+/// Input scripts: timed input events, one per line. Used by tests, `tender sim`, and the demo's
+/// record/replay.
+///
+///   # comment
+///   <tick> grab particle <index>
+///   <tick> grab ray <ox> <oy> <oz> <dx> <dy> <dz>
+///   <tick> move <x> <y> <z>          grab target in world units
+///   <tick> release
+///   <tick> wind on|off|toggle
+///   <tick> pins on|off|toggle
+///   <tick> pause on|off|toggle
+///   <tick> reset
+///
+/// Events of tick T apply just before tick T runs (ticks count from 0); lines must be in tick order.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace tender {
+
+enum class EventKind { GrabParticle, GrabRay, Move, Release, Wind, Pins, Pause, Reset };
+/// Value of on/off/toggle events.
+enum class Toggle { Off, On, Flip };
+
+struct ScriptEvent {
+  uint64_t tick = 0;
+  EventKind kind = EventKind::Release;
+  uint32_t particle = 0;   ///< GrabParticle
+  glm::vec3 a{0.0f};       ///< GrabRay origin, Move target
+  glm::vec3 b{0.0f};       ///< GrabRay direction
+  Toggle toggle = Toggle::Flip;
+};
+
+/// A parsed script, sorted by tick.
+struct InputScript {
+  std::vector<ScriptEvent> events;
+};
+
+/// Parses script text; on failure returns nullopt and sets `error` to "line N: what".
+std::optional<InputScript> parseScript(const std::string& text, std::string& error);
+/// Reads and parses a script file; errors name the file.
+std::optional<InputScript> loadScript(const std::string& path, std::string& error);
+/// Formats one event as a script line.
+std::string formatEvent(const ScriptEvent& e);
+
+} // namespace tender

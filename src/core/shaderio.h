@@ -1,0 +1,25 @@
+#pragma once
+/// C++ view of the GPU structs and per-constraint maths in shaders/shared/.
+/// The same headers compile as GLSL; `using namespace glm` makes vec4, dot, length mean the same here.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <glm/glm.hpp>
+
+namespace shaderio {
+using namespace glm;
+using uint = glm::uint;
+#include "sim_types.h"
+#include "xpbd.h"
+
+static_assert(sizeof(Constraint) == 16);
+static_assert(sizeof(SimPush) == 16);
+static_assert(sizeof(Counters) == 48);
+static_assert(offsetof(Counters, compact_dispatch) == 16);
+static_assert(offsetof(Counters, draw_args) == 32);
+static_assert(sizeof(PickResult) == 8);
+static_assert(offsetof(SimUniforms, stiffness) == 80);
+static_assert(offsetof(SimUniforms, grab_index) == 96);
+static_assert(offsetof(SimUniforms, wind) == 112);
+static_assert(sizeof(SimUniforms) == 112 + 4 * 16 * SIM_MAX_SUBSTEPS);
+} // namespace shaderio

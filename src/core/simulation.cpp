@@ -1,0 +1,241 @@
+#include "simulation.h"
+
+#include <cmath>
+
+namespace tender {
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+
+// Smooth 1-D value noise in [-1, 1]: hashed values at integer knots, smoothstep between them.
+double valueNoise(double x, uint32_t seed) {
+  auto knot = [seed](int64_t i) {
+    uint32_t h = uint32_t(i) * 747796405u + seed * 2891336453u;
+    h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
+    h = (h >> 22u) ^ h;
+    return double(h) / 2147483647.5 - 1.0;
+  };
+  double f = std::floor(x);
+  double t = x - f, s = t * t * (3.0 - 2.0 * t);
+  return knot(int64_t(f)) * (1.0 - s) + knot(int64_t(f) + 1) * s;
+}
+
+double fractalNoise(double t, uint32_t seed) {
+  return 0.65 * valueNoise(t * 0.6, seed) + 0.35 * valueNoise(t * 1.7, seed + 101u);
+}
+
+} // namespace
+
+WindSample windAt(WindKind kind, double t, float amplitude) {
+  WindSample w;
+  double a = amplitude;
+  if (kind == WindKind::Sinusoid) {
+    // 1.3 Hz + 2.7 Hz in X, 0.7 Hz in Y, 1.1 Hz + 3.1 Hz in Z, over a steady breeze towards +Z.
+    double x = 0.6 * std::sin(kTwoPi * 1.3 * t) + 0.3 * std::sin(kTwoPi * 2.7 * t + 1.0);
+    double y = 0.2 * std::sin(kTwoPi * 0.7 * t);
+    double z = 0.5 + 0.6 * std::sin(kTwoPi * 1.1 * t + 0.5) + 0.25 * std::sin(kTwoPi * 3.1 * t + 2.0);
+    double twist = 0.5 * std::sin(kTwoPi * 0.9 * t + 0.3);
+    w.uniform = glm::vec3(float(a * x), float(a * y), float(a * z));
+    w.twist = glm::vec3(0.0f, 0.0f, float(a * twist));
+  } else {
+    // Smooth noise gusts in every direction, stronger across the sheet (Z).
+    w.uniform = glm::vec3(float(a * 0.8 * fractalNoise(t, 1u)), float(a * 0.3 * fractalNoise(t, 2u)),
+                          float(a * (0.3 + 1.0 * fractalNoise(t, 3u))));
+    w.twist = glm::vec3(0.0f, 0.0f, float(a * 0.8 * fractalNoise(t, 4u)));
+  }
+  return w;
+}
+
+Simulation::Simulation(const SimParams& params, Solver& solver) : params_(params), solver_(solver) {
+  rebuild(params);
+}
+
+void Simulation::setLiveParams(const SimParams& p) {
+  bool wind_changed = p.wind != params_.wind;
+  params_ = p;
+  if (wind_changed) wind_ = p.wind;
+}
+
+void Simulation::rebuild(const SimParams& p) {
+  params_ = p;
+  topo_ = buildSheet(params_);
+  solver_.upload(topo_);
+  wind_ = params_.wind;
+  pins_ = params_.pins != PinMode::None;
+  grab_index_ = release_index_ = SIM_NONE;
+  reset_frame_ = 0;
+  physics_ticks_ = 0;
+  accumulator_ = 0.0;
+}
+
+void Simulation::setScript(InputScript script) {
+  script_ = std::move(script);
+  next_event_ = 0;
+  while (next_event_ < script_.events.size() && script_.events[next_event_].tick < frame_) ++next_event_;
+}
+
+void Simulation::apply(const ScriptEvent& e) {
+  auto flip = [](Toggle t, bool cur) { return t == Toggle::Flip ? !cur : t == Toggle::On; };
+  switch (e.kind) {
+  case EventKind::GrabParticle:
+    if (e.particle < topo_.particleCount()) grabParticle(e.particle);
+    break;
+  case EventKind::GrabRay: grabRay(e.a, e.b); break;
+  case EventKind::Move: moveGrab(e.a); break;
+  case EventKind::Release: release(); break;
+  case EventKind::Wind: wind_ = flip(e.toggle, wind_); break;
+  case EventKind::Pins: pins_ = flip(e.toggle, pins_); break;
+  case EventKind::Pause: paused_ = flip(e.toggle, paused_); break;
+  case EventKind::Reset: reset(); break;
+  }
+}
+
+void Simulation::grabParticle(uint32_t i) {
+  glm::vec3 p = solver_.particlePosition(i);
+  grab_index_ = i;
+  grab_from_ = grab_to_ = p;
+  grab_history_.fill(p);
+  grab_ticks_ = 0;
+  release_index_ = SIM_NONE;
+}
+
+bool Simulation::grabRay(glm::vec3 origin, glm::vec3 dir) {
+  dir = glm::normalize(dir);
+  shaderio::PickResult r = solver_.pick(origin, dir, params_.grab_radius);
+  if (r.index == SIM_NONE) return false;
+  grabParticle(r.index);
+  // The particle follows the cursor: it moves onto the ray at its nearest point.
+  grab_to_ = origin + dir * r.t;
+  return true;
+}
+
+void Simulation::moveGrab(glm::vec3 target) {
+  if (grab_index_ != SIM_NONE) grab_to_ = target;
+}
+
+void Simulation::release() {
+  if (grab_index_ == SIM_NONE) return;
+  if (params_.release == ReleaseMode::DragVelocity) {
+    // Average drag velocity over the last few ticks (the cursor moves less often than ticks run).
+    uint32_t n = std::min<uint32_t>(grab_ticks_, uint32_t(grab_history_.size()) - 1);
+    glm::vec3 oldest = grab_history_[(grab_ticks_ - n) % grab_history_.size()];
+    release_velocity_ = n > 0 ? (grab_to_ - oldest) / (float(n) * params_.tickDt()) : glm::vec3(0.0f);
+    release_index_ = grab_index_;
+  }
+  grab_index_ = SIM_NONE;
+}
+
+void Simulation::reset() {
+  grab_index_ = release_index_ = SIM_NONE;
+  solver_.beginReset();
+  reset_frame_ = SIM_RESET_FRAMES;
+}
+
+shaderio::SimUniforms Simulation::makeUniforms() const {
+  const SimParams& p = params_;
+  shaderio::SimUniforms u{};
+  u.particle_count = topo_.particleCount();
+  u.cols = topo_.cols;
+  u.rows = topo_.rows;
+  u.substeps = p.substeps;
+  u.constraint_count = topo_.constraintCount();
+  u.triangle_count = topo_.triangleCount();
+  u.hash_mask = topo_.hash_size - 1;
+  u.color_count = topo_.colorCount();
+  u.dt = p.substepDt();
+  u.damping = p.damping;
+  u.gravity = p.gravity;
+  u.floor_y = p.floor_y;
+  u.restitution = p.restitution;
+  u.friction = p.friction;
+  u.collision_radius = p.collisionRadius();
+  u.inv_cell = 1.0f / p.cell_size;
+  u.collision_stiffness = p.collision_stiffness;
+  u.tear_factor = p.tear_factor;
+  u.tear_kinds = (p.tear_structural ? 1u << SIM_KIND_STRUCTURAL : 0u) | (p.tear_shear ? 1u << SIM_KIND_SHEAR : 0u) |
+                 (p.tear_bend ? (1u << SIM_KIND_BEND) | (1u << SIM_KIND_TRIBEND) : 0u);
+  u.flags = (p.collision ? SIM_FLAG_COLLISION : 0u) | (pins_ ? SIM_FLAG_PINS : 0u);
+  u.stiffness = glm::vec4(p.stiffness, p.stiffness, p.bend_stiffness, p.bend_stiffness);
+  u.reset_active = reset_frame_ > 0 ? 1u : 0u;
+  u.reset_alpha = reset_frame_ > 0 ? float(SIM_RESET_FRAMES - reset_frame_ + 1) / float(SIM_RESET_FRAMES) : 0.0f;
+  u.iterations = p.iterations;
+
+  const double t0 = double(physics_ticks_) / double(p.tick_hz);
+  const double dts = 1.0 / (double(p.tick_hz) * p.substeps);
+  const float amp = wind_ ? p.wind_strength * p.wind_scale : 0.0f;
+  u.grab_index = grab_index_ != SIM_NONE ? grab_index_ : release_index_;
+  for (uint32_t s = 0; s < p.substeps; ++s) {
+    WindSample w = amp > 0.0f ? windAt(p.wind_kind, t0 + double(s + 1) * dts, amp) : WindSample{};
+    u.wind[s] = glm::vec4(w.uniform, 0.0f);
+    u.wind_twist[s] = glm::vec4(w.twist, 0.0f);
+    if (grab_index_ != SIM_NONE) {
+      // The target moves from where it was at the last tick to the newest cursor position.
+      float f1 = float(s + 1) / float(p.substeps), f0 = float(s) / float(p.substeps);
+      glm::vec3 target = glm::mix(grab_from_, grab_to_, f1);
+      glm::vec3 prev = p.release == ReleaseMode::DragVelocity ? glm::mix(grab_from_, grab_to_, f0) : target;
+      u.grab_target[s] = glm::vec4(target, 1.0f);
+      u.grab_prev[s] = glm::vec4(prev, 1.0f);
+    } else if (release_index_ != SIM_NONE && s == 0) {
+      // A toss: the first substep after release sets the drag velocity, then the particle is free.
+      glm::vec3 prev = grab_to_ - release_velocity_ * float(dts);
+      u.grab_target[s] = glm::vec4(grab_to_, 1.0f);
+      u.grab_prev[s] = glm::vec4(prev, 1.0f);
+    }
+  }
+  return u;
+}
+
+void Simulation::runPhysicsTick() {
+  solver_.tick(makeUniforms());
+  ++physics_ticks_;
+  release_index_ = SIM_NONE;
+  if (grab_index_ != SIM_NONE) {
+    grab_from_ = grab_to_;
+    ++grab_ticks_;
+    grab_history_[grab_ticks_ % grab_history_.size()] = grab_to_;
+  }
+}
+
+void Simulation::runResetFrame() {
+  solver_.tick(makeUniforms());
+  --reset_frame_;
+}
+
+void Simulation::applyDueEvents() {
+  while (next_event_ < script_.events.size() && script_.events[next_event_].tick <= frame_)
+    apply(script_.events[next_event_++]);
+}
+
+bool Simulation::tick() {
+  applyDueEvents();
+  ++frame_;
+  if (reset_frame_ > 0) {
+    runResetFrame();
+    return false;
+  }
+  if (paused_) return false;
+  runPhysicsTick();
+  return true;
+}
+
+int Simulation::advance(float frame_dt) {
+  applyDueEvents();
+  ++frame_;
+  if (reset_frame_ > 0) {
+    runResetFrame();
+    accumulator_ = 0.0;
+    return 0;
+  }
+  if (paused_) return 0;
+  accumulator_ += std::min(double(frame_dt), double(params_.max_frame_dt));
+  int n = 0;
+  const double step = 1.0 / double(params_.tick_hz);
+  while (accumulator_ >= step) {
+    runPhysicsTick();
+    accumulator_ -= step;
+    ++n;
+  }
+  return n;
+}
+
+} // namespace tender

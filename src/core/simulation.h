@@ -1,0 +1,98 @@
+#pragma once
+/// The controller shared by every program: input state (grab, wind, pins, pause, reset), the
+/// fixed-step accumulator, input scripts, and the per-tick uniforms handed to a Solver.
+#include <array>
+#include <memory>
+
+#include "params.h"
+#include "script.h"
+#include "sheet.h"
+#include "solver.h"
+
+namespace tender {
+
+/// Wind acceleration at time t: uniform part and the part scaled by (u - 0.5) across the sheet.
+struct WindSample {
+  glm::vec3 uniform{0.0f};
+  glm::vec3 twist{0.0f};
+};
+/// Wind of the given kind at time t (seconds), amplitude in units/s^2.
+WindSample windAt(WindKind kind, double t, float amplitude);
+
+class Simulation {
+public:
+  /// Builds the sheet and uploads it to the solver (params must be valid).
+  Simulation(const SimParams& params, Solver& solver);
+
+  const SimParams& params() const { return params_; }
+  const SheetTopology& topology() const { return topo_; }
+  Solver& solver() { return solver_; }
+
+  /// Changes parameters that need no rebuild (damping, iterations, wind, tear factor, ...).
+  void setLiveParams(const SimParams& p);
+  /// Changes parameters and rebuilds the sheet (grid size, spacing, pins, constraint families).
+  void rebuild(const SimParams& p);
+
+  /// Attaches a script; its events apply as ticks reach them.
+  void setScript(InputScript script);
+  /// Applies one input event now.
+  void apply(const ScriptEvent& e);
+
+  /// Grabs particle i at its current position.
+  void grabParticle(uint32_t i);
+  /// Grabs the nearest particle within grab_radius of the ray; returns false when none is near.
+  bool grabRay(glm::vec3 origin, glm::vec3 dir);
+  /// Moves the grab target (world units).
+  void moveGrab(glm::vec3 target);
+  /// Releases the grabbed particle (zero velocity or drag velocity, per params).
+  void release();
+  void setWind(bool on) { wind_ = on; }
+  void setPins(bool on) { pins_ = on; }
+  void setPaused(bool on) { paused_ = on; }
+  /// Starts the animated reset (SIM_RESET_FRAMES frames).
+  void reset();
+
+  bool wind() const { return wind_; }
+  bool pins() const { return pins_; }
+  bool paused() const { return paused_; }
+  bool resetting() const { return reset_frame_ > 0; }
+  uint32_t grabbed() const { return grab_index_; }
+  glm::vec3 grabTarget() const { return grab_to_; }
+
+  /// One frame of headless time: the script's events for this tick, then one physics tick (or one
+  /// reset frame, or nothing when paused). Returns true when the solver ran physics.
+  bool tick();
+  /// Real-time frame: clamps dt, runs as many fixed ticks as the accumulator holds (one reset
+  /// frame while resetting). Returns the number of physics ticks run.
+  int advance(float frame_dt);
+
+  /// Ticks (frames) seen so far, the clock of scripts.
+  uint64_t frameCount() const { return frame_; }
+  /// Physics ticks run so far (the wind's clock).
+  uint64_t physicsTicks() const { return physics_ticks_; }
+  /// Uniforms of the next physics tick (for tests and tools).
+  shaderio::SimUniforms makeUniforms() const;
+
+private:
+  void runPhysicsTick();
+  void runResetFrame();
+  void applyDueEvents();
+
+  SimParams params_;
+  Solver& solver_;
+  SheetTopology topo_;
+  InputScript script_;
+  size_t next_event_ = 0;
+  bool wind_ = true, pins_ = true, paused_ = false;
+  uint32_t grab_index_ = SIM_NONE;
+  glm::vec3 grab_from_{0.0f}, grab_to_{0.0f};
+  std::array<glm::vec3, 4> grab_history_{}; ///< grab target at the last ticks, for the drag velocity
+  uint32_t grab_ticks_ = 0;
+  uint32_t release_index_ = SIM_NONE;       ///< particle released with drag velocity at the next tick
+  glm::vec3 release_velocity_{0.0f};
+  uint32_t reset_frame_ = 0;                ///< frames left in the animated reset
+  uint64_t frame_ = 0, physics_ticks_ = 0;
+  double accumulator_ = 0.0;
+};
+
+} // namespace tender

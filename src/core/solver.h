@@ -1,0 +1,56 @@
+#pragma once
+/// The interface both solvers implement, and the state they read back.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sheet.h"
+
+namespace tender {
+
+/// A solver's full state, read back for tests, stats and files.
+struct SimState {
+  std::vector<glm::vec4> pos, prev;                 ///< w = inverse mass of the last substep
+  std::vector<glm::vec4> normal;                    ///< from the last normals pass
+  std::vector<shaderio::Constraint> constraints;    ///< live constraints, colour ranges compacted in place
+  std::vector<ColorRange> colors;                   ///< first stays, count shrinks as constraints tear
+  std::vector<uint32_t> torn;                       ///< per original constraint id: 1 when torn
+  std::vector<glm::uvec4> triangles;                ///< live triangles (first triangle_count entries)
+  uint32_t triangle_count = 0;
+};
+
+/// Per-pass GPU times of the last measured tick, in milliseconds.
+struct PassTimes {
+  std::vector<std::pair<std::string, double>> ms;
+};
+
+/// A simulation backend: the CPU reference or the Vulkan compute solver.
+/// Both run the same passes in the same order on the same arrays.
+class Solver {
+public:
+  virtual ~Solver() = default;
+  /// Backend name ("cpu", "gpu").
+  virtual std::string name() const = 0;
+  /// (Re)initialises every array from the topology: particles at rest, all constraints alive.
+  virtual void upload(const SheetTopology& topo) = 0;
+  /// Runs one tick (all substeps) with these inputs; reset_active ticks run the reset pass only.
+  virtual void tick(const shaderio::SimUniforms& u) = 0;
+  /// Starts an animated reset: the current positions become the reset source, constraints and
+  /// triangles are restored.
+  virtual void beginReset() = 0;
+  /// Recomputes the normals (once per frame, before drawing or reading back).
+  virtual void computeNormals() = 0;
+  /// Nearest particle to the ray o + t d (|d| = 1) within radius, or SIM_NONE.
+  virtual shaderio::PickResult pick(glm::vec3 o, glm::vec3 d, float radius) = 0;
+  /// Position of one particle (a small read-back, used when a grab starts).
+  virtual glm::vec3 particlePosition(uint32_t index) = 0;
+  /// Copies the whole state to the host.
+  virtual void readback(SimState& out) = 0;
+  /// GPU time per pass of the last tick (empty on the CPU).
+  virtual PassTimes passTimes() const { return {}; }
+  /// Dispatches (or pass invocations) recorded per tick.
+  virtual uint32_t dispatchesPerTick() const { return 0; }
+};
+
+} // namespace tender

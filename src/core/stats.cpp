@@ -1,0 +1,90 @@
+#include "stats.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+namespace tender {
+
+const char* kindName(uint32_t kind) {
+  static const char* names[] = {"structural", "shear", "bend", "tri_bend"};
+  return kind < 4 ? names[kind] : "?";
+}
+
+uint64_t hashPositions(const std::vector<glm::vec4>& pos) {
+  uint64_t h = 1469598103934665603ull;
+  auto bytes = reinterpret_cast<const unsigned char*>(pos.data());
+  for (size_t i = 0, n = pos.size() * sizeof(glm::vec4); i < n; ++i) h = (h ^ bytes[i]) * 1099511628211ull;
+  return h;
+}
+
+SheetStats computeStats(const SimState& s, float substep_dt) {
+  SheetStats st;
+  st.particles = uint32_t(s.pos.size());
+  st.colors = uint32_t(s.colors.size());
+  for (uint32_t t : s.torn) st.torn += t ? 1u : 0u;
+  st.triangles = s.triangle_count;
+  st.state_hash = hashPositions(s.pos);
+  st.bbox_min = glm::vec3(INFINITY);
+  st.bbox_max = glm::vec3(-INFINITY);
+  for (size_t i = 0; i < s.pos.size(); ++i) {
+    glm::vec3 p(s.pos[i]);
+    bool finite = true;
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(p[k])) ++st.nan_count, finite = false;
+    if (!finite) continue;
+    st.bbox_min = glm::min(st.bbox_min, p);
+    st.bbox_max = glm::max(st.bbox_max, p);
+    if (i < s.prev.size()) st.max_speed = std::max(st.max_speed, glm::length(p - glm::vec3(s.prev[i])) / substep_dt);
+  }
+  for (const ColorRange& r : s.colors)
+    for (uint32_t k = r.first; k < r.first + r.count; ++k) {
+      const auto& c = s.constraints[k];
+      uint32_t kind = c.kind_id & SIM_KIND_MASK;
+      st.constraints[kind]++;
+      if (kind == SIM_KIND_STRUCTURAL) {
+        float len = glm::length(glm::vec3(s.pos[c.b]) - glm::vec3(s.pos[c.a]));
+        if (std::isfinite(len)) st.max_stretch = std::max(st.max_stretch, len / c.rest);
+      }
+    }
+  return st;
+}
+
+nlohmann::json statsJson(const SheetStats& s) {
+  nlohmann::json j;
+  j["particles"] = s.particles;
+  nlohmann::json cs;
+  uint32_t total = 0;
+  for (uint32_t k = 0; k < 4; ++k) cs[kindName(k)] = s.constraints[k], total += s.constraints[k];
+  cs["total"] = total;
+  j["constraints"] = cs;
+  j["colors"] = s.colors;
+  j["torn"] = s.torn;
+  j["triangles"] = s.triangles;
+  char hash[17];
+  snprintf(hash, sizeof(hash), "%016llx", static_cast<unsigned long long>(s.state_hash));
+  j["state_hash"] = hash;
+  j["bbox_min"] = {s.bbox_min.x, s.bbox_min.y, s.bbox_min.z};
+  j["bbox_max"] = {s.bbox_max.x, s.bbox_max.y, s.bbox_max.z};
+  j["max_stretch"] = s.max_stretch;
+  j["max_speed"] = s.max_speed;
+  j["nan_count"] = s.nan_count;
+  return j;
+}
+
+bool writePly(const std::string& path, const SimState& s) {
+  std::ofstream f(path, std::ios::binary);
+  if (!f) return false;
+  f << "ply\nformat binary_little_endian 1.0\ncomment Tender receipt sheet\n"
+    << "element vertex " << s.pos.size() << "\nproperty float x\nproperty float y\nproperty float z\n"
+    << "element face " << s.triangle_count << "\nproperty list uchar uint vertex_indices\nend_header\n";
+  for (const glm::vec4& p : s.pos) f.write(reinterpret_cast<const char*>(&p), 12);
+  for (uint32_t k = 0; k < s.triangle_count; ++k) {
+    const unsigned char three = 3;
+    f.write(reinterpret_cast<const char*>(&three), 1);
+    f.write(reinterpret_cast<const char*>(&s.triangles[k]), 12);
+  }
+  return bool(f);
+}
+
+} // namespace tender

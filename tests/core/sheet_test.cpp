@@ -1,0 +1,91 @@
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "core/sheet.h"
+
+using namespace tender;
+
+TEST(Sheet, CountsMatchTheSpecFor32x48) {
+  SheetTopology t = buildSheet(*presetParams("tender"));
+  EXPECT_EQ(t.particleCount(), 1536u);
+  EXPECT_EQ(t.kind_counts[SIM_KIND_STRUCTURAL], 2992u);
+  EXPECT_EQ(t.kind_counts[SIM_KIND_SHEAR], 2914u);
+  EXPECT_EQ(t.kind_counts[SIM_KIND_BEND], 2912u);
+  EXPECT_EQ(t.kind_counts[SIM_KIND_TRIBEND], 0u);
+  EXPECT_EQ(t.triangleCount(), 2914u);
+  EXPECT_EQ(t.constraintCount(), 2992u + 2914u + 2912u);
+}
+
+TEST(Sheet, CrumpleHasTriangleBending) {
+  SheetTopology t = buildSheet(*presetParams("crumple"));
+  EXPECT_EQ(t.particleCount(), 2400u);
+  EXPECT_EQ(t.kind_counts[SIM_KIND_BEND], 0u);
+  // One per interior structural edge: (W-1)(H-2) horizontal + (W-2)(H-1) vertical.
+  EXPECT_EQ(t.kind_counts[SIM_KIND_TRIBEND], 39u * 58u + 38u * 59u);
+}
+
+// No two constraints of one colour share a particle; ranges tile the array.
+static void expectValidColoring(const SheetTopology& t) {
+  uint32_t next = 0;
+  for (const ColorRange& r : t.colors) {
+    EXPECT_EQ(r.first, next);
+    next = r.first + r.count;
+    std::set<uint32_t> seen;
+    for (uint32_t k = r.first; k < r.first + r.count; ++k) {
+      EXPECT_TRUE(seen.insert(t.constraints[k].a).second) << "colour shares particle " << t.constraints[k].a;
+      EXPECT_TRUE(seen.insert(t.constraints[k].b).second) << "colour shares particle " << t.constraints[k].b;
+    }
+  }
+  EXPECT_EQ(next, t.constraintCount());
+}
+
+TEST(Coloring, NoSharedParticleWithinColor) {
+  for (auto [w, h] : {std::pair{1u, 2u}, {2u, 2u}, {37u, 53u}, {32u, 48u}, {1u, 1u}, {5u, 1u}}) {
+    for (const char* preset : {"tender", "crumple"}) {
+      SimParams p = *presetParams(preset);
+      p.cols = w;
+      p.rows = h;
+      SCOPED_TRACE(std::string(preset) + " " + std::to_string(w) + "x" + std::to_string(h));
+      expectValidColoring(buildSheet(p));
+    }
+  }
+}
+
+TEST(Coloring, GridNeedsTwelveColours) {
+  // An interior particle has 12 constraints, so 12 colours is optimal; greedy reaches it.
+  EXPECT_EQ(buildSheet(*presetParams("tender")).colorCount(), 12u);
+}
+
+TEST(Sheet, AdjacencyIsSymmetricAndFromConstraints) {
+  SimParams p = *presetParams("tender");
+  p.cols = 7;
+  p.rows = 9;
+  SheetTopology t = buildSheet(p);
+  for (auto& c : t.constraints) {
+    EXPECT_TRUE(t.adjacent(c.a, c.b));
+    EXPECT_TRUE(t.adjacent(c.b, c.a));
+  }
+  EXPECT_FALSE(t.adjacent(0, 7 * 2 + 1)); // (1,2): a knight's move away, not connected
+}
+
+TEST(Sheet, TrianglesAreCounterClockwiseFromFront) {
+  SheetTopology t = buildSheet(*presetParams("tender"));
+  for (auto& tri : t.triangles) {
+    glm::vec3 a(t.rest_pos[tri.x]), b(t.rest_pos[tri.y]), c(t.rest_pos[tri.z]);
+    EXPECT_GT(glm::cross(b - a, c - a).z, 0.0f);
+  }
+}
+
+TEST(Sheet, PinsAndPlacement) {
+  SimParams p = *presetParams("tender");
+  SheetTopology t = buildSheet(p);
+  std::vector<uint32_t> pins;
+  for (uint32_t i = 0; i < t.particleCount(); ++i)
+    if (t.rest_pos[i].w > 0.5f) pins.push_back(i);
+  EXPECT_EQ(pins, (std::vector<uint32_t>{0, 16, 31}));
+  float lowest = 1e9f;
+  for (auto& r : t.rest_pos) lowest = std::min(lowest, r.y);
+  EXPECT_GT(lowest, p.floor_y + 1.0f);
+  EXPECT_TRUE(buildSheet(*presetParams("crumple")).rest_pos[39].w > 0.5f);
+}
