@@ -51,6 +51,8 @@ public:
   virtual PassTimes passTimes() const { return {}; }
   /// Dispatches (or pass invocations) recorded per tick.
   virtual uint32_t dispatchesPerTick() const { return 0; }
+  /// Bytes of device (or host) memory the solver's arrays take.
+  virtual uint64_t memoryBytes() const { return 0; }
 };
 
 } // namespace tender
