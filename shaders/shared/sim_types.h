@@ -50,7 +50,7 @@ struct SimUniforms {
 
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
   vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet
-  vec4 grab_target[SIM_MAX_SUBSTEPS]; // grabbed particle position at each substep; w = 1 while held
+  vec4 grab_target[SIM_MAX_SUBSTEPS]; // grabbed particle position per substep; w: 0 free, 1 held, 2 tossed
   vec4 grab_prev[SIM_MAX_SUBSTEPS];   // its previous position (equal to target: zero velocity)
 };
 

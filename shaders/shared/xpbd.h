@@ -41,6 +41,25 @@ SIM_INLINE VerletState verletStep(vec4 pos, vec4 prev, vec3 accel, float damping
   return s;
 }
 
+/// One particle's integration at a substep. The grabbed particle (is_grabbed) follows grab_target
+/// when grab_target.w is 1 (held: infinite mass, previous position grab_prev) or is let go with the
+/// velocity grab_target - grab_prev when grab_target.w is 2 (a toss); otherwise damped Verlet.
+SIM_INLINE VerletState integrateParticle(vec4 pos, vec4 prev, vec4 rest, float u, bool is_grabbed, vec4 grab_target,
+                                         vec4 grab_prev, uint flags, float gravity, vec4 wind, vec4 wind_twist,
+                                         float damping, float dt2) {
+  bool placed = is_grabbed && grab_target.w > 0.5f;
+  bool held = placed && grab_target.w < 1.5f;
+  float w = inverseMass(rest, held, flags);
+  VerletState s;
+  if (placed) {
+    s.pos = vec4(vec3(grab_target), w);
+    s.prev = vec4(vec3(grab_prev), w);
+  } else {
+    s = verletStep(pos, prev, externalAccel(gravity, wind, wind_twist, u), damping, dt2, w);
+  }
+  return s;
+}
+
 /// Projects one distance constraint; corrections are weighted by inverse mass (pos.w).
 SIM_INLINE PairDelta solveDistance(vec4 pa, vec4 pb, float rest, float stiffness) {
   PairDelta r;

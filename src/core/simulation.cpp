@@ -176,9 +176,9 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
       u.grab_target[s] = glm::vec4(target, 1.0f);
       u.grab_prev[s] = glm::vec4(prev, 1.0f);
     } else if (release_index_ != SIM_NONE && s == 0) {
-      // A toss: the first substep after release sets the drag velocity, then the particle is free.
+      // A toss: the first substep after release gives the particle the drag velocity and lets go.
       glm::vec3 prev = grab_to_ - release_velocity_ * float(dts);
-      u.grab_target[s] = glm::vec4(grab_to_, 1.0f);
+      u.grab_target[s] = glm::vec4(grab_to_, 2.0f);
       u.grab_prev[s] = glm::vec4(prev, 1.0f);
     }
   }

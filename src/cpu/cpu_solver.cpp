@@ -31,19 +31,12 @@ void CpuSolver::upload(const SheetTopology& topo) {
 
 void CpuSolver::integrate(const SimUniforms& u, uint32_t s) {
   const float dt2 = u.dt * u.dt;
-  const vec4 wind = u.wind[s], twist = u.wind_twist[s];
-  const bool grab_held = u.grab_index != SIM_NONE && u.grab_target[s].w > 0.5f;
+  const vec4 wind = u.wind[s], twist = u.wind_twist[s], target = u.grab_target[s], grab_prev = u.grab_prev[s];
   for (uint32_t i = 0, n = uint32_t(pos_.size()); i < n; ++i) {
-    const bool held = grab_held && i == u.grab_index;
-    const float w = inverseMass(rest_[i], held, u.flags);
-    if (held) {
-      pos_[i] = vec4(vec3(u.grab_target[s]), w);
-      prev_[i] = vec4(vec3(u.grab_prev[s]), w);
-    } else {
-      VerletState st = verletStep(pos_[i], prev_[i], externalAccel(u.gravity, wind, twist, uv_[i].x), u.damping, dt2, w);
-      pos_[i] = st.pos;
-      prev_[i] = st.prev;
-    }
+    VerletState st = integrateParticle(pos_[i], prev_[i], rest_[i], uv_[i].x, i == u.grab_index, target, grab_prev,
+                                       u.flags, u.gravity, wind, twist, u.damping, dt2);
+    pos_[i] = st.pos;
+    prev_[i] = st.prev;
   }
 }
 
