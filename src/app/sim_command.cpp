@@ -38,6 +38,7 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
     std::string error;
     auto s = loadScript(common.script, error);
     if (!s) return fail(error);
+    if (auto err = checkScript(*s, common.params.particleCount())) return fail(common.script + ": " + *err);
     script = *s;
   }
   int status = 0;

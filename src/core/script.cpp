@@ -95,15 +95,22 @@ std::optional<InputScript> parseScript(const std::string& text, std::string& err
 
 std::optional<InputScript> loadScript(const std::string& path, std::string& error) {
   std::ifstream f(path, std::ios::binary);
-  if (!f) {
+  std::stringstream ss;
+  if (!f || !(ss << f.rdbuf())) {
     error = "cannot read script '" + path + "'";
     return std::nullopt;
   }
-  std::stringstream ss;
-  ss << f.rdbuf();
   auto s = parseScript(ss.str(), error);
   if (!s) error = path + ": " + error;
   return s;
+}
+
+std::optional<std::string> checkScript(const InputScript& script, uint32_t particle_count) {
+  for (const ScriptEvent& e : script.events)
+    if (e.kind == EventKind::GrabParticle && e.particle >= particle_count)
+      return "tick " + std::to_string(e.tick) + ": particle " + std::to_string(e.particle) + " does not exist (the sheet has " +
+             std::to_string(particle_count) + ")";
+  return std::nullopt;
 }
 
 std::string formatEvent(const ScriptEvent& e) {

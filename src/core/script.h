@@ -44,6 +44,8 @@ struct InputScript {
 std::optional<InputScript> parseScript(const std::string& text, std::string& error);
 /// Reads and parses a script file; errors name the file.
 std::optional<InputScript> loadScript(const std::string& path, std::string& error);
+/// Checks a script against a sheet: particle indices must exist. Returns an error message.
+std::optional<std::string> checkScript(const InputScript& script, uint32_t particle_count);
 /// Formats one event as a script line.
 std::string formatEvent(const ScriptEvent& e);
 

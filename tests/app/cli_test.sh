@@ -36,7 +36,10 @@ printf '0 grab particle 5\n3 jump\n' >"$tmp/bad.txt"
 expect_bad "${sim[@]}" --script "$tmp/bad.txt"
 printf '5 release\n2 reset\n' >"$tmp/order.txt"
 expect_bad "${sim[@]}" --script "$tmp/order.txt"
-expect_bad "${sim[@]}" --backend quantum
+expect_bad sim --backend quantum --ticks 2
+printf '0 grab particle 99999\n' >"$tmp/range.txt"
+expect_bad "${sim[@]}" --script "$tmp/range.txt"
+expect_bad "${sim[@]}" --script /
 expect_bad sim --ticks -5
 expect_bad sim --bogus-flag
 
