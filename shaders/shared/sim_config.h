@@ -54,5 +54,18 @@
 #define SIM_BIND_SCRATCH 19
 #define SIM_BIND_PICK 20
 #define SIM_BIND_RESET_FROM 21
+#define SIM_BIND_CELL_SCATTER 22
+#define SIM_BIND_COMPACT_TMP 23
+#define SIM_BIND_CELL_POS 24
+
+// Elements one workgroup of the block scan covers
+#define SIM_SCAN_BLOCK (SIM_WG_SCAN * SIM_SCAN_PER_THREAD)
+// Workgroup size of the fused small-sheet substep (integrate + every colour in one workgroup)
+#define SIM_WG_FUSED 256
+// Largest sheet the fused substep takes: its positions fill 32 KiB of shared memory (vec4 each)
+#define SIM_FUSED_MAX_PARTICLES 2048
+
+// Largest workgroup count in X of one dispatch; bigger grids spill into Y
+#define SIM_MAX_GROUPS_X 65535u
 
 #endif

@@ -82,4 +82,24 @@ struct PickResult {
   float t;    // ray parameter of the point nearest to the particle
 };
 
+/// Push constants of the scan passes (block scan and block-sum add).
+struct ScanPush {
+  uint mode;   // SIM_SCAN_HASH: cell_count -> cell_start; SIM_SCAN_SCRATCH: in place in scratch
+  uint offset; // first element in scratch (SIM_SCAN_SCRATCH)
+  uint count;  // elements to scan
+  uint sums;   // scratch offset of the per-block sums
+};
+#define SIM_SCAN_HASH 0u
+#define SIM_SCAN_SCRATCH 1u
+
+/// Push constants of the pick passes: a ray and a radius.
+struct PickPush {
+  vec4 origin_radius; // xyz ray origin, w pick radius
+  vec4 dir;           // xyz unit direction
+  uint count;         // particle count
+  uint pad0;
+  uint pad1;
+  uint pad2;
+};
+
 #endif

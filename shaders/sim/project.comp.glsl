@@ -1,0 +1,16 @@
+#version 460
+// Projects the live constraints of one colour (no two share a particle, so no races).
+// Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
+#define SIM_LOCAL_SIZE SIM_WG_PROJECT
+#include "sim_common.glsl"
+layout(push_constant) uniform PushBlock { SimPush p; };
+
+void main() {
+  uint t = threadIndex();
+  uvec2 range = color_range[p.color];
+  if (t >= range.y) return; // beyond the live count of this colour
+  Constraint c = constraints[range.x + t];
+  PairDelta d = solveDistance(pos[c.a], pos[c.b], c.rest, u.stiffness[c.kind_id & SIM_KIND_MASK]);
+  pos[c.a] += vec4(d.da, 0.0f);
+  pos[c.b] += vec4(d.db, 0.0f);
+}

@@ -1,0 +1,484 @@
+#include "context.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include <vulkan/vulkan.hpp>
+#include <vulkan/vulkan_to_string.hpp>
+
+namespace tender::gpu {
+
+std::string vkResultName(VkResult result) { return vk::to_string(vk::Result(result)); }
+
+void vkCheckFailed(VkResult result, const char* expr, const char* file, int line) {
+  std::fprintf(stderr, "tender: Vulkan error %s (%d) in %s at %s:%d\n", vkResultName(result).c_str(), int(result), expr,
+               file, line);
+  std::fflush(stderr);
+  std::abort();
+}
+
+void preferLavapipeForTests() {
+  if (!std::getenv("VK_DRIVER_FILES") && !std::getenv("VK_ICD_FILENAMES"))
+    setenv("VK_DRIVER_FILES", "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json", 0);
+}
+
+namespace {
+
+const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+const char* typeName(VkPhysicalDeviceType t) {
+  switch (t) {
+  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+    return "discrete";
+  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+    return "integrated";
+  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+    return "virtual";
+  case VK_PHYSICAL_DEVICE_TYPE_CPU:
+    return "cpu";
+  default:
+    return "other";
+  }
+}
+
+// Preference of a device type when no index is given: discrete first, CPU last.
+int typeRank(VkPhysicalDeviceType t) {
+  switch (t) {
+  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+    return 0;
+  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+    return 1;
+  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+    return 2;
+  case VK_PHYSICAL_DEVICE_TYPE_CPU:
+    return 3;
+  default:
+    return 4;
+  }
+}
+
+// Queue family with compute (and graphics when asked), preferring one that has timestamps.
+std::optional<uint32_t> findQueueFamily(VkPhysicalDevice pd, bool graphics) {
+  uint32_t n = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(pd, &n, nullptr);
+  std::vector<VkQueueFamilyProperties> fams(n);
+  vkGetPhysicalDeviceQueueFamilyProperties(pd, &n, fams.data());
+  std::optional<uint32_t> best;
+  for (uint32_t i = 0; i < n; ++i) {
+    VkQueueFlags need = VK_QUEUE_COMPUTE_BIT | (graphics ? VK_QUEUE_GRAPHICS_BIT : 0);
+    if ((fams[i].queueFlags & need) != need) continue;
+    if (!best || (fams[*best].timestampValidBits == 0 && fams[i].timestampValidBits > 0)) best = i;
+  }
+  return best;
+}
+
+DeviceInfo describe(VkPhysicalDevice pd, uint32_t index) {
+  VkPhysicalDeviceDriverProperties driver{};
+  driver.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES;
+  VkPhysicalDeviceProperties2 props2{};
+  props2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+  props2.pNext = &driver;
+  vkGetPhysicalDeviceProperties2(pd, &props2);
+  const VkPhysicalDeviceProperties& p = props2.properties;
+  VkPhysicalDeviceMemoryProperties mem{};
+  vkGetPhysicalDeviceMemoryProperties(pd, &mem);
+  DeviceInfo d;
+  d.index = index;
+  d.name = p.deviceName;
+  d.type = typeName(p.deviceType);
+  d.driver = std::string(driver.driverName);
+  if (driver.driverInfo[0]) d.driver += std::string(" ") + driver.driverInfo;
+  for (uint32_t h = 0; h < mem.memoryHeapCount; ++h)
+    if (mem.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+      d.memory_bytes = std::max<uint64_t>(d.memory_bytes, mem.memoryHeaps[h].size);
+  d.api_version = p.apiVersion;
+  d.usable = p.apiVersion >= VK_API_VERSION_1_3 && findQueueFamily(pd, false).has_value();
+  return d;
+}
+
+bool hasLayer(const char* name) {
+  uint32_t n = 0;
+  vkEnumerateInstanceLayerProperties(&n, nullptr);
+  std::vector<VkLayerProperties> layers(n);
+  vkEnumerateInstanceLayerProperties(&n, layers.data());
+  for (auto& l : layers)
+    if (std::strcmp(l.layerName, name) == 0) return true;
+  return false;
+}
+
+bool hasInstanceExtension(const char* name) {
+  uint32_t n = 0;
+  vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr);
+  std::vector<VkExtensionProperties> exts(n);
+  vkEnumerateInstanceExtensionProperties(nullptr, &n, exts.data());
+  for (auto& e : exts)
+    if (std::strcmp(e.extensionName, name) == 0) return true;
+  return false;
+}
+
+bool hasDeviceExtension(VkPhysicalDevice pd, const std::string& name) {
+  uint32_t n = 0;
+  vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, nullptr);
+  std::vector<VkExtensionProperties> exts(n);
+  vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, exts.data());
+  for (auto& e : exts)
+    if (name == e.extensionName) return true;
+  return false;
+}
+
+// A bare instance for enumeration; VK_NULL_HANDLE and a message when the loader finds nothing.
+VkInstance createBareInstance(std::string& error) {
+  VkApplicationInfo app{};
+  app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+  app.pApplicationName = "tender";
+  app.apiVersion = VK_API_VERSION_1_3;
+  VkInstanceCreateInfo ci{};
+  ci.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+  ci.pApplicationInfo = &app;
+  VkInstance inst = VK_NULL_HANDLE;
+  VkResult r = vkCreateInstance(&ci, nullptr, &inst);
+  if (r != VK_SUCCESS) {
+    error = "no Vulkan driver found (vkCreateInstance: " + vkResultName(r) + ")";
+    return VK_NULL_HANDLE;
+  }
+  return inst;
+}
+
+std::vector<VkPhysicalDevice> physicalDevices(VkInstance inst) {
+  uint32_t n = 0;
+  if (vkEnumeratePhysicalDevices(inst, &n, nullptr) != VK_SUCCESS) return {};
+  std::vector<VkPhysicalDevice> pds(n);
+  if (vkEnumeratePhysicalDevices(inst, &n, pds.data()) < 0) return {};
+  pds.resize(n);
+  return pds;
+}
+
+} // namespace
+
+Result<std::vector<DeviceInfo>> listDevices() {
+  std::string error;
+  VkInstance inst = createBareInstance(error);
+  if (!inst) return Result<std::vector<DeviceInfo>>::failure(error);
+  std::vector<DeviceInfo> out;
+  auto pds = physicalDevices(inst);
+  for (uint32_t i = 0; i < pds.size(); ++i) out.push_back(describe(pds[i], i));
+  vkDestroyInstance(inst, nullptr);
+  if (out.empty()) return Result<std::vector<DeviceInfo>>::failure("no Vulkan device found");
+  return out;
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL VulkanContext::debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                            VkDebugUtilsMessageTypeFlagsEXT,
+                                                            const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                            void* user) {
+  auto* self = static_cast<VulkanContext*>(user);
+  if (severity < VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) return VK_FALSE;
+  self->validation_messages_.fetch_add(1);
+  if (!self->quiet_)
+    std::fprintf(stderr, "tender: validation %s: %s\n",
+                 severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning",
+                 data && data->pMessage ? data->pMessage : "(no message)");
+  return VK_FALSE;
+}
+
+Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOptions& o) {
+  using R = Result<std::unique_ptr<VulkanContext>>;
+  std::unique_ptr<VulkanContext> ctx(new VulkanContext());
+  ctx->validation_ = o.validation;
+  ctx->quiet_ = o.quiet;
+
+  // Instance: layers, extensions, the debug messenger chained for creation-time messages.
+  std::vector<const char*> layers, inst_exts;
+  for (auto& e : o.instance_extensions) inst_exts.push_back(e.c_str());
+  if (o.validation) {
+    if (!hasLayer(kValidationLayer))
+      return R::failure("validation requested but VK_LAYER_KHRONOS_validation is not installed");
+    layers.push_back(kValidationLayer);
+  }
+  const bool debug_utils = o.validation && hasInstanceExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  if (debug_utils) inst_exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  for (auto* e : inst_exts)
+    if (std::strcmp(e, VK_EXT_DEBUG_UTILS_EXTENSION_NAME) != 0 && !hasInstanceExtension(e))
+      return R::failure(std::string("Vulkan instance extension ") + e + " is not available");
+
+  VkDebugUtilsMessengerCreateInfoEXT dbg{};
+  dbg.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+  dbg.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  dbg.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                    VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+  dbg.pfnUserCallback = &VulkanContext::debugCallback;
+  dbg.pUserData = ctx.get();
+
+  VkValidationFeatureEnableEXT sync_feature = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+  VkValidationFeaturesEXT features{};
+  features.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
+  features.enabledValidationFeatureCount = 1;
+  features.pEnabledValidationFeatures = &sync_feature;
+  features.pNext = debug_utils ? &dbg : nullptr;
+
+  VkApplicationInfo app{};
+  app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+  app.pApplicationName = "tender";
+  app.pEngineName = "tender";
+  app.apiVersion = VK_API_VERSION_1_3;
+  VkInstanceCreateInfo ici{};
+  ici.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+  ici.pApplicationInfo = &app;
+  ici.enabledLayerCount = uint32_t(layers.size());
+  ici.ppEnabledLayerNames = layers.data();
+  ici.enabledExtensionCount = uint32_t(inst_exts.size());
+  ici.ppEnabledExtensionNames = inst_exts.data();
+  if (o.validation && o.sync_validation)
+    ici.pNext = &features;
+  else if (debug_utils)
+    ici.pNext = &dbg;
+  VkResult r = vkCreateInstance(&ici, nullptr, &ctx->instance_);
+  if (r != VK_SUCCESS) {
+    ctx->instance_ = VK_NULL_HANDLE;
+    return R::failure("no Vulkan driver found (vkCreateInstance: " + vkResultName(r) + ")");
+  }
+  if (debug_utils) {
+    auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(ctx->instance_, "vkCreateDebugUtilsMessengerEXT"));
+    if (create_messenger) VK_CHECK(create_messenger(ctx->instance_, &dbg, nullptr, &ctx->messenger_));
+  }
+
+  // Physical device: the given index, or the best-ranked usable one.
+  auto pds = physicalDevices(ctx->instance_);
+  if (pds.empty()) return R::failure("no Vulkan device found");
+  int chosen = -1;
+  if (o.device >= 0) {
+    if (o.device >= int(pds.size()))
+      return R::failure("no Vulkan device " + std::to_string(o.device) + " (there are " + std::to_string(pds.size()) +
+                        "; see `tender devices`)");
+    DeviceInfo d = describe(pds[size_t(o.device)], uint32_t(o.device));
+    if (!d.usable)
+      return R::failure("Vulkan device " + std::to_string(o.device) + " (" + d.name + ") lacks Vulkan 1.3 compute");
+    chosen = o.device;
+  } else {
+    int best_rank = 1 << 30;
+    for (uint32_t i = 0; i < pds.size(); ++i) {
+      DeviceInfo d = describe(pds[i], i);
+      if (!d.usable || (o.graphics && !findQueueFamily(pds[i], true))) continue;
+      VkPhysicalDeviceProperties p;
+      vkGetPhysicalDeviceProperties(pds[i], &p);
+      if (typeRank(p.deviceType) < best_rank) {
+        best_rank = typeRank(p.deviceType);
+        chosen = int(i);
+      }
+    }
+    if (chosen < 0) return R::failure("no Vulkan 1.3 device with a compute queue found");
+  }
+  ctx->physical_ = pds[size_t(chosen)];
+  ctx->info_ = describe(ctx->physical_, uint32_t(chosen));
+  vkGetPhysicalDeviceProperties(ctx->physical_, &ctx->props_);
+  vkGetPhysicalDeviceMemoryProperties(ctx->physical_, &ctx->mem_props_);
+  auto family = findQueueFamily(ctx->physical_, o.graphics);
+  if (!family)
+    return R::failure("Vulkan device " + ctx->info_.name + " has no " + (o.graphics ? "graphics+compute" : "compute") +
+                      " queue");
+  ctx->queue_family_ = *family;
+  {
+    uint32_t n = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(ctx->physical_, &n, nullptr);
+    std::vector<VkQueueFamilyProperties> fams(n);
+    vkGetPhysicalDeviceQueueFamilyProperties(ctx->physical_, &n, fams.data());
+    ctx->timestamp_bits_ = fams[*family].timestampValidBits;
+  }
+  ctx->timestamp_period_ = ctx->props_.limits.timestampPeriod;
+
+  // Device: Vulkan 1.3 synchronization2 and dynamic rendering, plus the requested extensions.
+  std::vector<const char*> dev_exts;
+  for (auto& e : o.device_extensions) {
+    if (!hasDeviceExtension(ctx->physical_, e))
+      return R::failure("Vulkan device extension " + e + " is not available on " + ctx->info_.name);
+    dev_exts.push_back(e.c_str());
+  }
+  VkPhysicalDeviceVulkan13Features f13{};
+  f13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
+  VkPhysicalDeviceVulkan12Features f12{};
+  f12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+  f12.pNext = &f13;
+  VkPhysicalDeviceFeatures2 f2{};
+  f2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+  f2.pNext = &f12;
+  vkGetPhysicalDeviceFeatures2(ctx->physical_, &f2);
+  if (!f13.synchronization2) return R::failure("Vulkan device " + ctx->info_.name + " lacks synchronization2");
+  VkPhysicalDeviceVulkan13Features en13{};
+  en13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
+  en13.synchronization2 = VK_TRUE;
+  en13.dynamicRendering = f13.dynamicRendering;
+  en13.maintenance4 = f13.maintenance4;
+  VkPhysicalDeviceVulkan12Features en12{};
+  en12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+  en12.pNext = &en13;
+  en12.hostQueryReset = f12.hostQueryReset;
+  en12.timelineSemaphore = f12.timelineSemaphore;
+  en12.scalarBlockLayout = f12.scalarBlockLayout;
+  VkPhysicalDeviceFeatures2 en2{};
+  en2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+  en2.pNext = &en12;
+  en2.features.samplerAnisotropy = f2.features.samplerAnisotropy;
+  en2.features.fillModeNonSolid = f2.features.fillModeNonSolid;
+  en2.features.depthClamp = f2.features.depthClamp;
+
+  float priority = 1.0f;
+  VkDeviceQueueCreateInfo qci{};
+  qci.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+  qci.queueFamilyIndex = ctx->queue_family_;
+  qci.queueCount = 1;
+  qci.pQueuePriorities = &priority;
+  VkDeviceCreateInfo dci{};
+  dci.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+  dci.pNext = &en2;
+  dci.queueCreateInfoCount = 1;
+  dci.pQueueCreateInfos = &qci;
+  dci.enabledExtensionCount = uint32_t(dev_exts.size());
+  dci.ppEnabledExtensionNames = dev_exts.data();
+  r = vkCreateDevice(ctx->physical_, &dci, nullptr, &ctx->device_);
+  if (r != VK_SUCCESS) {
+    ctx->device_ = VK_NULL_HANDLE;
+    return R::failure("cannot create the Vulkan device on " + ctx->info_.name + " (" + vkResultName(r) + ")");
+  }
+  vkGetDeviceQueue(ctx->device_, ctx->queue_family_, 0, &ctx->queue_);
+
+  VkCommandPoolCreateInfo pci{};
+  pci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pci.queueFamilyIndex = ctx->queue_family_;
+  VK_CHECK(vkCreateCommandPool(ctx->device_, &pci, nullptr, &ctx->pool_));
+  VkFenceCreateInfo fci{};
+  fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  VK_CHECK(vkCreateFence(ctx->device_, &fci, nullptr, &ctx->once_fence_));
+  return R(std::move(ctx));
+}
+
+VulkanContext::~VulkanContext() {
+  if (device_) {
+    vkDeviceWaitIdle(device_);
+    if (once_fence_) vkDestroyFence(device_, once_fence_, nullptr);
+    if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
+    vkDestroyDevice(device_, nullptr);
+  }
+  if (messenger_) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    if (destroy) destroy(instance_, messenger_, nullptr);
+  }
+  if (instance_) vkDestroyInstance(instance_, nullptr);
+}
+
+uint32_t VulkanContext::findMemoryType(uint32_t type_bits, VkMemoryPropertyFlags flags) const {
+  for (uint32_t i = 0; i < mem_props_.memoryTypeCount; ++i)
+    if ((type_bits & (1u << i)) && (mem_props_.memoryTypes[i].propertyFlags & flags) == flags) return i;
+  return UINT32_MAX;
+}
+
+Buffer VulkanContext::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags flags, bool map) {
+  Buffer b;
+  b.size = std::max<VkDeviceSize>(size, 16);
+  VkBufferCreateInfo bci{};
+  bci.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+  bci.size = b.size;
+  bci.usage = usage;
+  bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VK_CHECK(vkCreateBuffer(device_, &bci, nullptr, &b.buffer));
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device_, b.buffer, &req);
+  uint32_t type = findMemoryType(req.memoryTypeBits, flags);
+  if (type == UINT32_MAX && (flags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
+    type = findMemoryType(req.memoryTypeBits, 0); // no device-local type: take any
+  if (type == UINT32_MAX) vkCheckFailed(VK_ERROR_OUT_OF_DEVICE_MEMORY, "findMemoryType", __FILE__, __LINE__);
+  VkMemoryAllocateInfo mai{};
+  mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  mai.allocationSize = req.size;
+  mai.memoryTypeIndex = type;
+  VK_CHECK(vkAllocateMemory(device_, &mai, nullptr, &b.memory));
+  VK_CHECK(vkBindBufferMemory(device_, b.buffer, b.memory, 0));
+  if (map) VK_CHECK(vkMapMemory(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+  return b;
+}
+
+Buffer VulkanContext::createDeviceBuffer(VkDeviceSize size, VkBufferUsageFlags usage) {
+  return createBuffer(size, usage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, false);
+}
+
+Buffer VulkanContext::createHostBuffer(VkDeviceSize size, VkBufferUsageFlags usage) {
+  return createBuffer(size, usage, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, true);
+}
+
+void VulkanContext::destroyBuffer(Buffer& b) {
+  if (b.mapped) vkUnmapMemory(device_, b.memory);
+  if (b.buffer) vkDestroyBuffer(device_, b.buffer, nullptr);
+  if (b.memory) vkFreeMemory(device_, b.memory, nullptr);
+  b = Buffer{};
+}
+
+void VulkanContext::submitOnce(const std::function<void(VkCommandBuffer)>& record) {
+  VkCommandBufferAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  ai.commandPool = pool_;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VkCommandBuffer cmd;
+  VK_CHECK(vkAllocateCommandBuffers(device_, &ai, &cmd));
+  VkCommandBufferBeginInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+  // Everything submitted earlier on this queue finishes writing before these commands start.
+  VkMemoryBarrier2 mb{};
+  mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2;
+  mb.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+  mb.srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT;
+  mb.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+  mb.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
+  VkDependencyInfo dep{};
+  dep.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
+  dep.memoryBarrierCount = 1;
+  dep.pMemoryBarriers = &mb;
+  vkCmdPipelineBarrier2(cmd, &dep);
+  record(cmd);
+  // ... and later submissions (and host reads after the fence) see what these commands wrote.
+  mb.dstAccessMask |= VK_ACCESS_2_HOST_READ_BIT;
+  mb.dstStageMask |= VK_PIPELINE_STAGE_2_HOST_BIT;
+  vkCmdPipelineBarrier2(cmd, &dep);
+  VK_CHECK(vkEndCommandBuffer(cmd));
+  VkCommandBufferSubmitInfo cbi{};
+  cbi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO;
+  cbi.commandBuffer = cmd;
+  VkSubmitInfo2 si{};
+  si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2;
+  si.commandBufferInfoCount = 1;
+  si.pCommandBufferInfos = &cbi;
+  VK_CHECK(vkResetFences(device_, 1, &once_fence_));
+  VK_CHECK(vkQueueSubmit2(queue_, 1, &si, once_fence_));
+  VK_CHECK(vkWaitForFences(device_, 1, &once_fence_, VK_TRUE, UINT64_MAX));
+  vkFreeCommandBuffers(device_, pool_, 1, &cmd);
+}
+
+void VulkanContext::waitIdle() { VK_CHECK(vkQueueWaitIdle(queue_)); }
+
+void VulkanContext::upload(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset) {
+  if (size == 0) return;
+  Buffer staging = createHostBuffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  std::memcpy(staging.mapped, data, size_t(size));
+  submitOnce([&](VkCommandBuffer cmd) {
+    VkBufferCopy region{0, offset, size};
+    vkCmdCopyBuffer(cmd, staging.buffer, dst.buffer, 1, &region);
+  });
+  destroyBuffer(staging);
+}
+
+void VulkanContext::download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset) {
+  if (size == 0) return;
+  Buffer staging = createHostBuffer(size, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  submitOnce([&](VkCommandBuffer cmd) {
+    VkBufferCopy region{offset, 0, size};
+    vkCmdCopyBuffer(cmd, src.buffer, staging.buffer, 1, &region);
+  });
+  std::memcpy(data, staging.mapped, size_t(size));
+  destroyBuffer(staging);
+}
+
+} // namespace tender::gpu

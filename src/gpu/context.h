@@ -1,0 +1,174 @@
+#pragma once
+/// The Vulkan base shared by the simulation and the renderer: instance, device, one queue, a
+/// command pool, buffers, one-shot submissions, validation with a message counter.
+///
+/// How the renderer uses it: fill ContextOptions with `graphics = true`, the surface instance
+/// extensions (VK_KHR_surface + the platform one, e.g. from glfwGetRequiredInstanceExtensions)
+/// and the device extension VK_KHR_swapchain, call VulkanContext::create(), create its surface
+/// from `instance()`, then build a GpuSolver on the same context (`GpuSolver(ctx)`). Solver and
+/// renderer share `queue()`: the solver's submissions end with a compute → vertex-input barrier,
+/// so a frame submitted after a tick reads the solver's buffers (pos, normal, uv, triangles,
+/// counters.draw_args) directly, with no copy. Vulkan 1.3 synchronization2 and dynamic rendering
+/// are enabled on the device.
+#include <atomic>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+namespace tender::gpu {
+
+/// Prints the VkResult name, the call, file and line, then aborts (never reached on success).
+[[noreturn]] void vkCheckFailed(VkResult result, const char* expr, const char* file, int line);
+/// Name of a VkResult ("VK_ERROR_DEVICE_LOST").
+std::string vkResultName(VkResult result);
+
+/// Checks a Vulkan call in every build type (Release too).
+#define VK_CHECK(expr)                                                                                                 \
+  do {                                                                                                                 \
+    VkResult vk_check_result_ = (expr);                                                                                \
+    if (vk_check_result_ != VK_SUCCESS) ::tender::gpu::vkCheckFailed(vk_check_result_, #expr, __FILE__, __LINE__);     \
+  } while (0)
+
+/// A value or a one-line error message (C++20 has no std::expected).
+template <class T>
+class Result {
+public:
+  /// A success holding `value`.
+  Result(T value) : v_(std::move(value)) {}
+  /// A failure with a one-line message.
+  static Result failure(std::string message) {
+    Result r;
+    r.v_ = Error{std::move(message)};
+    return r;
+  }
+  /// True on success.
+  explicit operator bool() const { return std::holds_alternative<T>(v_); }
+  /// The value (success only).
+  T& value() { return std::get<T>(v_); }
+  T& operator*() { return value(); }
+  T* operator->() { return &value(); }
+  /// The message (failure only).
+  const std::string& error() const { return std::get<Error>(v_).message; }
+
+private:
+  struct Error {
+    std::string message;
+  };
+  Result() = default;
+  std::variant<Error, T> v_;
+};
+
+/// How to create the context.
+struct ContextOptions {
+  int device = -1;                              ///< index as `tender devices` lists; -1 = prefer discrete
+  bool validation = false;                      ///< VK_LAYER_KHRONOS_validation
+  bool sync_validation = true;                  ///< with validation: synchronization validation too
+  bool graphics = false;                        ///< the queue must support graphics as well as compute
+  bool quiet = false;                           ///< do not print validation messages (still counted)
+  std::vector<std::string> instance_extensions; ///< e.g. VK_KHR_surface for the renderer
+  std::vector<std::string> device_extensions;   ///< e.g. VK_KHR_swapchain for the renderer
+};
+
+/// One physical device as `tender devices` shows it.
+struct DeviceInfo {
+  uint32_t index = 0; ///< enumeration order (the --device value)
+  std::string name;
+  std::string type;          ///< "discrete", "integrated", "virtual", "cpu", "other"
+  std::string driver;        ///< driver name and info
+  uint64_t memory_bytes = 0; ///< largest device-local heap
+  uint32_t api_version = 0;
+  bool usable = false; ///< Vulkan 1.3 with a compute queue
+};
+
+/// Lists the Vulkan devices, or fails with one line when Vulkan or a device is missing.
+Result<std::vector<DeviceInfo>> listDevices();
+
+/// A buffer with its own memory; `mapped` is set for host-visible buffers.
+struct Buffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceSize size = 0;
+  void* mapped = nullptr;
+};
+
+/// Instance, device, queue, command pool and helpers. Not copyable; destroy after every user.
+class VulkanContext {
+public:
+  /// Creates the context; fails with one line (no device, no Vulkan 1.3, missing layer).
+  static Result<std::unique_ptr<VulkanContext>> create(const ContextOptions& options);
+  ~VulkanContext();
+  VulkanContext(const VulkanContext&) = delete;
+  VulkanContext& operator=(const VulkanContext&) = delete;
+
+  VkInstance instance() const { return instance_; }
+  VkPhysicalDevice physicalDevice() const { return physical_; }
+  VkDevice device() const { return device_; }
+  VkQueue queue() const { return queue_; }
+  uint32_t queueFamily() const { return queue_family_; }
+  /// Command pool of the queue family (command buffers may be reset individually).
+  VkCommandPool commandPool() const { return pool_; }
+  /// Nanoseconds per timestamp tick.
+  double timestampPeriod() const { return timestamp_period_; }
+  /// True when the queue supports timestamps.
+  bool timestampsSupported() const { return timestamp_bits_ > 0; }
+  const VkPhysicalDeviceProperties& properties() const { return props_; }
+  /// The chosen device as `tender devices` describes it.
+  const DeviceInfo& info() const { return info_; }
+  /// Validation warnings and errors reported so far (0 without validation).
+  uint32_t validationMessages() const { return validation_messages_.load(); }
+  bool validationEnabled() const { return validation_; }
+
+  /// Creates a buffer in device-local memory.
+  Buffer createDeviceBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
+  /// Creates a persistently mapped host-visible, host-coherent buffer.
+  Buffer createHostBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
+  /// Destroys a buffer and frees its memory (no-op on an empty one).
+  void destroyBuffer(Buffer& b);
+  /// Copies bytes into a device buffer through a staging buffer (waits for completion).
+  void upload(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset = 0);
+  /// Copies bytes out of a device buffer through a staging buffer (waits for completion).
+  void download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset = 0);
+  /// Records commands into a fresh command buffer, submits, and waits for the queue to finish them.
+  void submitOnce(const std::function<void(VkCommandBuffer)>& record);
+  /// Waits until the queue is idle.
+  void waitIdle();
+  /// Memory type index with these properties, or UINT32_MAX.
+  uint32_t findMemoryType(uint32_t type_bits, VkMemoryPropertyFlags flags) const;
+
+private:
+  VulkanContext() = default;
+  Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags flags, bool map);
+  static VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                      VkDebugUtilsMessageTypeFlagsEXT types,
+                                                      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);
+
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queue_family_ = 0;
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkFence once_fence_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceProperties props_{};
+  VkPhysicalDeviceMemoryProperties mem_props_{};
+  DeviceInfo info_;
+  double timestamp_period_ = 1.0;
+  uint32_t timestamp_bits_ = 0;
+  bool validation_ = false, quiet_ = false;
+  std::atomic<uint32_t> validation_messages_{0};
+};
+
+/// Sets VK_DRIVER_FILES to lavapipe when it is unset (tests: results independent of the machine).
+void preferLavapipeForTests();
+
+} // namespace tender::gpu

@@ -1,0 +1,190 @@
+// Recording of the simulation passes: one tick reads like the algorithm of DESIGN.md §3.
+#include <cassert>
+
+#include "gpu/barriers.h"
+#include "gpu/gpu_solver.h"
+
+namespace tender::gpu {
+
+using namespace shaderio;
+
+void GpuSolver::bindSet(VkCommandBuffer cmd, uint32_t uniform_slot) {
+  uint32_t offset = uint32_t(uniform_slot * uniform_stride_);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 1, &offset);
+  bound_ = VK_NULL_HANDLE;
+}
+
+template <class Push>
+void GpuSolver::dispatchThreads(VkCommandBuffer cmd, const ComputePipeline& p, uint32_t count, const Push& push) {
+  assert(sizeof(Push) == p.push_size);
+  if (sizeof(Push) != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
+  if (count == 0) return;
+  if (bound_ != p.pipeline) {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+    bound_ = p.pipeline;
+  }
+  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Push), &push);
+  // Grids wider than SIM_MAX_GROUPS_X spill into Y (the shaders linearise the group index).
+  const uint32_t groups = (count + p.workgroup - 1) / p.workgroup;
+  const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X);
+  vkCmdDispatch(cmd, gx, (groups + gx - 1) / gx, 1);
+  ++recorded_dispatches_;
+}
+
+void GpuSolver::dispatchWorkgroup(VkCommandBuffer cmd, const ComputePipeline& p, const SimPush& push) {
+  if (sizeof(push) != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
+  if (bound_ != p.pipeline) {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+    bound_ = p.pipeline;
+  }
+  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+  vkCmdDispatch(cmd, 1, 1, 1);
+  ++recorded_dispatches_;
+}
+
+void GpuSolver::dispatchIndirect(VkCommandBuffer cmd, const ComputePipeline& p, const void* push, uint32_t push_size) {
+  if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
+  if (bound_ != p.pipeline) {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+    bound_ = p.pipeline;
+  }
+  if (push_size) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_size, push);
+  vkCmdDispatchIndirect(cmd, buf_[SIM_BIND_COUNTERS].buffer, offsetof(Counters, compact_dispatch));
+  ++recorded_dispatches_;
+}
+
+void GpuSolver::recordScan(VkCommandBuffer cmd, uint32_t mode, uint32_t offset, uint32_t count, uint32_t sums,
+                           bool indirect) {
+  // Exclusive scan: block scans, then (several blocks) scan the block sums and add them back.
+  const uint32_t blocks = (count + SIM_SCAN_BLOCK - 1) / SIM_SCAN_BLOCK;
+  ScanPush push{mode, offset, count, sums};
+  if (indirect)
+    dispatchIndirect(cmd, pipes_.scan, &push, sizeof(push));
+  else
+    dispatchThreads(cmd, pipes_.scan, count, push);
+  computeToCompute(cmd);
+  if (blocks <= 1) return;
+  recordScan(cmd, SIM_SCAN_SCRATCH, sums, blocks, sums + blocks, indirect);
+  if (indirect)
+    dispatchIndirect(cmd, pipes_.scan_add, &push, sizeof(push));
+  else
+    dispatchThreads(cmd, pipes_.scan_add, count, push);
+  computeToCompute(cmd);
+}
+
+void GpuSolver::timestamp(VkCommandBuffer cmd, Slot& slot, Category c) {
+  if (!slot.queries) return;
+  // Query k closes interval k - 1, which belongs to category c.
+  const uint32_t q = uint32_t(slot.categories.size()) + 1;
+  if (q >= query_capacity_) return;
+  vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, q);
+  slot.categories.push_back(uint8_t(c));
+}
+
+void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
+  VkCommandBuffer cmd = slot.tick;
+  VK_CHECK(vkResetCommandBuffer(cmd, 0));
+  VkCommandBufferBeginInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+  const uint32_t n = topo_.particleCount(), m = topo_.constraintCount();
+  recorded_dispatches_ = 0;
+  slot.categories.clear();
+  if (slot.queries) {
+    vkCmdResetQueryPool(cmd, slot.queries, 0, query_capacity_);
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, 0);
+  }
+  anyToCompute(cmd); // earlier submissions (previous tick, copies, the renderer) are done
+  bindSet(cmd, index);
+  SimPush all{0, n, 0, 0};
+  for (uint32_t s = 0; s < key.substeps; ++s) {
+    all.substep = s;
+    if (key.fused) {
+      // 1 + 2. Small sheet: integration and all colours in one workgroup
+      dispatchWorkgroup(cmd, pipes_.substep_fused, all);
+      computeToCompute(cmd);
+    } else {
+      // 1. Verlet integration
+      dispatchThreads(cmd, pipes_.integrate, n, all);
+      computeToCompute(cmd);
+      timestamp(cmd, slot, kIntegrate);
+      // 2. Gauss-Seidel over colours; constraints beyond a colour's live count exit
+      for (uint32_t it = 0; it < key.iterations; ++it)
+        for (uint32_t c = 0; c < topo_.colorCount(); ++c) {
+          const ColorRange& range = topo_.colors[c];
+          if (range.count == 0) continue;
+          dispatchThreads(cmd, pipes_.project, range.count, SimPush{range.first, range.count, s, c});
+          computeToCompute(cmd);
+        }
+    }
+    timestamp(cmd, slot, kProject);
+    if (key.collision) {
+      // 3. Spatial hash: count, scan, scatter, order within bucket; then gather repulsion
+      dispatchThreads(cmd, pipes_.hash_count, n, all);
+      computeToCompute(cmd);
+      recordScan(cmd, SIM_SCAN_HASH, 0, topo_.hash_size, hash_sums_, false);
+      dispatchThreads(cmd, pipes_.hash_scatter, n, all);
+      computeToCompute(cmd);
+      dispatchThreads(cmd, pipes_.hash_sort, n, all);
+      computeToCompute(cmd);
+      timestamp(cmd, slot, kHash);
+      dispatchThreads(cmd, pipes_.collide, n, all);
+      computeToCompute(cmd);
+      timestamp(cmd, slot, kCollide);
+    }
+    // 4. Collision deltas and ground contact
+    dispatchThreads(cmd, pipes_.floor, n, all);
+    computeToCompute(cmd);
+    timestamp(cmd, slot, kFloor);
+    // 5. Tear marking; the compaction runs zero workgroups unless something tore this substep
+    if (m > 0) {
+      dispatchThreads(cmd, pipes_.tear_mark, m, SimPush{0, m, s, 0});
+      computeToCompute(cmd);
+      dispatchIndirect(cmd, pipes_.tear_flags, nullptr, 0);
+      computeToCompute(cmd);
+      recordScan(cmd, SIM_SCAN_SCRATCH, 0, tear_slots_, tear_sums_, true);
+      dispatchIndirect(cmd, pipes_.tear_compact, nullptr, 0);
+      computeToCompute(cmd);
+    }
+    timestamp(cmd, slot, kTear);
+  }
+  computeToAll(cmd); // the renderer and copies see this tick
+  VK_CHECK(vkEndCommandBuffer(cmd));
+  slot.recorded = key;
+  slot.dispatches = recorded_dispatches_;
+}
+
+void GpuSolver::recordReset(Slot& slot, uint32_t index) {
+  VkCommandBuffer cmd = slot.reset;
+  VkCommandBufferBeginInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+  anyToCompute(cmd);
+  bindSet(cmd, index);
+  const uint32_t n = topo_.particleCount();
+  dispatchThreads(cmd, pipes_.reset, n, SimPush{0, n, 0, 0});
+  computeToAll(cmd);
+  VK_CHECK(vkEndCommandBuffer(cmd));
+}
+
+void GpuSolver::recordNormals() {
+  VkCommandBuffer cmd = normals_cmd_;
+  VkCommandBufferBeginInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+  if (normals_queries_) vkCmdResetQueryPool(cmd, normals_queries_, 0, 2);
+  anyToCompute(cmd);
+  bindSet(cmd, kStaticSlot);
+  if (normals_queries_) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, normals_queries_, 0);
+  const uint32_t n = topo_.particleCount();
+  dispatchThreads(cmd, pipes_.normals, n, SimPush{0, n, 0, 0});
+  computeToAll(cmd);
+  if (normals_queries_) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, normals_queries_, 1);
+  VK_CHECK(vkEndCommandBuffer(cmd));
+}
+
+template void GpuSolver::dispatchThreads<SimPush>(VkCommandBuffer, const ComputePipeline&, uint32_t, const SimPush&);
+template void GpuSolver::dispatchThreads<ScanPush>(VkCommandBuffer, const ComputePipeline&, uint32_t, const ScanPush&);
+template void GpuSolver::dispatchThreads<PickPush>(VkCommandBuffer, const ComputePipeline&, uint32_t, const PickPush&);
+
+} // namespace tender::gpu

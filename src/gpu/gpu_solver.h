@@ -1,0 +1,169 @@
+#pragma once
+/// The Vulkan compute solver: the CPU reference's passes, in the same order, over storage buffers.
+/// One descriptor set holds every array (bindings in shaders/shared/sim_config.h); the tick's
+/// command buffers are recorded once and re-recorded only when substeps, iterations or the
+/// collision flag change; nothing is read back in the steady-state loop. Two ticks may be in
+/// flight: each has its own uniform slot, command buffer, fence and timestamp pool.
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/solver.h"
+#include "gpu/context.h"
+
+namespace tender::gpu {
+
+/// Options of the factory.
+struct GpuOptions {
+  int device = -1;         ///< Vulkan device index, -1 = prefer a discrete GPU
+  bool validation = false; ///< VK_LAYER_KHRONOS_validation with synchronization validation
+};
+
+/// Creates a GpuSolver with its own VulkanContext; nullptr and a one-line `error` when no usable
+/// Vulkan device exists.
+std::unique_ptr<Solver> createGpuSolver(const GpuOptions& options, std::string& error);
+
+/// A compute pipeline and what dispatching it needs.
+struct ComputePipeline {
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  uint32_t push_size = 0; ///< bytes of the shader's push-constant block (0: none)
+  uint32_t workgroup = 0; ///< local_size_x
+};
+
+/// Every pipeline of the simulation (one file per shader in shaders/sim/).
+struct SimPipelines {
+  ComputePipeline integrate, project, hash_count, scan, scan_add, hash_scatter, hash_sort, collide, floor, tear_mark,
+      tear_flags, tear_compact, normals, reset;
+  ComputePipeline substep_fused; ///< null when the device has under 32 KiB of shared memory
+  std::array<ComputePipeline, 3> pick;
+};
+
+/// The Solver on Vulkan compute. Per substep: integrate, project (one dispatch per colour, or the
+/// fused one-workgroup substep for small sheets), hash count/scan/scatter/sort, collide, floor,
+/// tear mark, and the tear compaction as indirect dispatches (zero workgroups when nothing tore).
+class GpuSolver final : public Solver {
+public:
+  /// A solver on an existing context (the renderer's); the context must outlive the solver.
+  explicit GpuSolver(VulkanContext& ctx);
+  /// A solver that owns its context.
+  explicit GpuSolver(std::unique_ptr<VulkanContext> ctx);
+  ~GpuSolver() override;
+  GpuSolver(const GpuSolver&) = delete;
+  GpuSolver& operator=(const GpuSolver&) = delete;
+
+  std::string name() const override { return "gpu"; }
+  void upload(const SheetTopology& topo) override;
+  void tick(const shaderio::SimUniforms& u) override;
+  void beginReset() override;
+  void computeNormals() override;
+  shaderio::PickResult pick(glm::vec3 o, glm::vec3 d, float radius) override;
+  glm::vec3 particlePosition(uint32_t index) override;
+  void readback(SimState& out) override;
+  PassTimes passTimes() const override;
+  uint32_t dispatchesPerTick() const override { return dispatches_per_tick_; }
+  uint64_t memoryBytes() const override;
+
+  /// The context the solver runs on.
+  VulkanContext& context() { return ctx_; }
+  /// Buffers the renderer binds directly (vertex pulling or vertex/index input).
+  VkBuffer positionBuffer() const { return buf_[SIM_BIND_POS].buffer; }
+  VkBuffer normalBuffer() const { return buf_[SIM_BIND_NORMAL].buffer; }
+  VkBuffer uvBuffer() const { return buf_[SIM_BIND_UV].buffer; }
+  /// Live triangles: uvec4 (xyz vertices, w = triangle id); draw with counters' draw_args.
+  VkBuffer triangleBuffer() const { return buf_[SIM_BIND_TRIANGLES].buffer; }
+  /// shaderio::Counters; draw_args (offset 32) is a VkDrawIndirectCommand of 3 x live triangles.
+  VkBuffer counterBuffer() const { return buf_[SIM_BIND_COUNTERS].buffer; }
+  /// Byte offset of draw_args in the counter buffer.
+  static constexpr VkDeviceSize kDrawArgsOffset = 32;
+  /// Reads the spatial hash of the last substep (tests): bucket starts (T + 1) and particles (N).
+  void readHash(std::vector<uint32_t>& cell_start, std::vector<uint32_t>& cell_particles);
+  /// The buffer of a binding (SIM_BIND_*), for tests and tools.
+  const Buffer& buffer(uint32_t binding) const { return buf_[binding]; }
+  /// Allows (default) or forbids the fused small-sheet substep; it is used when allowed, the
+  /// device has the shared memory, and the sheet has at most SIM_FUSED_MAX_PARTICLES particles.
+  void setFusedPath(bool allowed) { fused_allowed_ = allowed; }
+  /// True when ticks run the fused small-sheet substep.
+  bool usesFusedPath() const;
+  /// Waits until every submitted tick has finished.
+  void finish();
+
+private:
+  /// Tick command buffers in flight; each has its own uniform slot, fence and timestamp pool.
+  static constexpr uint32_t kSlots = 2;
+  /// Uniform slot of the normals and pick passes (static: written at upload).
+  static constexpr uint32_t kStaticSlot = kSlots;
+  static constexpr uint32_t kBindingCount = SIM_BIND_CELL_POS + 1;
+  /// Timestamp categories, in passTimes() order.
+  enum Category : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kCategoryCount };
+
+  struct RecordKey {
+    uint32_t substeps = 0, iterations = 0;
+    bool collision = false;
+    bool fused = false;
+    bool operator==(const RecordKey&) const = default;
+  };
+  struct Slot {
+    VkCommandBuffer tick = VK_NULL_HANDLE, reset = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    VkQueryPool queries = VK_NULL_HANDLE;
+    bool pending = false; ///< submitted, fence not yet waited
+    bool timed = false;   ///< the pending submission is a tick with timestamps
+    std::optional<RecordKey> recorded;
+    std::vector<uint8_t> categories; ///< category of each timestamp interval
+    uint32_t dispatches = 0;
+  };
+
+  void createPipelines();
+  void destroySheet();
+  void writeStaticUniforms();
+  void uploadMutable(VkCommandBuffer cmd, std::vector<Buffer>& staging);
+  void recordTick(Slot& slot, uint32_t index, const RecordKey& key);
+  void recordReset(Slot& slot, uint32_t index);
+  void recordNormals();
+  void bindSet(VkCommandBuffer cmd, uint32_t uniform_slot);
+  template <class Push>
+  void dispatchThreads(VkCommandBuffer cmd, const ComputePipeline& p, uint32_t count, const Push& push);
+  void dispatchWorkgroup(VkCommandBuffer cmd, const ComputePipeline& p, const shaderio::SimPush& push);
+  void dispatchIndirect(VkCommandBuffer cmd, const ComputePipeline& p, const void* push, uint32_t push_size);
+  void recordScan(VkCommandBuffer cmd, uint32_t mode, uint32_t offset, uint32_t count, uint32_t sums, bool indirect);
+  void timestamp(VkCommandBuffer cmd, Slot& slot, Category c);
+  void waitSlot(Slot& slot) const;
+  void collectTimes(const Slot& slot) const;
+  void submit(VkCommandBuffer cmd, VkFence fence);
+  static uint32_t scanSumsSize(uint32_t count);
+
+  std::unique_ptr<VulkanContext> owned_ctx_;
+  VulkanContext& ctx_;
+  SheetTopology topo_;
+  bool uploaded_ = false;
+
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  SimPipelines pipes_;
+  std::vector<VkShaderModule> modules_;
+
+  std::array<Buffer, kBindingCount> buf_{};
+  Buffer small_readback_; ///< host-visible: pick result and particle positions
+  VkDeviceSize uniform_stride_ = 0;
+  uint32_t tear_slots_ = 0;                ///< constraints + triangles + 1: the compaction's scan length
+  uint32_t tear_sums_ = 0, hash_sums_ = 0; ///< scratch offsets of the per-block sums
+
+  mutable std::array<Slot, kSlots> slots_{};
+  uint32_t next_slot_ = 0;
+  int last_tick_slot_ = -1;
+  VkCommandBuffer normals_cmd_ = VK_NULL_HANDLE;
+  VkFence normals_fence_ = VK_NULL_HANDLE;
+  VkQueryPool normals_queries_ = VK_NULL_HANDLE;
+  mutable bool normals_pending_ = false;
+  uint32_t query_capacity_ = 0;
+  uint32_t dispatches_per_tick_ = 0;
+  VkPipeline bound_ = VK_NULL_HANDLE; ///< pipeline bound while recording
+  uint32_t recorded_dispatches_ = 0;
+  bool fused_allowed_ = true; ///< dispatches recorded into the current command buffer
+  mutable std::array<double, kCategoryCount> last_ms_{};
+};
+
+} // namespace tender::gpu
