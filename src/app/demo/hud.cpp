@@ -1,0 +1,164 @@
+#include "hud.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include <imgui.h>
+
+namespace tender::demo {
+namespace {
+
+constexpr const char* kSans = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+constexpr const char* kSansBold = "/usr/share/fonts/truetype/dejavu/DejaVuSans-Bold.ttf";
+// Seconds before the instruction line fades, and the fade's length.
+constexpr double kInstructionSeconds = 4.0;
+constexpr double kFadeSeconds = 1.0;
+
+ImU32 rgba(uint32_t rgb, float alpha = 1.0f) {
+  return IM_COL32((rgb >> 16) & 255, (rgb >> 8) & 255, rgb & 255, int(std::lround(alpha * 255.0f)));
+}
+
+// Latin-1 plus the punctuation the HUD prints (em dash, ellipsis).
+const ImWchar* glyphRanges() {
+  static const ImWchar ranges[] = {0x0020, 0x00FF, 0x2014, 0x2014, 0x2026, 0x2026, 0};
+  return ranges;
+}
+
+void textAt(ImDrawList* dl, ImFont* font, float size, ImVec2 pos, ImU32 color, const char* text) {
+  dl->AddText(font, size, pos, color, text);
+}
+
+} // namespace
+
+Hud::Hud(float scale) : scale_(scale) {
+  ImGuiIO& io = ImGui::GetIO();
+  for (const char* f : {kSans, kSansBold})
+    if (!std::filesystem::exists(f))
+      throw std::runtime_error(std::string("cannot load the HUD font '") + f + "' (install fonts-dejavu-core)");
+  body_ = io.Fonts->AddFontFromFileTTF(kSans, 15.0f * scale, nullptr, glyphRanges());
+  title_ = io.Fonts->AddFontFromFileTTF(kSansBold, 20.0f * scale, nullptr, glyphRanges());
+  big_ = io.Fonts->AddFontFromFileTTF(kSansBold, 44.0f * scale, nullptr, glyphRanges());
+  io.FontDefault = body_;
+  ImGui::StyleColorsLight();
+  ImGuiStyle& style = ImGui::GetStyle();
+  style.WindowRounding = 6.0f;
+  style.FrameRounding = 4.0f;
+  style.Colors[ImGuiCol_WindowBg].w = 0.88f;
+  style.ScaleAllSizes(scale);
+}
+
+HudActions Hud::draw(const HudState& s, SimParams& params) {
+  HudActions a;
+  ImGuiIO& io = ImGui::GetIO();
+  const ImVec2 size = io.DisplaySize;
+  const float m = 20.0f * scale_;
+  ImDrawList* dl = ImGui::GetBackgroundDrawList();
+  const float body = body_->FontSize;
+
+  // Title, top-left: 20 px semibold #444.
+  textAt(dl, title_, title_->FontSize, {m, m * 0.8f}, rgba(0x444444), "Tender");
+
+  if (s.init_alpha > 0.0f) {
+    // Loading: "Initialising…" centred with a progress bar, fading out once the simulation runs.
+    ImDrawList* fg = ImGui::GetForegroundDrawList();
+    const float al = s.init_alpha;
+    const char* text = "Initialising\xe2\x80\xa6";
+    ImVec2 ts = title_->CalcTextSizeA(title_->FontSize, FLT_MAX, 0.0f, text);
+    ImVec2 c{size.x * 0.5f, size.y * 0.5f};
+    fg->AddRectFilled({0.0f, 0.0f}, size, rgba(0xe4e0dc, al));
+    fg->AddText(title_, title_->FontSize, {c.x - ts.x * 0.5f, c.y - ts.y - 8.0f * scale_}, rgba(0x444444, al), text);
+    float w = 220.0f * scale_, h = 6.0f * scale_;
+    fg->AddRectFilled({c.x - w * 0.5f, c.y}, {c.x + w * 0.5f, c.y + h}, rgba(0x000000, 0.12f * al), h);
+    fg->AddRectFilled({c.x - w * 0.5f, c.y}, {c.x - w * 0.5f + w * s.init_progress, c.y + h}, rgba(0x444444, al), h);
+  }
+  if (s.init_progress < 1.0f) return a;
+
+  // Instruction line, centred at the bottom, fading out after 4 seconds.
+  double fade = 1.0 - std::clamp((s.seconds - kInstructionSeconds) / kFadeSeconds, 0.0, 1.0);
+  if (fade > 0.0) {
+    const char* text = params.release == ReleaseMode::DragVelocity
+                           ? "Click and drag to crumple \xc2\xb7 Right-drag to orbit"
+                           : "Click and drag to interact \xc2\xb7 Right-drag to orbit";
+    ImVec2 ts = body_->CalcTextSizeA(body, FLT_MAX, 0.0f, text);
+    textAt(dl, body_, body, {(size.x - ts.x) * 0.5f, size.y - m * 2.6f}, rgba(0x555555, float(fade)), text);
+  }
+  // Controls hint, bottom-left.
+  textAt(dl, body_, body * 0.9f, {m, size.y - m - body * 0.9f}, rgba(0x666666),
+         "R to Reset \xc2\xb7 W to toggle Wind \xc2\xb7 I to toggle FPS \xc2\xb7 P to toggle Pins \xc2\xb7 Space to "
+         "Pause");
+  // FPS, top-right, hidden until I.
+  if (s.show_fps) {
+    char fps[32];
+    std::snprintf(fps, sizeof(fps), "%.0f FPS", double(s.fps));
+    ImVec2 ts = body_->CalcTextSizeA(body, FLT_MAX, 0.0f, fps);
+    textAt(dl, body_, body, {size.x - m - ts.x, m}, rgba(0x444444), fps);
+  }
+
+  // Buttons for wind, reset and pins, bottom-right.
+  ImGui::SetNextWindowPos({size.x - m, size.y - m}, ImGuiCond_Always, {1.0f, 1.0f});
+  ImGui::Begin("##buttons", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav);
+  if (ImGui::Button(s.wind ? "Wind: on" : "Wind: off")) a.toggle_wind = true;
+  ImGui::SameLine();
+  if (ImGui::Button("Reset")) a.reset = true;
+  ImGui::SameLine();
+  if (ImGui::Button(s.pins ? "Pins: on" : "Pins: off")) a.toggle_pins = true;
+  ImGui::SameLine();
+  if (ImGui::Button(s.paused ? "Resume" : "Pause")) a.toggle_pause = true;
+  ImGui::End();
+
+  // The parameter panel, collapsed at first, under the FPS counter.
+  ImGui::SetNextWindowPos({size.x - m, m + body * 1.8f}, ImGuiCond_FirstUseEver, {1.0f, 0.0f});
+  ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize({320.0f * scale_, 0.0f}, ImGuiCond_FirstUseEver);
+  if (ImGui::Begin("Parameters", nullptr, ImGuiWindowFlags_NoSavedSettings)) {
+    if (ImGui::BeginCombo("preset", params.preset.c_str())) {
+      for (auto& name : presetNames())
+        if (ImGui::Selectable(name.c_str(), name == params.preset)) a.preset = name;
+      ImGui::EndCombo();
+    }
+    int substeps = int(params.substeps), iterations = int(params.iterations);
+    if (ImGui::SliderInt("substeps", &substeps, 1, SIM_MAX_SUBSTEPS))
+      params.substeps = uint32_t(substeps), a.live_changed = true;
+    if (ImGui::SliderInt("iterations", &iterations, 1, 32))
+      params.iterations = uint32_t(iterations), a.live_changed = true;
+    a.live_changed |= ImGui::SliderFloat("damping", &params.damping, 0.9f, 1.0f, "%.4f");
+    a.live_changed |= ImGui::SliderFloat("wind strength", &params.wind_strength, 0.0f, 5.0f, "%.2f");
+    a.live_changed |= ImGui::SliderFloat("tear factor", &params.tear_factor, 0.0f, 6.0f, "%.2f");
+    a.live_changed |= ImGui::Checkbox("collision", &params.collision);
+    int grid[2] = {int(params.cols), int(params.rows)};
+    if (ImGui::InputInt2("grid (cols, rows)", grid)) {
+      params.cols = uint32_t(std::clamp(grid[0], 2, 4096));
+      params.rows = uint32_t(std::clamp(grid[1], 2, 4096));
+    }
+    if (ImGui::Button("Rebuild sheet")) a.rebuild = true;
+    if (!s.device.empty()) ImGui::TextDisabled("%s", s.device.c_str());
+    if (s.triangles > 0) ImGui::Text("%u triangles", s.triangles);
+    if (s.times && !s.times->ms.empty() &&
+        ImGui::CollapsingHeader("GPU time per pass", ImGuiTreeNodeFlags_DefaultOpen)) {
+      double total = 0.0;
+      for (auto& [name, ms] : s.times->ms) {
+        ImGui::Text("%-10s %7.3f ms", name.c_str(), ms);
+        total += ms;
+      }
+      ImGui::Text("%-10s %7.3f ms", "total", total);
+    }
+  }
+  ImGui::End();
+
+  // Paused: 50% overlay with "PAUSED" centred.
+  if (s.paused) {
+    ImDrawList* fg = ImGui::GetForegroundDrawList();
+    fg->AddRectFilled({0.0f, 0.0f}, size, rgba(0x000000, 0.5f));
+    ImVec2 ts = big_->CalcTextSizeA(big_->FontSize, FLT_MAX, 0.0f, "PAUSED");
+    fg->AddText(big_, big_->FontSize, {(size.x - ts.x) * 0.5f, (size.y - ts.y) * 0.5f}, rgba(0xffffff), "PAUSED");
+  }
+  return a;
+}
+
+} // namespace tender::demo

@@ -1,0 +1,51 @@
+#pragma once
+/// The HUD over the scene (Dear ImGui): the spec's title, instruction line, controls hint, FPS,
+/// "Initialising…" progress, "PAUSED" overlay, buttons, and a parameter panel.
+#include <optional>
+#include <string>
+
+#include "core/params.h"
+#include "core/shaderio.h"
+#include "core/solver.h"
+
+struct ImFont;
+
+namespace tender::demo {
+
+/// What the HUD shows this frame.
+struct HudState {
+  float init_progress = 1.0f; ///< pipelines built, 0..1 (< 1: "Initialising…")
+  float init_alpha = 0.0f;    ///< opacity of "Initialising…" (fades out once the simulation starts)
+  double seconds = 0.0;       ///< since the simulation started
+  float fps = 0.0f;
+  bool show_fps = false, paused = false, wind = true, pins = true;
+  std::string device; ///< renderer device name
+  const PassTimes* times = nullptr;
+  uint32_t triangles = 0; ///< live triangles (0 when unknown)
+};
+
+/// What the user asked for through the HUD this frame.
+struct HudActions {
+  bool toggle_wind = false, reset = false, toggle_pins = false, toggle_pause = false;
+  bool live_changed = false;         ///< `params` changed in ways that need no rebuild
+  bool rebuild = false;              ///< `params` needs a rebuild (grid size)
+  std::optional<std::string> preset; ///< switch to this preset
+};
+
+/// Draws the HUD with Dear ImGui (the ImGui context must exist).
+class Hud {
+public:
+  /// Loads the TTF fonts at this UI scale (call before the font atlas is uploaded).
+  explicit Hud(float scale);
+  /// Draws the HUD; `params` is the panel's working copy of the parameters.
+  HudActions draw(const HudState& state, SimParams& params);
+
+private:
+  float scale_ = 1.0f;
+  ImFont* body_ = nullptr;
+  ImFont* title_ = nullptr;
+  ImFont* big_ = nullptr;
+  std::string instruction_;
+};
+
+} // namespace tender::demo

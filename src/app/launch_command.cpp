@@ -1,0 +1,71 @@
+// `tender` with no subcommand: the interactive demo (a separate program, so that `tender` itself
+// links no window system) when a display is there; otherwise a headless render to a PNG.
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+
+namespace tender {
+namespace {
+
+bool hasDisplay() {
+  for (const char* v : {"DISPLAY", "WAYLAND_DISPLAY"}) {
+    const char* s = std::getenv(v);
+    if (s && *s) return true;
+  }
+  return false;
+}
+
+// The arguments this process was started with.
+std::vector<std::string> ownArguments() {
+  std::ifstream f("/proc/self/cmdline", std::ios::binary);
+  std::string all((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  std::vector<std::string> args;
+  for (size_t i = 0; i < all.size();) {
+    size_t end = all.find('\0', i);
+    if (end == std::string::npos) end = all.size();
+    args.push_back(all.substr(i, end - i));
+    i = end + 1;
+  }
+  return args;
+}
+
+} // namespace
+
+int runDemo(const CommonOptions& common, const DemoOptions& o) {
+  std::error_code ec;
+  const std::filesystem::path demo = std::filesystem::read_symlink("/proc/self/exe", ec).parent_path() / "tender-demo";
+  if (hasDisplay()) {
+    if (!ec && std::filesystem::exists(demo)) {
+      std::vector<std::string> args = ownArguments();
+      if (args.empty()) args.push_back("tender");
+      args[0] = demo.string();
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(demo.c_str(), argv.data());
+      std::fprintf(stderr, "tender: cannot start %s; rendering headless instead\n", demo.c_str());
+    } else {
+      std::fprintf(stderr, "tender: this build has no tender-demo; rendering headless instead\n");
+    }
+  }
+  // No display: one picture of the preset after two seconds of simulation.
+  RenderOptions r;
+  r.width = o.width;
+  r.height = o.height;
+  r.ticks = uint64_t(2.0f * common.params.tick_hz);
+  r.out = "tender.png";
+  std::printf("tender: no display; rendering a picture instead\n");
+  int status = runRender(common, r);
+  if (status == 0) std::printf("tender: wrote %s\n", std::filesystem::absolute(r.out, ec).string().c_str());
+  return status;
+}
+
+} // namespace tender

@@ -1,0 +1,66 @@
+#pragma once
+/// The orbit camera of the scene: spherical coordinates around a target, perspective projection
+/// for Vulkan (y down in clip space, depth 0..1), picking rays and the grab plane.
+#include <optional>
+
+#include <glm/glm.hpp>
+
+namespace tender::render {
+
+/// A ray in world space (|dir| = 1).
+struct Ray {
+  glm::vec3 origin{0.0f};
+  glm::vec3 dir{0.0f, 0.0f, -1.0f};
+};
+
+/// Orbit camera: the eye sits at `radius` from `target`, at polar angle `phi` (from +Y) and
+/// azimuth `theta` (around +Y, from +Z towards +X), as three.js' Spherical does.
+class OrbitCamera {
+public:
+  /// Smallest and largest polar angle (keeps the eye off the poles).
+  static constexpr float kMinPhi = 0.1f;
+  static constexpr float kMaxPhi = 3.14159265f - 0.1f;
+  /// Zoom range (distance to the target).
+  static constexpr float kMinRadius = 3.0f;
+  static constexpr float kMaxRadius = 30.0f;
+  /// Vertical field of view in degrees.
+  static constexpr float kFovDegrees = 50.0f;
+
+  /// The spec's start view: eye at (6, 4, 10) looking at (0, 1, 0).
+  OrbitCamera();
+  /// Places the eye at `eye` looking at `target` (radius and phi clamped to their ranges).
+  void lookAt(glm::vec3 eye, glm::vec3 target);
+
+  /// Orbits by a cursor movement in pixels (right-drag).
+  void orbit(float dx_pixels, float dy_pixels);
+  /// Zooms by wheel steps (positive = closer), keeping the radius in [3, 30].
+  void zoom(float wheel_steps);
+  /// Pans the target by a cursor movement in pixels in a viewport of this height (middle-drag).
+  void pan(float dx_pixels, float dy_pixels, float viewport_height);
+
+  /// Eye position, target, spherical coordinates and distance.
+  glm::vec3 eye() const;
+  glm::vec3 target() const { return target_; }
+  float theta() const { return theta_; }
+  float phi() const { return phi_; }
+  float radius() const { return radius_; }
+  /// Unit vector from the eye towards the target.
+  glm::vec3 forward() const;
+
+  /// World to view matrix.
+  glm::mat4 view() const;
+  /// View to clip matrix for Vulkan (y flipped, depth in [0, 1]).
+  glm::mat4 projection(float aspect) const;
+  /// Ray through pixel (x, y) of a width x height viewport (origin top-left, pixel centres at +0.5).
+  Ray ray(float x, float y, float width, float height) const;
+
+private:
+  glm::vec3 target_{0.0f, 1.0f, 0.0f};
+  float radius_ = 1.0f, theta_ = 0.0f, phi_ = 1.0f;
+};
+
+/// Intersection of a ray with the plane through `point` with normal `normal`; nullopt when the
+/// ray is parallel to the plane or the plane is behind the origin.
+std::optional<glm::vec3> intersectPlane(const Ray& ray, glm::vec3 point, glm::vec3 normal);
+
+} // namespace tender::render

@@ -1,0 +1,55 @@
+#pragma once
+/// The receipt printed on the paper: its text per preset, and its rasterisation with FreeType
+/// into a 512 x 768 RGBA image (dark ink on off-white).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace tender::render {
+
+/// Size of the receipt texture in pixels.
+constexpr uint32_t kReceiptWidth = 512;
+constexpr uint32_t kReceiptHeight = 768;
+/// The monospace font the receipt is printed with.
+constexpr const char* kReceiptFont = "/usr/share/fonts/truetype/dejavu/DejaVuSansMono.ttf";
+
+/// One priced line of the receipt.
+struct ReceiptItem {
+  std::string name;
+  uint32_t cents = 0; ///< price; 0 with `value` set prints the value instead of a price
+  std::string value;  ///< non-price value (the crumple receipt's specification lines)
+};
+
+/// What a receipt says.
+struct ReceiptText {
+  std::string header;               ///< "PHYSICS DINER"
+  std::vector<std::string> address; ///< lines under the header
+  std::vector<ReceiptItem> items;   ///< nine menu items (or specification lines)
+  std::string total_label;          ///< "TOTAL"
+  std::string total_value;          ///< the sum of the items, formatted
+  std::vector<std::string> thanks;  ///< thank-you lines
+  std::string barcode;              ///< digits printed under the barcode
+};
+
+/// The receipt of a preset: the diner receipt, or the crumple preset's simulation receipt.
+ReceiptText receiptText(const std::string& preset);
+/// Price in cents formatted as "12.34".
+std::string formatPrice(uint32_t cents);
+
+/// Where one printed line landed (pixel rectangle, for tests).
+struct PrintedLine {
+  std::string text;
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+/// An RGBA8 image of the receipt, rows top to bottom.
+struct ReceiptImage {
+  uint32_t width = kReceiptWidth, height = kReceiptHeight;
+  std::vector<uint8_t> rgba;
+  std::vector<PrintedLine> lines; ///< every text line, divider and the barcode
+};
+
+/// Rasterises a receipt; throws std::runtime_error with one clear line when the font is missing.
+ReceiptImage rasterizeReceipt(const ReceiptText& text, const std::string& font_path = kReceiptFont);
+
+} // namespace tender::render

@@ -1,0 +1,145 @@
+// Golden images: small renders of presets on the CPU backend (deterministic) through the Vulkan
+// renderer on lavapipe, compared with committed PNGs.
+//
+// Tolerance: a pixel differs when a channel is off by more than 24 levels; at most 0.5% of the
+// pixels may differ and the mean absolute channel error must stay below 1.5 levels (rasteriser
+// and driver rounding, not a changed picture).
+// On failure the actual picture and a diff are written next to the test binary's working
+// directory as golden_<name>_actual.png and golden_<name>_diff.png.
+// Regenerate the goldens after an intended change with
+//   TENDER_UPDATE_GOLDEN=1 VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
+//     ./tests/tender_render_tests --gtest_filter='Golden.*'
+// and look at the new PNGs in tests/render/data before committing them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include "core/params.h"
+#include "gpu/context.h"
+#include "render/headless.h"
+
+using namespace tender;
+
+namespace {
+
+constexpr int kChannelTolerance = 24;
+constexpr double kMaxDifferentFraction = 0.005;
+constexpr double kMaxMeanError = 1.5;
+
+render::HeadlessResult renderPreset(const std::string& preset, uint64_t ticks, const std::string& script_text,
+                                    const std::string& backend = "cpu") {
+  gpu::preferLavapipeForTests();
+  render::HeadlessOptions o;
+  o.params = *presetParams(preset);
+  o.backend = backend;
+  o.validation = true;
+  o.ticks = ticks;
+  o.width = 320;
+  o.height = 240;
+  if (!script_text.empty()) {
+    std::string error;
+    auto s = parseScript(script_text, error);
+    EXPECT_TRUE(s.has_value()) << error;
+    if (s) o.script = *s;
+  }
+  return render::renderHeadless(o);
+}
+
+void compareWithGolden(const std::string& name, const render::Picture& actual) {
+  const std::string golden_path = std::string(TENDER_TEST_DATA) + "/golden_" + name + ".png";
+  if (const char* u = std::getenv("TENDER_UPDATE_GOLDEN"); u && std::string(u) == "1") {
+    ASSERT_TRUE(render::writePng(golden_path, actual));
+    GTEST_SKIP() << "wrote " << golden_path;
+  }
+  render::Picture golden = render::readPng(golden_path);
+  ASSERT_FALSE(golden.rgba.empty()) << "missing golden " << golden_path << " (TENDER_UPDATE_GOLDEN=1 writes it)";
+  ASSERT_EQ(golden.width, actual.width);
+  ASSERT_EQ(golden.height, actual.height);
+  render::Picture diff = actual;
+  size_t different = 0;
+  double total = 0.0;
+  const size_t pixels = size_t(actual.width) * actual.height;
+  for (size_t p = 0; p < pixels; ++p) {
+    int worst = 0;
+    for (int c = 0; c < 3; ++c) {
+      int d = std::abs(int(actual.rgba[p * 4 + c]) - int(golden.rgba[p * 4 + c]));
+      worst = std::max(worst, d);
+      total += d;
+    }
+    different += worst > kChannelTolerance;
+    // Diff image: differences in red over a faded copy of the golden.
+    uint8_t g = uint8_t(golden.rgba[p * 4 + 1] / 3 + 170);
+    diff.rgba[p * 4 + 0] = worst > kChannelTolerance ? 255 : g;
+    diff.rgba[p * 4 + 1] = worst > kChannelTolerance ? 0 : g;
+    diff.rgba[p * 4 + 2] = worst > kChannelTolerance ? 0 : g;
+    diff.rgba[p * 4 + 3] = 255;
+  }
+  const double fraction = double(different) / double(pixels);
+  const double mean = total / double(pixels * 3);
+  const bool ok = fraction <= kMaxDifferentFraction && mean <= kMaxMeanError;
+  if (!ok) {
+    render::writePng("golden_" + name + "_actual.png", actual);
+    render::writePng("golden_" + name + "_diff.png", diff);
+  }
+  EXPECT_TRUE(ok) << name << ": " << different << " pixels (" << fraction * 100.0 << "%) differ, mean error " << mean
+                  << "; wrote " << std::filesystem::absolute("golden_" + name + "_actual.png") << " and _diff.png";
+}
+
+// Printed ink in the picture: pixels much darker than the background, the ground and the shadow.
+size_t inkPixels(const render::Picture& p) {
+  size_t n = 0;
+  for (size_t i = 0; i < size_t(p.width) * p.height; ++i)
+    n += p.rgba[i * 4] < 100 && p.rgba[i * 4 + 1] < 100 && p.rgba[i * 4 + 2] < 100;
+  return n;
+}
+
+} // namespace
+
+TEST(Golden, TenderPresetHangingFromItsPins) {
+  auto r = renderPreset("tender", 60, "");
+  if (!r.error.empty()) GTEST_SKIP() << "no Vulkan device: " << r.error;
+  EXPECT_EQ(r.validation_messages, 0u);
+  ASSERT_EQ(r.picture.width, 320u);
+  EXPECT_GT(inkPixels(r.picture), 150u); // the receipt's text and barcode
+  compareWithGolden("tender_60", r.picture);
+}
+
+TEST(Golden, TornSheetShowsTheGap) {
+  // Pull the bottom edge down hard: the sheet tears at its pins and the compacted triangles leave gaps.
+  auto r = renderPreset("tender", 40,
+                        "0 wind off\n0 grab particle 1520\n1 move 0 -4.5 0\n5 move 0 -6 0\n10 move 0 -8 0\n"
+                        "15 move 0 -10 0\n");
+  if (!r.error.empty()) GTEST_SKIP() << "no Vulkan device: " << r.error;
+  EXPECT_EQ(r.validation_messages, 0u);
+  compareWithGolden("tender_torn", r.picture);
+}
+
+TEST(Golden, CrumplePresetPrintsItsReceipt) {
+  auto r = renderPreset("crumple", 30, "");
+  if (!r.error.empty()) GTEST_SKIP() << "no Vulkan device: " << r.error;
+  EXPECT_EQ(r.validation_messages, 0u);
+  compareWithGolden("crumple_30", r.picture);
+}
+
+// The GPU backend: the renderer binds the solver's own buffers and draws the live triangles with
+// the indirect arguments the tear compaction writes; the solvers agree, so the pictures do too.
+TEST(Golden, GpuSolverBuffersDrawTheSamePicture) {
+  auto r = renderPreset("tender", 60, "", "gpu");
+  if (!r.error.empty()) GTEST_SKIP() << "no Vulkan device: " << r.error;
+  EXPECT_EQ(r.validation_messages, 0u);
+  if (std::getenv("TENDER_UPDATE_GOLDEN")) GTEST_SKIP() << "the CPU render is the golden";
+  compareWithGolden("tender_60", r.picture);
+}
+
+TEST(Golden, GpuSolverTornSheet) {
+  auto r = renderPreset("tender", 40,
+                        "0 wind off\n0 grab particle 1520\n1 move 0 -4.5 0\n5 move 0 -6 0\n10 move 0 -8 0\n"
+                        "15 move 0 -10 0\n",
+                        "gpu");
+  if (!r.error.empty()) GTEST_SKIP() << "no Vulkan device: " << r.error;
+  EXPECT_EQ(r.validation_messages, 0u);
+  if (std::getenv("TENDER_UPDATE_GOLDEN")) GTEST_SKIP() << "the CPU render is the golden";
+  compareWithGolden("tender_torn", r.picture);
+}
