@@ -17,7 +17,7 @@ namespace tender {
 
 std::unique_ptr<Solver> createSolver(const CommonOptions& o, int& status) {
   status = 0;
-  if (o.backend == "cpu") return std::make_unique<CpuSolver>();
+  if (o.backend == "cpu") return std::make_unique<CpuSolver>(CpuOptions{o.params.threads});
 #ifdef TENDER_HAS_GPU
   gpu::GpuOptions g;
   g.device = o.device;

@@ -131,6 +131,7 @@ const std::vector<Param>& params() {
                 {{"zero", ReleaseMode::ZeroVelocity}, {"drag", ReleaseMode::DragVelocity}},
                 "velocity on release: zero, drag"),
       floatParam("grab_radius", &SimParams::grab_radius, 0.0f, 100.0f, "pick radius around the ray"),
+      uintParam("threads", &SimParams::threads, 0, 255, "CPU solver threads, 0: one per core (same results)"),
   };
   return table;
 }

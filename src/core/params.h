@@ -57,6 +57,8 @@ struct SimParams {
   // Interaction
   ReleaseMode release = ReleaseMode::ZeroVelocity;
   float grab_radius = 0.6f;    ///< pick radius around the ray
+  // Performance
+  uint32_t threads = 0;        ///< CPU solver worker threads; 0 = one per hardware thread (results do not change)
 
   uint32_t particleCount() const { return cols * rows; }
   float tickDt() const { return 1.0f / tick_hz; }

@@ -1,11 +1,65 @@
 #include "cpu_solver.h"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
 #include <limits>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+#include "worker_pool.h"
+#if defined(TENDER_CPU_AVX)
+#include "kernels_avx.h"
+#endif
 
 namespace tender {
 
 using namespace shaderio;
+
+namespace {
+
+// Smallest share of a loop worth handing to another thread (elements). Below it the hand-off
+// (about a microsecond) costs more than the work saved.
+constexpr uint32_t kGrainParticles = 4096;   // integrate, floor, hash, reset: a few ns per particle
+constexpr uint32_t kGrainConstraints = 1024; // projection of one colour, tear marking: ~2 ns each
+constexpr uint32_t kGrainCollide = 256;      // collision gather: ~100 ns per particle
+
+// Extra float slots after the sorted position arrays, so 4-wide loads never leave them.
+constexpr uint32_t kSortedPad = 4;
+
+template <typename T>
+uint64_t bytesOf(const std::vector<T>& v) {
+  return uint64_t(v.capacity()) * sizeof(T);
+}
+
+} // namespace
+
+CpuSolver::CpuSolver(CpuOptions options) : options_(options), pool_(std::make_unique<WorkerPool>(options.threads)) {
+#if defined(TENDER_CPU_AVX)
+  avx_ = avx::available();
+#endif
+}
+
+void CpuSolver::splitConstraints() {
+  const size_t m = constraints_.size();
+  con_a_.resize(m);
+  con_b_.resize(m);
+  con_kind_.resize(m);
+  con_rest_.resize(m);
+  for (size_t k = 0; k < m; ++k) {
+    con_a_[k] = constraints_[k].a;
+    con_b_[k] = constraints_[k].b;
+    con_kind_[k] = constraints_[k].kind_id & SIM_KIND_MASK;
+    con_rest_[k] = constraints_[k].rest;
+  }
+}
+
+CpuSolver::~CpuSolver() = default;
+
+uint32_t CpuSolver::threadCount() const { return pool_->size(); }
 
 void CpuSolver::upload(const SheetTopology& topo) {
   topo_ = &topo;
@@ -20,110 +74,318 @@ void CpuSolver::upload(const SheetTopology& topo) {
   reset_from_ = pos_;
   constraints_ = topo.constraints;
   colors_ = topo.colors;
+  splitConstraints();
   torn_.assign(topo.constraintCount(), 0u);
   triangles_ = topo.triangles;
   triangle_count_ = topo.triangleCount();
+  adj_offsets_ = topo.adj_offsets;
+  adj_list_ = topo.adj_list;
   cell_count_.assign(topo.hash_size, 0u);
   cell_start_.assign(topo.hash_size + 1, 0u);
   cell_particles_.assign(n, 0u);
   particle_cell_.assign(n, 0u);
+  particle_coord_.assign(n, glm::ivec4(0));
+  sorted_x_.assign(n + kSortedPad, 0.0f);
+  sorted_y_.assign(n + kSortedPad, 0.0f);
+  sorted_z_.assign(n + kSortedPad, 0.0f);
+  sorted_coord_.assign(n, glm::ivec4(0));
 }
 
 void CpuSolver::integrate(const SimUniforms& u, uint32_t s) {
   const float dt2 = u.dt * u.dt;
-  const vec4 wind = u.wind[s], twist = u.wind_twist[s], target = u.grab_target[s], grab_prev = u.grab_prev[s];
-  for (uint32_t i = 0, n = uint32_t(pos_.size()); i < n; ++i) {
-    VerletState st = integrateParticle(pos_[i], prev_[i], rest_[i], uv_[i].x, i == u.grab_index, target, grab_prev,
-                                       u.flags, u.gravity, wind, twist, u.damping, dt2);
-    pos_[i] = st.pos;
-    prev_[i] = st.prev;
+  const vec4 wind = u.wind[s], twist = u.wind_twist[s];
+  const vec4 target = u.grab_target[s], grab_prev = u.grab_prev[s];
+  pool_->parallelFor(uint32_t(pos_.size()), grain(kGrainParticles), [&](uint32_t begin, uint32_t end) {
+    vec4* pos = pos_.data();
+    vec4* prev = prev_.data();
+    const vec4* rest = rest_.data();
+    const vec2* uv = uv_.data();
+    for (uint32_t i = begin; i < end; ++i) {
+      const VerletState st = integrateParticle(pos[i], prev[i], rest[i], uv[i].x, i == u.grab_index, target, grab_prev,
+                                               u.flags, u.gravity, wind, twist, u.damping, dt2);
+      pos[i] = st.pos;
+      prev[i] = st.prev;
+    }
+  });
+}
+
+// Projects constraints [begin, end) of one colour. No two of them share a particle, so eight
+// (AVX) or four (SSE) are solved at once with the exact operations of solveDistance (same order,
+// same rounding).
+void CpuSolver::projectRange(const float stiffness[4], uint32_t begin, uint32_t end) {
+  vec4* p = pos_.data();
+  const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data();
+  const float* rest = con_rest_.data();
+  uint32_t k = begin;
+#if defined(TENDER_CPU_AVX)
+  if (avx_) k = avx::projectColor(&p[0].x, ca, cb, rest, kind, stiffness, begin, end);
+#endif
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps(), tiny = _mm_set1_ps(1e-9f), sign = _mm_set1_ps(-0.0f);
+  for (; k + 4 <= end; k += 4) {
+    float *a0 = &p[ca[k]].x, *a1 = &p[ca[k + 1]].x, *a2 = &p[ca[k + 2]].x, *a3 = &p[ca[k + 3]].x;
+    float *b0 = &p[cb[k]].x, *b1 = &p[cb[k + 1]].x, *b2 = &p[cb[k + 2]].x, *b3 = &p[cb[k + 3]].x;
+    const __m128 pa0 = _mm_loadu_ps(a0), pa1 = _mm_loadu_ps(a1), pa2 = _mm_loadu_ps(a2), pa3 = _mm_loadu_ps(a3);
+    const __m128 pb0 = _mm_loadu_ps(b0), pb1 = _mm_loadu_ps(b1), pb2 = _mm_loadu_ps(b2), pb3 = _mm_loadu_ps(b3);
+    // Transpose to one register per component.
+    __m128 ax = pa0, ay = pa1, az = pa2, aw = pa3;
+    _MM_TRANSPOSE4_PS(ax, ay, az, aw);
+    __m128 bx = pb0, by = pb1, bz = pb2, bw = pb3;
+    _MM_TRANSPOSE4_PS(bx, by, bz, bw);
+    // d = b - a; len = sqrt(dot(d, d)) with dot = (x*x + y*y) + z*z
+    const __m128 dx = _mm_sub_ps(bx, ax), dy = _mm_sub_ps(by, ay), dz = _mm_sub_ps(bz, az);
+    const __m128 len = _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz)));
+    const __m128 wsum = _mm_add_ps(aw, bw);
+    const __m128 r = _mm_loadu_ps(rest + k);
+    const __m128 stiff =
+        _mm_setr_ps(stiffness[kind[k]], stiffness[kind[k + 1]], stiffness[kind[k + 2]], stiffness[kind[k + 3]]);
+    // s = stiffness * (len - rest) / (len * wsum); corrections are zero unless wsum > 0 and len > 1e-9
+    const __m128 s = _mm_div_ps(_mm_mul_ps(stiff, _mm_sub_ps(len, r)), _mm_mul_ps(len, wsum));
+    const __m128 ok = _mm_and_ps(_mm_cmpgt_ps(wsum, zero), _mm_cmpgt_ps(len, tiny));
+    const __m128 ta = _mm_mul_ps(s, aw), tb = _mm_mul_ps(_mm_xor_ps(s, sign), bw);
+    __m128 dax = _mm_and_ps(_mm_mul_ps(dx, ta), ok), day = _mm_and_ps(_mm_mul_ps(dy, ta), ok);
+    __m128 daz = _mm_and_ps(_mm_mul_ps(dz, ta), ok), daw = zero;
+    __m128 dbx = _mm_and_ps(_mm_mul_ps(dx, tb), ok), dby = _mm_and_ps(_mm_mul_ps(dy, tb), ok);
+    __m128 dbz = _mm_and_ps(_mm_mul_ps(dz, tb), ok), dbw = zero;
+    // Back to one register per particle (w correction 0), then p += correction.
+    _MM_TRANSPOSE4_PS(dax, day, daz, daw);
+    _MM_TRANSPOSE4_PS(dbx, dby, dbz, dbw);
+    _mm_storeu_ps(a0, _mm_add_ps(pa0, dax));
+    _mm_storeu_ps(a1, _mm_add_ps(pa1, day));
+    _mm_storeu_ps(a2, _mm_add_ps(pa2, daz));
+    _mm_storeu_ps(a3, _mm_add_ps(pa3, daw));
+    _mm_storeu_ps(b0, _mm_add_ps(pb0, dbx));
+    _mm_storeu_ps(b1, _mm_add_ps(pb1, dby));
+    _mm_storeu_ps(b2, _mm_add_ps(pb2, dbz));
+    _mm_storeu_ps(b3, _mm_add_ps(pb3, dbw));
+  }
+#endif
+  for (; k < end; ++k) {
+    PairDelta d = solveDistance(p[ca[k]], p[cb[k]], rest[k], stiffness[kind[k]]);
+    p[ca[k]] += vec4(d.da, 0.0f);
+    p[cb[k]] += vec4(d.db, 0.0f);
   }
 }
 
 void CpuSolver::project(const SimUniforms& u, uint32_t iterations) {
   const float stiffness[4] = {u.stiffness.x, u.stiffness.y, u.stiffness.z, u.stiffness.w};
-  vec4* p = pos_.data();
+  const uint32_t g = grain(kGrainConstraints);
   for (uint32_t it = 0; it < iterations; ++it)
-    for (const ColorRange& range : colors_) { // Gauss-Seidel over colours
-      const Constraint* c = constraints_.data() + range.first;
-      for (uint32_t k = 0; k < range.count; ++k) {
-        PairDelta d = solveDistance(p[c[k].a], p[c[k].b], c[k].rest, stiffness[c[k].kind_id & SIM_KIND_MASK]);
-        p[c[k].a] += vec4(d.da, 0.0f);
-        p[c[k].b] += vec4(d.db, 0.0f);
-      }
-    }
+    for (const ColorRange& range : colors_) // Gauss-Seidel over colours
+      pool_->parallelFor(range.count, g, [&](uint32_t begin, uint32_t end) {
+        projectRange(stiffness, range.first + begin, range.first + end);
+      });
 }
 
 void CpuSolver::buildHash(const SimUniforms& u) {
   const uint32_t n = uint32_t(pos_.size());
+  const uint32_t g = grain(kGrainParticles);
+  // Cell and bucket of every particle
+  pool_->parallelFor(n, g, [&](uint32_t begin, uint32_t end) {
+    for (uint32_t i = begin; i < end; ++i) {
+      const ivec3 c = cellOf(vec3(pos_[i]), u.inv_cell);
+      particle_coord_[i] = ivec4(c, 0);
+      particle_cell_[i] = hashCell(c, u.hash_mask);
+    }
+  });
+  // Count
   std::fill(cell_count_.begin(), cell_count_.end(), 0u);
-  for (uint32_t i = 0; i < n; ++i) { // count
-    uint32_t h = hashCell(cellOf(vec3(pos_[i]), u.inv_cell), u.hash_mask);
-    particle_cell_[i] = h;
-    cell_count_[h]++;
+  uint32_t* count = cell_count_.data();
+  const uint32_t* cell = particle_cell_.data();
+  for (uint32_t i = 0; i < n; ++i) count[cell[i]]++;
+  // Exclusive scan
+  uint32_t sum = 0;
+  uint32_t* start = cell_start_.data();
+  for (size_t h = 0, buckets = cell_count_.size(); h < buckets; ++h) {
+    start[h] = sum;
+    sum += count[h];
   }
-  uint32_t sum = 0; // exclusive scan
-  for (size_t h = 0; h < cell_count_.size(); ++h) {
-    cell_start_[h] = sum;
-    sum += cell_count_[h];
-  }
-  cell_start_[cell_count_.size()] = sum;
-  std::copy(cell_start_.begin(), cell_start_.end() - 1, cell_count_.begin()); // scatter cursors
-  for (uint32_t i = 0; i < n; ++i) cell_particles_[cell_count_[particle_cell_[i]]++] = i;
+  start[cell_count_.size()] = sum;
+  // Scatter in index order, so the particles of a bucket stay sorted by index
+  std::copy(cell_start_.begin(), cell_start_.end() - 1, cell_count_.begin());
+  uint32_t* sorted = cell_particles_.data();
+  for (uint32_t i = 0; i < n; ++i) sorted[count[cell[i]]++] = i;
+  // Gather positions and cells in bucket order, for the collision pass
+  pool_->parallelFor(n, g, [&](uint32_t begin, uint32_t end) {
+    for (uint32_t k = begin; k < end; ++k) {
+      const uint32_t j = cell_particles_[k];
+      sorted_x_[k] = pos_[j].x;
+      sorted_y_[k] = pos_[j].y;
+      sorted_z_[k] = pos_[j].z;
+      sorted_coord_[k] = particle_coord_[j];
+    }
+  });
 }
 
-void CpuSolver::collide(const SimUniforms& u) {
-  const uint32_t n = uint32_t(pos_.size());
+// Collision gather for the particles in hash slots [begin, end). Each particle sums the
+// repulsion of its neighbours in the same order as the GPU: cells in dz, dy, dx order, the
+// particles of a bucket in ascending index.
+void CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end) {
   const float r = u.collision_radius, r2 = r * r;
-  const uint32_t* adj_off = topo_->adj_offsets.data();
-  const uint32_t* adj = topo_->adj_list.data();
-  for (uint32_t i = 0; i < n; ++i) {
-    const vec3 pi = vec3(pos_[i]);
-    const ivec3 ci = cellOf(pi, u.inv_cell);
+  const float *sx = sorted_x_.data(), *sy = sorted_y_.data(), *sz = sorted_z_.data();
+  const uint32_t* slots = cell_particles_.data();
+  const ivec4* coords = sorted_coord_.data();
+  const uint32_t* start = cell_start_.data();
+
+  // Buckets of the 27 cells around the current cell (dz, dy, dx order), looked up when first
+  // needed and reused while the cell repeats.
+  struct Bucket {
+    uint32_t first, last;
+    ivec3 cell;
+  };
+  Bucket buckets[27];
+  ivec3 cached_cell(0);
+  bool cached = false;
+  uint32_t known = 0;    // bit b: bucket b is looked up for the current cell
+  uint32_t nonempty = 0; // bit b: bucket b holds particles (among the known)
+  // A neighbour cell on one side can hold a particle within the radius only when the particle
+  // is closer than the radius to that side of its own cell (the radius never exceeds a cell).
+  // The test is in cell units with a generous margin, so no contributing cell is ever skipped.
+  const float reach = r * u.inv_cell + 1e-3f;
+  // Bucket masks (bit dz*9 + dy*3 + dx, offsets +1) selected by the needed -1/0/+1 sides of an axis.
+  static constexpr auto kAxisMasks = [] {
+    std::array<std::array<uint32_t, 8>, 3> m{};
+    for (uint32_t sides = 0; sides < 8; ++sides)
+      for (uint32_t b = 0; b < 27; ++b) {
+        if ((sides >> (b % 3)) & 1u) m[0][sides] |= 1u << b;
+        if ((sides >> (b / 3 % 3)) & 1u) m[1][sides] |= 1u << b;
+        if ((sides >> (b / 9)) & 1u) m[2][sides] |= 1u << b;
+      }
+    return m;
+  }();
+  // Slots within the radius, in summation order, with their bucket; filled without branches.
+  constexpr uint32_t kHitCapacity = 64;
+  uint32_t hit_slot[kHitCapacity + 4];
+  uint8_t hit_bucket[kHitCapacity + 4];
+
+  for (uint32_t k = begin; k < end; ++k) {
+    const uint32_t i = slots[k];
+    const vec3 pi(sx[k], sy[k], sz[k]);
+    const ivec3 ci(coords[k]);
+    if (!cached || ci != cached_cell) {
+      cached_cell = ci;
+      cached = true;
+      known = nonempty = 0;
+    }
+    // The buckets this particle visits: on a side within reach on every axis (all three sides
+    // of an axis when unsure), and non-empty.
+    uint32_t visit = (1u << 27) - 1u;
+    const vec3 scaled = pi * u.inv_cell;
+    for (int a = 0; a < 3; ++a) {
+      const float f = scaled[a] - float(ci[a]);
+      const bool sure = std::fabs(scaled[a]) < 1024.0f && f >= 0.0f && f <= 1.0f; // rounding well inside the margin
+      const uint32_t sides = 2u | (!sure || !(f >= reach) ? 1u : 0u) | (!sure || !(1.0f - f >= reach) ? 4u : 0u);
+      visit &= kAxisMasks[a][sides];
+    }
+    for (uint32_t missing = visit & ~known; missing; missing &= missing - 1u) {
+      const int b = __builtin_ctz(missing);
+      const ivec3 c = ci + ivec3(b % 3 - 1, b / 3 % 3 - 1, b / 9 - 1);
+      const uint32_t h = hashCell(c, u.hash_mask);
+      buckets[b] = {start[h], start[h + 1], c};
+      nonempty |= start[h] < start[h + 1] ? 1u << b : 0u;
+    }
+    known |= visit;
+    visit &= nonempty;
+    const uint32_t* adj = adj_list_.data() + adj_offsets_[i];
+    const uint32_t adj_count = adj_offsets_[i + 1] - adj_offsets_[i];
     vec3 sum(0.0f);
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const ivec3 c = ci + ivec3(dx, dy, dz);
-          const uint32_t h = hashCell(c, u.hash_mask);
-          for (uint32_t k = cell_start_[h], end = cell_start_[h + 1]; k < end; ++k) {
-            const uint32_t j = cell_particles_[k];
-            const vec3 pj = vec3(pos_[j]);
-            const vec3 d = pi - pj;
-            if (j == i || dot(d, d) >= r2) continue;
-            // Count j once, from its own cell, and never repel connected particles.
-            if (cellOf(pj, u.inv_cell) != c) continue;
-            if (std::binary_search(adj + adj_off[i], adj + adj_off[i + 1], j)) continue;
-            sum += repulsion(pi, pj, r, u.collision_stiffness);
-          }
+    uint32_t hit_count = 0;
+    // Sums the hits so far. Skips the particle itself (slot k), particles of other cells sharing
+    // a bucket (each is counted from its own cell) and connected particles.
+    auto flush = [&] {
+      for (uint32_t t = 0; t < hit_count; ++t) {
+        const uint32_t m = hit_slot[t];
+        const Bucket& bucket = buckets[hit_bucket[t]];
+        if (m == k || ivec3(coords[m]) != bucket.cell) continue;
+        // Branch-free lower bound in the sorted adjacency list
+        const uint32_t j = slots[m];
+        const uint32_t* base = adj;
+        for (uint32_t len = adj_count; len > 1; len -= len / 2) base = base[len / 2 - 1] < j ? base + len / 2 : base;
+        if (adj_count > 0 && (*base == j || (base + 1 < adj + adj_count && base[1] == j))) continue;
+        sum += repulsion(pi, vec3(sx[m], sy[m], sz[m]), r, u.collision_stiffness);
+      }
+      hit_count = 0;
+    };
+#if defined(__SSE2__)
+    const __m128 px = _mm_set1_ps(pi.x), py = _mm_set1_ps(pi.y), pz = _mm_set1_ps(pi.z), vr2 = _mm_set1_ps(r2);
+#endif
+    while (visit) { // ascending bucket index: dz, dy, dx order
+      const uint32_t b = uint32_t(__builtin_ctz(visit));
+      visit &= visit - 1u;
+      const Bucket& bucket = buckets[b];
+      for (uint32_t m = bucket.first; m < bucket.last; m += 4) {
+#if defined(__SSE2__)
+        // d = pi - pj; the same dot(d, d) < r2 test as the scalar maths, four at a time
+        const __m128 dx = _mm_sub_ps(px, _mm_loadu_ps(sx + m));
+        const __m128 dy = _mm_sub_ps(py, _mm_loadu_ps(sy + m));
+        const __m128 dz = _mm_sub_ps(pz, _mm_loadu_ps(sz + m));
+        const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+        uint32_t hits = uint32_t(_mm_movemask_ps(_mm_cmplt_ps(d2, vr2)));
+#else
+        uint32_t hits = 0;
+        for (uint32_t lane = 0; lane < 4 && m + lane < bucket.last; ++lane) {
+          const vec3 d = pi - vec3(sx[m + lane], sy[m + lane], sz[m + lane]);
+          hits |= dot(d, d) < r2 ? 1u << lane : 0u;
         }
+#endif
+        if (bucket.last - m < 4) hits &= (1u << (bucket.last - m)) - 1u;
+        for (uint32_t lane = 0; lane < 4; ++lane) {
+          hit_slot[hit_count] = m + lane;
+          hit_bucket[hit_count] = uint8_t(b);
+          hit_count += (hits >> lane) & 1u;
+        }
+        if (hit_count > kHitCapacity) flush();
+      }
+    }
+    flush();
     delta_[i] = vec4(sum, 0.0f);
   }
 }
 
-void CpuSolver::floorPass(const SimUniforms& u) {
-  const bool collide = (u.flags & SIM_FLAG_COLLISION) != 0u;
-  for (size_t i = 0; i < pos_.size(); ++i) {
-    vec4 p = pos_[i];
-    if (collide && p.w > 0.0f) p += vec4(vec3(delta_[i]), 0.0f);
-    VerletState st = floorContact(p, prev_[i], u.floor_y, u.restitution, u.friction);
-    pos_[i] = st.pos;
-    prev_[i] = st.prev;
-  }
+void CpuSolver::collide(const SimUniforms& u) {
+  pool_->parallelFor(uint32_t(pos_.size()), grain(kGrainCollide),
+                     [&](uint32_t begin, uint32_t end) { collideRange(u, begin, end); });
 }
 
-uint32_t CpuSolver::markTears(const SimUniforms& u) {
-  if (u.tear_factor <= 0.0f) return 0;
+void CpuSolver::floorPass(const SimUniforms& u) {
+  const bool collide = (u.flags & SIM_FLAG_COLLISION) != 0u;
+  pool_->parallelFor(uint32_t(pos_.size()), grain(kGrainParticles), [&](uint32_t begin, uint32_t end) {
+    vec4* pos = pos_.data();
+    vec4* prev = prev_.data();
+    const vec4* delta = delta_.data();
+    for (uint32_t i = begin; i < end; ++i) {
+      vec4 p = pos[i];
+      if (collide && p.w > 0.0f) p += vec4(vec3(delta[i]), 0.0f);
+      VerletState st = floorContact(p, prev[i], u.floor_y, u.restitution, u.friction);
+      pos[i] = st.pos;
+      prev[i] = st.prev;
+    }
+  });
+}
+
+// Marks the live constraints among array slots [begin, end); returns how many tore.
+uint32_t CpuSolver::markTearsRange(const SimUniforms& u, uint32_t begin, uint32_t end) {
   uint32_t torn = 0;
-  for (const ColorRange& range : colors_)
-    for (uint32_t k = range.first; k < range.first + range.count; ++k) {
+  for (const ColorRange& range : colors_) {
+    const uint32_t first = std::max(begin, range.first), last = std::min(end, range.first + range.count);
+    for (uint32_t k = first; k < last; ++k) {
       const Constraint& c = constraints_[k];
       if (shouldTear(pos_[c.a], pos_[c.b], c.rest, c.kind_id & SIM_KIND_MASK, u.tear_factor, u.tear_kinds)) {
         torn_[c.kind_id >> SIM_KIND_BITS] = 1u;
         ++torn;
       }
     }
+  }
   return torn;
+}
+
+uint32_t CpuSolver::markTears(const SimUniforms& u) {
+  if (u.tear_factor <= 0.0f) return 0;
+  std::atomic<uint32_t> torn{0};
+  pool_->parallelFor(uint32_t(constraints_.size()), grain(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
+    if (uint32_t t = markTearsRange(u, begin, end)) torn.fetch_add(t, std::memory_order_relaxed);
+  });
+  return torn.load();
 }
 
 void CpuSolver::compact() {
@@ -133,6 +395,7 @@ void CpuSolver::compact() {
       if (!torn_[constraints_[k].kind_id >> SIM_KIND_BITS]) constraints_[w++] = constraints_[k];
     range.count = w - range.first;
   }
+  splitConstraints();
   const auto& edges = topo_->tri_edges;
   uint32_t w = 0;
   for (uint32_t k = 0; k < triangle_count_; ++k) {
@@ -143,11 +406,13 @@ void CpuSolver::compact() {
 }
 
 void CpuSolver::resetPass(const SimUniforms& u) {
-  for (size_t i = 0; i < pos_.size(); ++i) {
-    const float w = inverseMass(rest_[i], false, u.flags);
-    pos_[i] = vec4(mix(vec3(reset_from_[i]), vec3(rest_[i]), u.reset_alpha), w);
-    prev_[i] = pos_[i];
-  }
+  pool_->parallelFor(uint32_t(pos_.size()), grain(kGrainParticles), [&](uint32_t begin, uint32_t end) {
+    for (uint32_t i = begin; i < end; ++i) {
+      const float w = inverseMass(rest_[i], false, u.flags);
+      pos_[i] = vec4(mix(vec3(reset_from_[i]), vec3(rest_[i]), u.reset_alpha), w);
+      prev_[i] = pos_[i];
+    }
+  });
 }
 
 void CpuSolver::tick(const SimUniforms& u) {
@@ -176,6 +441,7 @@ void CpuSolver::beginReset() {
   reset_from_ = pos_;
   constraints_ = topo_->constraints;
   colors_ = topo_->colors;
+  splitConstraints();
   std::fill(torn_.begin(), torn_.end(), 0u);
   triangles_ = topo_->triangles;
   triangle_count_ = topo_->triangleCount();
@@ -213,6 +479,15 @@ void CpuSolver::readback(SimState& out) {
   out.torn = torn_;
   out.triangles.assign(triangles_.begin(), triangles_.begin() + triangle_count_);
   out.triangle_count = triangle_count_;
+}
+
+uint64_t CpuSolver::memoryBytes() const {
+  return bytesOf(pos_) + bytesOf(prev_) + bytesOf(rest_) + bytesOf(normal_) + bytesOf(delta_) + bytesOf(reset_from_) +
+         bytesOf(uv_) + bytesOf(constraints_) + bytesOf(colors_) + bytesOf(torn_) + bytesOf(con_a_) + bytesOf(con_b_) +
+         bytesOf(con_kind_) + bytesOf(con_rest_) + bytesOf(triangles_) + bytesOf(adj_offsets_) + bytesOf(adj_list_) +
+         bytesOf(cell_count_) + bytesOf(cell_start_) + bytesOf(cell_particles_) + bytesOf(particle_cell_) +
+         bytesOf(particle_coord_) + bytesOf(sorted_x_) + bytesOf(sorted_y_) + bytesOf(sorted_z_) +
+         bytesOf(sorted_coord_);
 }
 
 } // namespace tender

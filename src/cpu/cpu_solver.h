@@ -1,14 +1,30 @@
 #pragma once
 /// The CPU reference solver: every pass of one tick over flat arrays, in float32, in the same
 /// order as the GPU solver, calling the same per-element maths (shaders/shared/xpbd.h).
+/// Parallel loops (the constraints of one colour, per-particle passes, the collision gather) are
+/// split over a small thread pool; every element is computed exactly as in one thread, so the
+/// results are bitwise identical whatever the thread count.
+#include <memory>
 #include <vector>
 
 #include "core/solver.h"
 
 namespace tender {
 
+class WorkerPool;
+
+/// How the CPU solver spreads its work over threads.
+struct CpuOptions {
+  uint32_t threads = 1;   ///< worker threads, the caller included; 0 = one per hardware thread
+  uint32_t min_chunk = 0; ///< smallest loop share worth a thread; 0 = tuned defaults, 1 = split every loop (tests)
+};
+
 class CpuSolver final : public Solver {
 public:
+  /// A solver running on `options.threads` threads (one by default: the plain reference).
+  explicit CpuSolver(CpuOptions options = {});
+  ~CpuSolver() override;
+
   std::string name() const override { return "cpu"; }
   void upload(const SheetTopology& topo) override;
   void tick(const shaderio::SimUniforms& u) override;
@@ -18,15 +34,20 @@ public:
   glm::vec3 particlePosition(uint32_t index) override { return glm::vec3(pos_[index]); }
   void readback(SimState& out) override;
   uint32_t dispatchesPerTick() const override { return passes_per_tick_; }
+  /// Bytes of host memory of the solver's own arrays (capacity, not size).
+  uint64_t memoryBytes() const override;
+  /// Worker threads in use, the caller included.
+  uint32_t threadCount() const;
 
   // The passes of one substep, public so tests can drive them one by one.
   /// Verlet integration with gravity, wind, damping; pins and the grab hold their particles.
   void integrate(const shaderio::SimUniforms& u, uint32_t substep);
   /// Gauss-Seidel over the colours, `iterations` times.
   void project(const shaderio::SimUniforms& u, uint32_t iterations);
-  /// Rebuilds the spatial hash: count, scan, scatter (particles of a cell in index order).
+  /// Rebuilds the spatial hash: count, scan, scatter (particles of a cell in index order), then
+  /// gathers positions and cells in that order for the collision pass.
   void buildHash(const shaderio::SimUniforms& u);
-  /// Gathers repulsion from non-adjacent neighbours into the delta array (Jacobi).
+  /// Gathers repulsion from non-adjacent neighbours into the delta array (Jacobi); needs buildHash.
   void collide(const shaderio::SimUniforms& u);
   /// Applies the collision deltas, then the ground contact.
   void floorPass(const shaderio::SimUniforms& u);
@@ -44,15 +65,30 @@ public:
   const std::vector<uint32_t>& cellParticles() const { return cell_particles_; }
 
 private:
+  void projectRange(const float stiffness[4], uint32_t begin, uint32_t end);
+  void collideRange(const shaderio::SimUniforms& u, uint32_t begin, uint32_t end);
+  uint32_t markTearsRange(const shaderio::SimUniforms& u, uint32_t begin, uint32_t end);
+  void splitConstraints();
+  uint32_t grain(uint32_t tuned) const { return options_.min_chunk ? options_.min_chunk : tuned; }
+
+  CpuOptions options_;
+  std::unique_ptr<WorkerPool> pool_;
   const SheetTopology* topo_ = nullptr;
   std::vector<glm::vec4> pos_, prev_, rest_, normal_, delta_, reset_from_;
   std::vector<glm::vec2> uv_;
   std::vector<shaderio::Constraint> constraints_;
   std::vector<ColorRange> colors_;
+  std::vector<uint32_t> con_a_, con_b_, con_kind_; // constraints_ split into arrays (SIMD loads)
+  std::vector<float> con_rest_;
+  bool avx_ = false; // the 8-wide kernels run on this CPU
   std::vector<uint32_t> torn_;
   std::vector<glm::uvec4> triangles_;
   uint32_t triangle_count_ = 0;
+  std::vector<uint32_t> adj_offsets_, adj_list_; // CSR adjacency (copied from the topology)
   std::vector<uint32_t> cell_count_, cell_start_, cell_particles_, particle_cell_;
+  std::vector<glm::ivec4> particle_coord_;            // integer cell of each particle
+  std::vector<float> sorted_x_, sorted_y_, sorted_z_; // positions in hash order (SoA, padded)
+  std::vector<glm::ivec4> sorted_coord_;              // cells in hash order
   uint32_t passes_per_tick_ = 0;
 };
 

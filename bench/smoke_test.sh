@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# Smoke test of tender-bench: two tiny sizes on every built backend; checks the JSON's and the
+# CSV's shape (never the timings) and that bad input exits 2 with one line.
+set -u
+B=${TENDER_BENCH:?set TENDER_BENCH to the tender-bench binary}
+backends=${TENDER_BENCH_BACKENDS:-cpu}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+
+if ! "$B" --sizes 8x12,12x16 --backends "$backends" --ticks 3 --warmup 1 --json "$tmp/b.json" --csv "$tmp/b.csv" \
+    >"$tmp/out" 2>"$tmp/err"; then
+  echo "FAIL: bench run exited $?"; cat "$tmp/out" "$tmp/err"; failures=$((failures + 1))
+else
+  cat "$tmp/out"
+  python3 - "$tmp/b.json" "$tmp/b.csv" "$backends" <<'PY' || failures=$((failures + 1))
+import csv, json, sys
+j = json.load(open(sys.argv[1]))
+backends = sys.argv[3].split(",")
+for k in ["tool", "version", "machine", "preset", "ticks", "warmup", "sets", "results"]:
+    assert k in j, k
+assert j["tool"] == "tender-bench" and j["ticks"] == 3 and j["warmup"] == 1, j
+assert "cpu_model" in j["machine"] and "cores" in j["machine"], j["machine"]
+rs = j["results"]
+assert len(rs) == 2 * len(backends), len(rs)
+seen = set()
+for r in rs:
+    for k in ["size", "cols", "rows", "particles", "backend", "status"]:
+        assert k in r, (k, r)
+    seen.add((r["size"], r["backend"]))
+    if r["backend"].startswith("gpu") and r["status"] == "skipped":
+        print("gpu skipped:", r.get("reason")); continue
+    assert r["status"] == "ok", r
+    for k in ["ms_median", "ms_p95", "ms_mean", "ms_min", "ticks_measured", "particle_substeps_per_s",
+              "dispatches_per_tick", "memory_bytes", "pass_ms", "threads", "spacing", "cell_size", "torn",
+              "state_hash"]:
+        assert k in r, (k, r)
+    assert r["particles"] == r["cols"] * r["rows"] and r["ticks_measured"] == 3, r
+    assert 0 < r["ms_min"] <= r["ms_median"] <= r["ms_p95"], r
+    assert r["memory_bytes"] > r["particles"] * 32 and r["dispatches_per_tick"] > 0, r
+    assert isinstance(r["pass_ms"], dict), r
+    if r["backend"] == "gpu":
+        assert len(r["pass_ms"]) > 0, r
+assert seen == {(s, b) for s in ["8x12", "12x16"] for b in backends}, seen
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert len(rows) == len(rs) and "ms_median" in rows[0] and "particles" in rows[0], rows[:1]
+print("ok: JSON and CSV shape,", len(rs), "results")
+PY
+fi
+
+# The plot script turns the JSON into a PNG (when gnuplot is installed).
+plot=$(dirname "$0")/../tools/plot-bench
+if command -v gnuplot >/dev/null && [ -f "$tmp/b.json" ]; then
+  if "$plot" -o "$tmp/b.png" "$tmp/b.json" >/dev/null && [ -s "$tmp/b.png" ]; then
+    echo "ok: plot-bench wrote a PNG"
+  else
+    echo "FAIL: plot-bench"; failures=$((failures + 1))
+  fi
+fi
+
+expect_bad() { # args...: must exit 2 with one stderr line
+  "$B" "$@" >"$tmp/out" 2>"$tmp/err"
+  local rc=$? lines
+  lines=$(wc -l <"$tmp/err")
+  if [ "$rc" -ne 2 ] || [ "$lines" -ne 1 ]; then
+    echo "FAIL: tender-bench $* -> exit $rc, $lines stderr lines:"; cat "$tmp/err"; failures=$((failures + 1))
+  else
+    echo "ok: tender-bench $* -> $(cat "$tmp/err")"
+  fi
+}
+expect_bad --sizes 32by48
+expect_bad --sizes 0x10
+expect_bad --sizes ""
+expect_bad --backends quantum
+expect_bad --preset nope
+expect_bad --set nope=1
+expect_bad --set damping=2
+expect_bad --ticks 0
+expect_bad --bogus
+"$B" --help >/dev/null && "$B" --version | grep -q '^tender-bench ' || { echo "FAIL: --help/--version"; failures=$((failures + 1)); }
+echo "$failures failed"
+[ "$failures" -eq 0 ]

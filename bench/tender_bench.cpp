@@ -1,0 +1,426 @@
+// tender-bench: scaling benchmark of the solvers. For each sheet size and backend it runs the full
+// physics (every substep, iteration, collision and tear check of the preset) and reports ms per
+// tick (median, p95), particle-substeps per second, dispatches per tick, memory and, on the GPU,
+// the time of each pass. Bench sizes keep the sheet's physical size: spacing and hash cell scale
+// with the grid (see bench/README.md).
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "core/simulation.h"
+#include "core/stats.h"
+#include "cpu/cpu_solver.h"
+
+#ifdef TENDER_HAS_GPU
+#include "gpu/gpu_solver.h"
+#endif
+
+namespace tender {
+namespace {
+
+constexpr int kExitBadInput = 2;
+
+/// Command-line options.
+struct BenchOptions {
+  std::string sizes = "32x48,64x96,128x192,256x384,512x768,1024x1536,2048x3072";
+  std::string backends;
+  std::string preset = "tender";
+  std::vector<std::string> sets;
+  uint32_t ticks = 60;
+  uint32_t warmup = 10;
+  int device = -1;
+  std::string json, csv;
+  uint64_t max_cpu_particles = 400000;
+  double max_seconds = 30.0;
+};
+
+/// One grid size.
+struct Size {
+  uint32_t cols = 0, rows = 0;
+  std::string text() const { return std::to_string(cols) + "x" + std::to_string(rows); }
+};
+
+int fail(const std::string& message) {
+  std::fprintf(stderr, "tender-bench: error: %s\n", message.c_str());
+  return kExitBadInput;
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, sep)) out.push_back(item);
+  if (!s.empty() && s.back() == sep) out.push_back("");
+  return out;
+}
+
+// Parses "32x48,128x192"; returns an error message.
+std::optional<std::string> parseSizes(const std::string& text, std::vector<Size>& out) {
+  if (text.empty()) return std::string("--sizes is empty");
+  for (const std::string& item : split(text, ',')) {
+    Size s;
+    char x = 0;
+    char rest = 0;
+    if (std::sscanf(item.c_str(), "%u%c%u%c", &s.cols, &x, &s.rows, &rest) != 3 || (x != 'x' && x != 'X') ||
+        item.find('-') != std::string::npos)
+      return "bad size '" + item + "' (expected WxH, e.g. 128x192)";
+    if (s.cols < 2 || s.rows < 2 || s.cols > 16384 || s.rows > 16384)
+      return "size '" + item + "' is out of range (2 to 16384 per side)";
+    out.push_back(s);
+  }
+  return std::nullopt;
+}
+
+bool gpuBuilt() {
+#ifdef TENDER_HAS_GPU
+  return true;
+#else
+  return false;
+#endif
+}
+
+std::string cpuModel() {
+  std::ifstream f("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("model name", 0) == 0) {
+      auto colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(line.find_first_not_of(' ', colon + 1));
+    }
+  return "unknown";
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * double(v.size() - 1);
+  const size_t lo = size_t(std::floor(pos)), hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (v[hi] - v[lo]) * (pos - double(lo));
+}
+
+std::string hex64(uint64_t v) {
+  char buf[20];
+  std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+/// Parameters of one bench size: the preset, the grid, spacing and hash cell scaled so the sheet
+/// keeps the preset's width, then the user's overrides (which win).
+std::optional<std::string> benchParams(const BenchOptions& o, const Size& size, SimParams& out) {
+  auto p = presetParams(o.preset);
+  if (!p) return "unknown preset '" + o.preset + "'";
+  const float scale = float(p->cols - 1) / float(size.cols - 1);
+  p->cols = size.cols;
+  p->rows = size.rows;
+  p->spacing *= scale;
+  p->cell_size *= scale;
+  for (const std::string& s : o.sets)
+    if (auto err = applyOverride(*p, s)) return err;
+  out = *p;
+  return validate(*p);
+}
+
+/// Progress on stderr: one line rewritten in place on a terminal, a line per case otherwise.
+class Progress {
+public:
+  Progress() : tty_(isatty(STDERR_FILENO) != 0) {}
+  void update(const std::string& text, bool final_line) {
+    if (tty_) {
+      std::fprintf(stderr, "\r%-100s%s", text.c_str(), final_line ? "\n" : "");
+    } else if (final_line) {
+      std::fprintf(stderr, "%s\n", text.c_str());
+    }
+    std::fflush(stderr);
+  }
+  bool live() const { return tty_; }
+
+private:
+  bool tty_;
+};
+
+/// A solver for a backend name, or nullptr and a reason.
+std::unique_ptr<Solver> makeSolver(const std::string& backend, const BenchOptions& o, const SimParams& p,
+                                   std::string& reason) {
+  if (backend == "cpu") return std::make_unique<CpuSolver>(CpuOptions{p.threads});
+#ifdef TENDER_HAS_GPU
+  gpu::GpuOptions g;
+  g.device = o.device;
+  auto solver = gpu::createGpuSolver(g, reason);
+  if (solver && backend == "gpu-percolor") static_cast<gpu::GpuSolver&>(*solver).setFusedPath(false);
+  return solver;
+#else
+  (void)o;
+  reason = "this build has no GPU backend";
+  return nullptr;
+#endif
+}
+
+/// Waits until the solver's last tick has finished (the GPU runs asynchronously).
+void finishTick(Solver& solver) {
+#ifdef TENDER_HAS_GPU
+  if (solver.name() == "gpu") static_cast<gpu::GpuSolver&>(solver).finish();
+#else
+  (void)solver;
+#endif
+}
+
+/// Runs one size on one backend and returns its JSON record.
+nlohmann::json runCase(const BenchOptions& o, const Size& size, const std::string& backend, const std::string& label,
+                       Progress& progress) {
+  nlohmann::json r;
+  r["size"] = size.text();
+  r["cols"] = size.cols;
+  r["rows"] = size.rows;
+  r["particles"] = uint64_t(size.cols) * size.rows;
+  r["backend"] = backend;
+  auto skip = [&](const std::string& why) {
+    r["status"] = "skipped";
+    r["reason"] = why;
+    progress.update(label + ": skipped (" + why + ")", true);
+    return r;
+  };
+  SimParams p;
+  if (auto err = benchParams(o, size, p)) return skip(*err);
+  if (backend == "cpu" && uint64_t(p.particleCount()) > o.max_cpu_particles)
+    return skip("over --max-cpu-particles " + std::to_string(o.max_cpu_particles));
+  r["spacing"] = p.spacing;
+  r["cell_size"] = p.cell_size;
+  r["substeps"] = p.substeps;
+  r["iterations"] = p.iterations;
+
+  std::string reason;
+  std::unique_ptr<Solver> solver;
+  std::optional<Simulation> sim;
+  try {
+    solver = makeSolver(backend, o, p, reason);
+    if (!solver) return skip(reason);
+    sim.emplace(p, *solver);
+  } catch (const std::exception& e) { // e.g. the device cannot hold the sheet
+    return skip(e.what());
+  }
+  if (auto* cpu = dynamic_cast<CpuSolver*>(solver.get()))
+    r["threads"] = cpu->threadCount();
+  else
+    r["threads"] = 0;
+#ifdef TENDER_HAS_GPU
+  if (auto* gpu_solver = dynamic_cast<gpu::GpuSolver*>(solver.get())) {
+    r["device"] = std::string(gpu_solver->context().properties().deviceName);
+    r["fused"] = gpu_solver->usesFusedPath();
+  }
+#endif
+
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  auto show = [&](const char* phase, uint32_t done, uint32_t total) {
+    if (!progress.live()) return;
+    char buf[160];
+    std::snprintf(buf, sizeof(buf), "%s: %s %u/%u (%.1f s)", label.c_str(), phase, done, total, elapsed());
+    progress.update(buf, false);
+  };
+  for (uint32_t t = 0; t < o.warmup; ++t) {
+    sim->tick();
+    finishTick(*solver);
+    show("warm-up", t + 1, o.warmup);
+    if (elapsed() > o.max_seconds / 2) break; // a slow size gets a short warm-up
+  }
+  std::vector<double> ms;
+  std::map<std::string, std::vector<double>> pass_ms;
+  const auto timed_start = Clock::now();
+  for (uint32_t t = 0; t < o.ticks; ++t) {
+    const auto t0 = Clock::now();
+    sim->tick();
+    finishTick(*solver);
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    for (auto& [name, v] : solver->passTimes().ms) pass_ms[name].push_back(v);
+    show("tick", t + 1, o.ticks);
+    // Stop a slow size once the time budget is spent (it still gets 3 ticks).
+    if (t + 1 >= 3 && std::chrono::duration<double>(Clock::now() - timed_start).count() > o.max_seconds) break;
+  }
+  solver->computeNormals();
+  SimState state;
+  solver->readback(state);
+  const SheetStats st = computeStats(state, p.substepDt());
+
+  const double median = percentile(ms, 0.5);
+  r["status"] = "ok";
+  r["ticks_measured"] = ms.size();
+  r["ms_median"] = median;
+  r["ms_p95"] = percentile(ms, 0.95);
+  r["ms_mean"] = [&] {
+    double s = 0.0;
+    for (double v : ms) s += v;
+    return s / double(ms.size());
+  }();
+  r["ms_min"] = *std::min_element(ms.begin(), ms.end());
+  r["particle_substeps_per_s"] = median > 0.0 ? double(p.particleCount()) * p.substeps * 1000.0 / median : 0.0;
+  r["dispatches_per_tick"] = solver->dispatchesPerTick();
+  r["memory_bytes"] = solver->memoryBytes();
+  nlohmann::json passes = nlohmann::json::object();
+  for (auto& [name, v] : pass_ms) passes[name] = percentile(v, 0.5);
+  r["pass_ms"] = passes;
+  r["torn"] = st.torn;
+  r["nan_count"] = st.nan_count;
+  r["state_hash"] = hex64(st.state_hash);
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "%s: %.3f ms/tick median, %.3f p95 (%zu ticks)", label.c_str(), median,
+                percentile(ms, 0.95), ms.size());
+  progress.update(buf, true);
+  return r;
+}
+
+std::string humanBytes(uint64_t b) {
+  char buf[32];
+  if (b >= (1ull << 30))
+    std::snprintf(buf, sizeof(buf), "%.2f GiB", double(b) / double(1ull << 30));
+  else if (b >= (1ull << 20))
+    std::snprintf(buf, sizeof(buf), "%.1f MiB", double(b) / double(1ull << 20));
+  else
+    std::snprintf(buf, sizeof(buf), "%.1f KiB", double(b) / 1024.0);
+  return buf;
+}
+
+void printTable(const nlohmann::json& results) {
+  std::printf("%-11s %-12s %9s %7s %10s %10s %14s %11s %10s\n", "size", "backend", "particles", "threads", "ms median",
+              "ms p95", "part-substep/s", "dispatches", "memory");
+  for (const auto& r : results) {
+    if (r["status"] != "ok") {
+      std::printf("%-11s %-12s %9llu  skipped: %s\n", r["size"].get<std::string>().c_str(),
+                  r["backend"].get<std::string>().c_str(),
+                  static_cast<unsigned long long>(r["particles"].get<uint64_t>()),
+                  r["reason"].get<std::string>().c_str());
+      continue;
+    }
+    std::printf("%-11s %-12s %9llu %7u %10.3f %10.3f %14.3g %11u %10s\n", r["size"].get<std::string>().c_str(),
+                r["backend"].get<std::string>().c_str(),
+                static_cast<unsigned long long>(r["particles"].get<uint64_t>()), r["threads"].get<uint32_t>(),
+                r["ms_median"].get<double>(), r["ms_p95"].get<double>(), r["particle_substeps_per_s"].get<double>(),
+                r["dispatches_per_tick"].get<uint32_t>(), humanBytes(r["memory_bytes"].get<uint64_t>()).c_str());
+    if (!r["pass_ms"].empty()) {
+      std::printf("%-11s   passes (ms):", "");
+      for (auto& [name, v] : r["pass_ms"].items()) std::printf(" %s %.4f", name.c_str(), v.get<double>());
+      std::printf("\n");
+    }
+  }
+}
+
+bool writeCsv(const std::string& path, const nlohmann::json& results) {
+  std::ofstream f(path);
+  f << "size,cols,rows,particles,backend,status,threads,ticks_measured,ms_median,ms_p95,ms_mean,ms_min,"
+       "particle_substeps_per_s,dispatches_per_tick,memory_bytes,torn,state_hash,passes\n";
+  for (const auto& r : results) {
+    auto num = [&](const char* k) -> std::string { return r.contains(k) ? r[k].dump() : ""; };
+    std::string passes;
+    if (r.contains("pass_ms"))
+      for (auto& [name, v] : r["pass_ms"].items()) passes += (passes.empty() ? "" : ";") + name + "=" + v.dump();
+    f << r["size"].get<std::string>() << ',' << num("cols") << ',' << num("rows") << ',' << num("particles") << ','
+      << r["backend"].get<std::string>() << ',' << r["status"].get<std::string>() << ',' << num("threads") << ','
+      << num("ticks_measured") << ',' << num("ms_median") << ',' << num("ms_p95") << ',' << num("ms_mean") << ','
+      << num("ms_min") << ',' << num("particle_substeps_per_s") << ',' << num("dispatches_per_tick") << ','
+      << num("memory_bytes") << ',' << num("torn") << ','
+      << (r.contains("state_hash") ? r["state_hash"].get<std::string>() : "") << ',' << passes << '\n';
+  }
+  return bool(f);
+}
+
+} // namespace
+} // namespace tender
+
+int main(int argc, char** argv) {
+  using namespace tender;
+  BenchOptions o;
+  o.backends = gpuBuilt() ? "cpu,gpu" : "cpu";
+  CLI::App app{"tender-bench: how the solvers scale with the size of the sheet."};
+  app.set_version_flag("--version", std::string("tender-bench ") + TENDER_VERSION);
+  app.add_option("--sizes", o.sizes, "grid sizes, WxH comma-separated")->capture_default_str();
+  app.add_option("--backends", o.backends, "cpu, gpu, gpu-percolor (GPU without the fused small-sheet path)")
+      ->capture_default_str();
+  app.add_option("--preset", o.preset, "tender, crumple, tender-low or crumple-low")->capture_default_str();
+  app.add_option("--set", o.sets, "override a parameter: key=value (repeatable; applied after the size scaling)");
+  app.add_option("--ticks", o.ticks, "timed ticks per case")->check(CLI::Range(1u, 1000000u))->capture_default_str();
+  app.add_option("--warmup", o.warmup, "untimed ticks first")->check(CLI::Range(0u, 1000000u))->capture_default_str();
+  app.add_option("--device", o.device, "Vulkan device index (see `tender devices`)");
+  app.add_option("--json", o.json, "write the results as JSON here");
+  app.add_option("--csv", o.csv, "write the results as CSV here");
+  app.add_option("--max-cpu-particles", o.max_cpu_particles, "skip CPU cases with more particles")
+      ->capture_default_str();
+  app.add_option("--max-seconds", o.max_seconds, "time budget of one case's timed ticks (at least 3 run)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    return fail(e.what());
+  }
+
+  // Validate everything before running anything.
+  std::vector<Size> sizes;
+  if (auto err = parseSizes(o.sizes, sizes)) return fail(*err);
+  std::vector<std::string> backends = split(o.backends, ',');
+  if (backends.empty()) return fail("--backends is empty");
+  for (const std::string& b : backends) {
+    if (b != "cpu" && b != "gpu" && b != "gpu-percolor")
+      return fail("unknown backend '" + b + "' (cpu, gpu or gpu-percolor)");
+    if (b != "cpu" && !gpuBuilt()) return fail("this build has no GPU backend (try --backends cpu)");
+  }
+  {
+    auto p = presetParams(o.preset);
+    if (!p) {
+      std::string names;
+      for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
+      return fail("unknown preset '" + o.preset + "' (one of " + names + ")");
+    }
+    for (const std::string& s : o.sets)
+      if (auto err = applyOverride(*p, s)) return fail(*err);
+    if (auto err = validate(*p)) return fail(*err);
+  }
+
+  nlohmann::json out;
+  out["tool"] = "tender-bench";
+  out["version"] = TENDER_VERSION;
+  out["machine"] = {{"cpu_model", cpuModel()}, {"cores", std::thread::hardware_concurrency()}};
+  out["preset"] = o.preset;
+  out["ticks"] = o.ticks;
+  out["warmup"] = o.warmup;
+  out["sets"] = o.sets;
+  out["results"] = nlohmann::json::array();
+
+  Progress progress;
+  const size_t total = sizes.size() * backends.size();
+  size_t index = 0;
+  for (const Size& size : sizes)
+    for (const std::string& backend : backends) {
+      const std::string label =
+          "[" + std::to_string(++index) + "/" + std::to_string(total) + "] " + size.text() + " " + backend;
+      nlohmann::json r = runCase(o, size, backend, label, progress);
+      if (r.contains("device")) out["machine"]["gpu"] = r["device"];
+      out["results"].push_back(r);
+    }
+
+  printTable(out["results"]);
+  if (!o.json.empty()) {
+    std::ofstream f(o.json);
+    if (!(f << out.dump(2) << '\n')) return fail("cannot write '" + o.json + "'");
+  }
+  if (!o.csv.empty() && !writeCsv(o.csv, out["results"])) return fail("cannot write '" + o.csv + "'");
+  return 0;
+}

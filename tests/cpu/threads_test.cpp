@@ -1,0 +1,108 @@
+// The CPU solver gives bitwise identical results on any number of threads.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "core/simulation.h"
+#include "cpu/cpu_solver.h"
+
+using namespace tender;
+
+namespace {
+
+// Runs `ticks` ticks of a preset (with overrides and a script) and returns the final state.
+SimState run(const std::string& preset, std::vector<std::string> sets, const std::string& script, uint32_t ticks,
+             CpuOptions options) {
+  SimParams p = *presetParams(preset);
+  for (auto& s : sets) EXPECT_FALSE(applyOverride(p, s).has_value()) << s;
+  EXPECT_FALSE(validate(p).has_value());
+  CpuSolver solver(options);
+  Simulation sim(p, solver);
+  if (!script.empty()) {
+    std::string error;
+    auto parsed = parseScript(script, error);
+    EXPECT_TRUE(parsed.has_value()) << error;
+    sim.setScript(*parsed);
+  }
+  for (uint32_t t = 0; t < ticks; ++t) sim.tick();
+  solver.computeNormals();
+  SimState s;
+  solver.readback(s);
+  return s;
+}
+
+template <typename T>
+bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+void expectIdentical(const SimState& a, const SimState& b) {
+  EXPECT_TRUE(sameBytes(a.pos, b.pos));
+  EXPECT_TRUE(sameBytes(a.prev, b.prev));
+  EXPECT_TRUE(sameBytes(a.normal, b.normal));
+  EXPECT_TRUE(sameBytes(a.constraints, b.constraints));
+  EXPECT_TRUE(sameBytes(a.colors, b.colors));
+  EXPECT_TRUE(sameBytes(a.torn, b.torn));
+  EXPECT_TRUE(sameBytes(a.triangles, b.triangles));
+  EXPECT_EQ(a.triangle_count, b.triangle_count);
+}
+
+uint32_t tornCount(const SimState& s) {
+  uint32_t n = 0;
+  for (uint32_t t : s.torn) n += t ? 1u : 0u;
+  return n;
+}
+
+// min_chunk = 1 splits every loop, however small, so the small sheets exercise every parallel path.
+constexpr CpuOptions kOne{1, 1}, kTwo{2, 1}, kThree{3, 1};
+
+} // namespace
+
+TEST(CpuThreads, HangingSheetIsIdenticalOnOneAndTwoThreads) {
+  SimState one = run("tender", {}, "", 60, kOne);
+  SimState two = run("tender", {}, "", 60, kTwo);
+  expectIdentical(one, two);
+}
+
+TEST(CpuThreads, TearingYankIsIdenticalOnOneAndTwoThreads) {
+  const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n40 release\n";
+  SimState one = run("tender", {}, yank, 80, kOne);
+  SimState two = run("tender", {}, yank, 80, kTwo);
+  EXPECT_GT(tornCount(one), 0u); // the run really tears and compacts
+  EXPECT_LT(one.triangle_count, 2914u);
+  expectIdentical(one, two);
+}
+
+TEST(CpuThreads, CrumpleTossAndAwkwardSizeAreIdentical) {
+  const std::string toss = "0 grab particle 100\n1 move 1 2 3\n10 release\n";
+  expectIdentical(run("crumple", {"cols=37", "rows=53"}, toss, 40, kOne),
+                  run("crumple", {"cols=37", "rows=53"}, toss, 40, kThree));
+}
+
+TEST(CpuThreads, TunedChunkingIsIdenticalOnALargerSheet) {
+  // Default chunk sizes: the loops of a 96 x 144 sheet are split the way real runs split them.
+  const std::string yank = "0 grab particle 13823\n1 move 6 -4 8\n20 release\n";
+  SimState one = run("tender", {"cols=96", "rows=144"}, yank, 24, CpuOptions{1, 0});
+  SimState two = run("tender", {"cols=96", "rows=144"}, yank, 24, CpuOptions{2, 0});
+  expectIdentical(one, two);
+}
+
+TEST(CpuThreads, ResetAndNoCollisionAreIdentical) {
+  const std::string script = "0 grab particle 1535\n1 move 4 -4 6\n20 reset\n";
+  expectIdentical(run("tender", {"collision=off"}, script, 40, kOne),
+                  run("tender", {"collision=off"}, script, 40, kTwo));
+}
+
+TEST(CpuThreads, ZeroMeansOnePerCore) {
+  CpuSolver solver(CpuOptions{0, 0});
+  EXPECT_GE(solver.threadCount(), 1u);
+  EXPECT_EQ(CpuSolver(CpuOptions{2, 0}).threadCount(), 2u);
+}
+
+TEST(CpuThreads, MemoryIsReported) {
+  SimParams p = *presetParams("tender");
+  CpuSolver solver;
+  Simulation sim(p, solver);
+  // At least pos, prev, rest, normal (16 bytes each) per particle, and the constraints.
+  EXPECT_GE(solver.memoryBytes(), 1536u * 64u + 8818u * 16u);
+}
