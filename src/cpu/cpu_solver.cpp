@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #if defined(__SSE2__)
@@ -26,9 +27,58 @@ namespace {
 constexpr uint32_t kGrainParticles = 4096;   // integrate, floor, hash, reset: a few ns per particle
 constexpr uint32_t kGrainConstraints = 1024; // projection of one colour, tear marking: ~2 ns each
 constexpr uint32_t kGrainCollide = 256;      // collision gather: ~100 ns per particle
+constexpr uint32_t kCollideChunksPerWorker = 4;
 
-// Extra float slots after the sorted position arrays, so 4-wide loads never leave them.
-constexpr uint32_t kSortedPad = 4;
+// Extra slots after the sorted position arrays and the adjacency list, so 4-wide loads never
+// leave them.
+constexpr uint32_t kSortedPad = 4, kAdjacencyPad = 16;
+
+// For each 4-bit hit mask: the indices of its set lanes packed to the front, then the hit count.
+alignas(16) constexpr auto kPackedLanes = [] {
+  std::array<std::array<uint32_t, 8>, 16> t{};
+  for (uint32_t mask = 0; mask < 16; ++mask)
+    for (uint32_t lane = 0; lane < 4; ++lane)
+      if ((mask >> lane) & 1u) t[mask][t[mask][4]++] = lane;
+  return t;
+}();
+
+// The sorted adjacency list of one particle, for the membership tests of its collision hits.
+// Lists of up to 16 entries sit in four registers (the unused lanes hold ~0u, never a particle),
+// so a test is a few compares with no branch on the data.
+class Adjacency {
+public:
+  Adjacency(const uint32_t* adj, uint32_t count) : adj_(adj), count_(count) {
+#if defined(__SSE2__)
+    if (count <= 16) {
+      const __m128i last = _mm_set1_epi32(int(count) - 1);
+      for (int g = 0; g < 4; ++g) {
+        const __m128i lane = _mm_setr_epi32(4 * g, 4 * g + 1, 4 * g + 2, 4 * g + 3);
+        const __m128i entries = _mm_loadu_si128(reinterpret_cast<const __m128i*>(adj + 4 * g));
+        q_[g] = _mm_or_si128(entries, _mm_cmpgt_epi32(lane, last));
+      }
+    }
+#endif
+  }
+
+  bool contains(uint32_t j) const {
+#if defined(__SSE2__)
+    if (count_ <= 16) {
+      const __m128i key = _mm_set1_epi32(int(j));
+      const __m128i eq = _mm_or_si128(_mm_or_si128(_mm_cmpeq_epi32(q_[0], key), _mm_cmpeq_epi32(q_[1], key)),
+                                      _mm_or_si128(_mm_cmpeq_epi32(q_[2], key), _mm_cmpeq_epi32(q_[3], key)));
+      return _mm_movemask_epi8(eq) != 0;
+    }
+#endif
+    return std::binary_search(adj_, adj_ + count_, j);
+  }
+
+private:
+  const uint32_t* adj_;
+  uint32_t count_;
+#if defined(__SSE2__)
+  __m128i q_[4];
+#endif
+};
 
 template <typename T>
 uint64_t bytesOf(const std::vector<T>& v) {
@@ -43,17 +93,31 @@ CpuSolver::CpuSolver(CpuOptions options) : options_(options), pool_(std::make_un
 #endif
 }
 
+// The constraints of each colour, reordered by their first particle, into split arrays for the
+// SIMD loops. Constraints of one colour share no particle, so their order within the colour
+// changes no result; this one makes the share of each worker a band of the sheet (the colours of
+// the greedy colouring mix kinds, each in row order), so a worker keeps the same particles in its
+// cache from colour to colour.
 void CpuSolver::splitConstraints() {
   const size_t m = constraints_.size();
+  std::vector<uint32_t> order(m);
+  for (uint32_t k = 0; k < m; ++k) order[k] = k;
+  auto first = [&](uint32_t k) { return std::min(constraints_[k].a, constraints_[k].b); };
+  for (const ColorRange& range : colors_)
+    std::stable_sort(order.begin() + range.first, order.begin() + range.first + range.count,
+                     [&](uint32_t x, uint32_t y) { return first(x) < first(y); });
   con_a_.resize(m);
   con_b_.resize(m);
   con_kind_.resize(m);
+  con_id_.resize(m);
   con_rest_.resize(m);
   for (size_t k = 0; k < m; ++k) {
-    con_a_[k] = constraints_[k].a;
-    con_b_[k] = constraints_[k].b;
-    con_kind_[k] = constraints_[k].kind_id & SIM_KIND_MASK;
-    con_rest_[k] = constraints_[k].rest;
+    const Constraint& c = constraints_[order[k]];
+    con_a_[k] = c.a;
+    con_b_[k] = c.b;
+    con_kind_[k] = c.kind_id & SIM_KIND_MASK;
+    con_id_[k] = c.kind_id >> SIM_KIND_BITS;
+    con_rest_[k] = c.rest;
   }
 }
 
@@ -80,9 +144,11 @@ void CpuSolver::upload(const SheetTopology& topo) {
   triangle_count_ = topo.triangleCount();
   adj_offsets_ = topo.adj_offsets;
   adj_list_ = topo.adj_list;
+  adj_list_.resize(adj_list_.size() + kAdjacencyPad, ~0u);
   cell_count_.assign(topo.hash_size, 0u);
   cell_start_.assign(topo.hash_size + 1, 0u);
   cell_particles_.assign(n, 0u);
+  particle_slot_.assign(n, 0u);
   particle_cell_.assign(n, 0u);
   particle_coord_.assign(n, glm::ivec4(0));
   sorted_x_.assign(n + kSortedPad, 0.0f);
@@ -169,12 +235,20 @@ void CpuSolver::projectRange(const float stiffness[4], uint32_t begin, uint32_t 
 
 void CpuSolver::project(const SimUniforms& u, uint32_t iterations) {
   const float stiffness[4] = {u.stiffness.x, u.stiffness.y, u.stiffness.z, u.stiffness.w};
-  const uint32_t g = grain(kGrainConstraints);
-  for (uint32_t it = 0; it < iterations; ++it)
-    for (const ColorRange& range : colors_) // Gauss-Seidel over colours
-      pool_->parallelFor(range.count, g, [&](uint32_t begin, uint32_t end) {
-        projectRange(stiffness, range.first + begin, range.first + end);
-      });
+  const uint32_t colors = uint32_t(colors_.size());
+  if (colors == 0) return;
+  uint32_t largest = 0;
+  for (const ColorRange& range : colors_) largest = std::max(largest, range.count);
+  const uint32_t chunks = pool_->chunksFor(largest, grain(kGrainConstraints));
+  // Gauss-Seidel over colours: one phase per colour, as many iterations per job as fit.
+  const uint32_t per_job = std::max(1u, WorkerPool::kMaxPhases / colors);
+  for (uint32_t it = 0; it < iterations; it += per_job)
+    pool_->runPhases(std::min(per_job, iterations - it) * colors, chunks, [&](uint32_t phase, uint32_t chunk) {
+      const ColorRange& range = colors_[phase % colors];
+      const uint32_t begin = WorkerPool::chunkBound(range.count, chunks, chunk);
+      const uint32_t end = WorkerPool::chunkBound(range.count, chunks, chunk + 1);
+      projectRange(stiffness, range.first + begin, range.first + end);
+    });
 }
 
 void CpuSolver::buildHash(const SimUniforms& u) {
@@ -188,23 +262,26 @@ void CpuSolver::buildHash(const SimUniforms& u) {
       particle_cell_[i] = hashCell(c, u.hash_mask);
     }
   });
-  // Count
-  std::fill(cell_count_.begin(), cell_count_.end(), 0u);
+  // Count (the counts are all zero here: the scan clears them)
   uint32_t* count = cell_count_.data();
   const uint32_t* cell = particle_cell_.data();
   for (uint32_t i = 0; i < n; ++i) count[cell[i]]++;
-  // Exclusive scan
+  // Exclusive scan, shifted by one: start[h + 1] is the scatter's cursor in bucket h, and ends as
+  // the start of bucket h + 1.
   uint32_t sum = 0;
   uint32_t* start = cell_start_.data();
+  start[0] = 0;
   for (size_t h = 0, buckets = cell_count_.size(); h < buckets; ++h) {
-    start[h] = sum;
+    start[h + 1] = sum;
     sum += count[h];
+    count[h] = 0;
   }
-  start[cell_count_.size()] = sum;
   // Scatter in index order, so the particles of a bucket stay sorted by index
-  std::copy(cell_start_.begin(), cell_start_.end() - 1, cell_count_.begin());
-  uint32_t* sorted = cell_particles_.data();
-  for (uint32_t i = 0; i < n; ++i) sorted[count[cell[i]]++] = i;
+  uint32_t *sorted = cell_particles_.data(), *slot = particle_slot_.data();
+  for (uint32_t i = 0; i < n; ++i) {
+    slot[i] = start[cell[i] + 1]++;
+    sorted[slot[i]] = i;
+  }
   // Gather positions and cells in bucket order, for the collision pass
   pool_->parallelFor(n, g, [&](uint32_t begin, uint32_t end) {
     for (uint32_t k = begin; k < end; ++k) {
@@ -229,11 +306,8 @@ void CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end)
 
   // Buckets of the 27 cells around the current cell (dz, dy, dx order), looked up when first
   // needed and reused while the cell repeats.
-  struct Bucket {
-    uint32_t first, last;
-    ivec3 cell;
-  };
-  Bucket buckets[27];
+  uint32_t bucket_first[27], bucket_last[27];
+  ivec4 bucket_cell[27];
   ivec3 cached_cell(0);
   bool cached = false;
   uint32_t known = 0;    // bit b: bucket b is looked up for the current cell
@@ -281,13 +355,14 @@ void CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end)
       const int b = __builtin_ctz(missing);
       const ivec3 c = ci + ivec3(b % 3 - 1, b / 3 % 3 - 1, b / 9 - 1);
       const uint32_t h = hashCell(c, u.hash_mask);
-      buckets[b] = {start[h], start[h + 1], c};
+      bucket_first[b] = start[h];
+      bucket_last[b] = start[h + 1];
+      bucket_cell[b] = ivec4(c, 0);
       nonempty |= start[h] < start[h + 1] ? 1u << b : 0u;
     }
     known |= visit;
     visit &= nonempty;
-    const uint32_t* adj = adj_list_.data() + adj_offsets_[i];
-    const uint32_t adj_count = adj_offsets_[i + 1] - adj_offsets_[i];
+    const Adjacency adjacency(adj_list_.data() + adj_offsets_[i], adj_offsets_[i + 1] - adj_offsets_[i]);
     vec3 sum(0.0f);
     uint32_t hit_count = 0;
     // Sums the hits so far. Skips the particle itself (slot k), particles of other cells sharing
@@ -295,13 +370,7 @@ void CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end)
     auto flush = [&] {
       for (uint32_t t = 0; t < hit_count; ++t) {
         const uint32_t m = hit_slot[t];
-        const Bucket& bucket = buckets[hit_bucket[t]];
-        if (m == k || ivec3(coords[m]) != bucket.cell) continue;
-        // Branch-free lower bound in the sorted adjacency list
-        const uint32_t j = slots[m];
-        const uint32_t* base = adj;
-        for (uint32_t len = adj_count; len > 1; len -= len / 2) base = base[len / 2 - 1] < j ? base + len / 2 : base;
-        if (adj_count > 0 && (*base == j || (base + 1 < adj + adj_count && base[1] == j))) continue;
+        if (m == k || coords[m] != bucket_cell[hit_bucket[t]] || adjacency.contains(slots[m])) continue;
         sum += repulsion(pi, vec3(sx[m], sy[m], sz[m]), r, u.collision_stiffness);
       }
       hit_count = 0;
@@ -312,8 +381,8 @@ void CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end)
     while (visit) { // ascending bucket index: dz, dy, dx order
       const uint32_t b = uint32_t(__builtin_ctz(visit));
       visit &= visit - 1u;
-      const Bucket& bucket = buckets[b];
-      for (uint32_t m = bucket.first; m < bucket.last; m += 4) {
+      const uint32_t first = bucket_first[b], last = bucket_last[b];
+      for (uint32_t m = first; m < last; m += 4) {
 #if defined(__SSE2__)
         // d = pi - pj; the same dot(d, d) < r2 test as the scalar maths, four at a time
         const __m128 dx = _mm_sub_ps(px, _mm_loadu_ps(sx + m));
@@ -323,28 +392,40 @@ void CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end)
         uint32_t hits = uint32_t(_mm_movemask_ps(_mm_cmplt_ps(d2, vr2)));
 #else
         uint32_t hits = 0;
-        for (uint32_t lane = 0; lane < 4 && m + lane < bucket.last; ++lane) {
+        for (uint32_t lane = 0; lane < 4 && m + lane < last; ++lane) {
           const vec3 d = pi - vec3(sx[m + lane], sy[m + lane], sz[m + lane]);
           hits |= dot(d, d) < r2 ? 1u << lane : 0u;
         }
 #endif
-        if (bucket.last - m < 4) hits &= (1u << (bucket.last - m)) - 1u;
+        if (last - m < 4) hits &= (1u << (last - m)) - 1u;
+#if defined(__SSE2__)
+        // Append the hit lanes, packed to the front: four slots and buckets stored, the hits kept.
+        const __m128i lanes = _mm_load_si128(reinterpret_cast<const __m128i*>(kPackedLanes[hits].data()));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(hit_slot + hit_count),
+                         _mm_add_epi32(_mm_set1_epi32(int(m)), lanes));
+        const uint32_t bucket4 = b * 0x01010101u;
+        std::memcpy(hit_bucket + hit_count, &bucket4, 4);
+        hit_count += kPackedLanes[hits][4];
+#else
         for (uint32_t lane = 0; lane < 4; ++lane) {
           hit_slot[hit_count] = m + lane;
           hit_bucket[hit_count] = uint8_t(b);
           hit_count += (hits >> lane) & 1u;
         }
+#endif
         if (hit_count > kHitCapacity) flush();
       }
     }
     flush();
-    delta_[i] = vec4(sum, 0.0f);
+    delta_[k] = vec4(sum, 0.0f);
   }
 }
 
 void CpuSolver::collide(const SimUniforms& u) {
-  pool_->parallelFor(uint32_t(pos_.size()), grain(kGrainCollide),
-                     [&](uint32_t begin, uint32_t end) { collideRange(u, begin, end); });
+  // Several shares per worker: the cost of a particle varies with the crowd around it.
+  pool_->parallelFor(
+      uint32_t(pos_.size()), grain(kGrainCollide), [&](uint32_t begin, uint32_t end) { collideRange(u, begin, end); },
+      kCollideChunksPerWorker);
 }
 
 void CpuSolver::floorPass(const SimUniforms& u) {
@@ -353,9 +434,10 @@ void CpuSolver::floorPass(const SimUniforms& u) {
     vec4* pos = pos_.data();
     vec4* prev = prev_.data();
     const vec4* delta = delta_.data();
+    const uint32_t* slot = particle_slot_.data();
     for (uint32_t i = begin; i < end; ++i) {
       vec4 p = pos[i];
-      if (collide && p.w > 0.0f) p += vec4(vec3(delta[i]), 0.0f);
+      if (collide && p.w > 0.0f) p += vec4(vec3(delta[slot[i]]), 0.0f);
       VerletState st = floorContact(p, prev[i], u.floor_y, u.restitution, u.friction);
       pos[i] = st.pos;
       prev[i] = st.prev;
@@ -363,18 +445,42 @@ void CpuSolver::floorPass(const SimUniforms& u) {
   });
 }
 
-// Marks the live constraints among array slots [begin, end); returns how many tore.
+// Marks the live constraints among array slots [begin, end) of the split arrays; returns how many
+// tore. Four at a time, the length test of shouldTear with the same operations; the few lanes that
+// pass it go through shouldTear itself.
 uint32_t CpuSolver::markTearsRange(const SimUniforms& u, uint32_t begin, uint32_t end) {
+  const vec4* p = pos_.data();
+  const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
+  const float* rest = con_rest_.data();
   uint32_t torn = 0;
+  auto check = [&](uint32_t k) {
+    if (shouldTear(p[ca[k]], p[cb[k]], rest[k], kind[k], u.tear_factor, u.tear_kinds)) {
+      torn_[id[k]] = 1u;
+      ++torn;
+    }
+  };
   for (const ColorRange& range : colors_) {
     const uint32_t first = std::max(begin, range.first), last = std::min(end, range.first + range.count);
-    for (uint32_t k = first; k < last; ++k) {
-      const Constraint& c = constraints_[k];
-      if (shouldTear(pos_[c.a], pos_[c.b], c.rest, c.kind_id & SIM_KIND_MASK, u.tear_factor, u.tear_kinds)) {
-        torn_[c.kind_id >> SIM_KIND_BITS] = 1u;
-        ++torn;
-      }
+    uint32_t k = first;
+#if defined(__SSE2__)
+    const __m128 factor = _mm_set1_ps(u.tear_factor);
+    for (; k + 4 <= last; k += 4) {
+      __m128 ax = _mm_loadu_ps(&p[ca[k]].x), ay = _mm_loadu_ps(&p[ca[k + 1]].x);
+      __m128 az = _mm_loadu_ps(&p[ca[k + 2]].x), aw = _mm_loadu_ps(&p[ca[k + 3]].x);
+      __m128 bx = _mm_loadu_ps(&p[cb[k]].x), by = _mm_loadu_ps(&p[cb[k + 1]].x);
+      __m128 bz = _mm_loadu_ps(&p[cb[k + 2]].x), bw = _mm_loadu_ps(&p[cb[k + 3]].x);
+      _MM_TRANSPOSE4_PS(ax, ay, az, aw);
+      _MM_TRANSPOSE4_PS(bx, by, bz, bw);
+      // sqrt(dot(d, d)) > rest * tear_factor with d = b - a and dot = (x*x + y*y) + z*z
+      const __m128 dx = _mm_sub_ps(bx, ax), dy = _mm_sub_ps(by, ay), dz = _mm_sub_ps(bz, az);
+      const __m128 len =
+          _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz)));
+      const __m128 limit = _mm_mul_ps(_mm_loadu_ps(rest + k), factor);
+      for (uint32_t over = uint32_t(_mm_movemask_ps(_mm_cmpgt_ps(len, limit))); over; over &= over - 1u)
+        check(k + uint32_t(__builtin_ctz(over)));
     }
+#endif
+    for (; k < last; ++k) check(k);
   }
   return torn;
 }
@@ -393,9 +499,18 @@ void CpuSolver::compact() {
     uint32_t w = range.first;
     for (uint32_t k = range.first; k < range.first + range.count; ++k)
       if (!torn_[constraints_[k].kind_id >> SIM_KIND_BITS]) constraints_[w++] = constraints_[k];
+    // The split arrays lose the same constraints of the colour and keep their order.
+    uint32_t v = range.first;
+    for (uint32_t k = range.first; k < range.first + range.count; ++k)
+      if (!torn_[con_id_[k]]) {
+        con_a_[v] = con_a_[k];
+        con_b_[v] = con_b_[k];
+        con_kind_[v] = con_kind_[k];
+        con_id_[v] = con_id_[k];
+        con_rest_[v++] = con_rest_[k];
+      }
     range.count = w - range.first;
   }
-  splitConstraints();
   const auto& edges = topo_->tri_edges;
   uint32_t w = 0;
   for (uint32_t k = 0; k < triangle_count_; ++k) {
@@ -484,10 +599,10 @@ void CpuSolver::readback(SimState& out) {
 uint64_t CpuSolver::memoryBytes() const {
   return bytesOf(pos_) + bytesOf(prev_) + bytesOf(rest_) + bytesOf(normal_) + bytesOf(delta_) + bytesOf(reset_from_) +
          bytesOf(uv_) + bytesOf(constraints_) + bytesOf(colors_) + bytesOf(torn_) + bytesOf(con_a_) + bytesOf(con_b_) +
-         bytesOf(con_kind_) + bytesOf(con_rest_) + bytesOf(triangles_) + bytesOf(adj_offsets_) + bytesOf(adj_list_) +
-         bytesOf(cell_count_) + bytesOf(cell_start_) + bytesOf(cell_particles_) + bytesOf(particle_cell_) +
-         bytesOf(particle_coord_) + bytesOf(sorted_x_) + bytesOf(sorted_y_) + bytesOf(sorted_z_) +
-         bytesOf(sorted_coord_);
+         bytesOf(con_kind_) + bytesOf(con_id_) + bytesOf(con_rest_) + bytesOf(triangles_) + bytesOf(adj_offsets_) +
+         bytesOf(adj_list_) + bytesOf(cell_count_) + bytesOf(cell_start_) + bytesOf(cell_particles_) +
+         bytesOf(particle_slot_) + bytesOf(particle_cell_) + bytesOf(particle_coord_) + bytesOf(sorted_x_) +
+         bytesOf(sorted_y_) + bytesOf(sorted_z_) + bytesOf(sorted_coord_);
 }
 
 } // namespace tender

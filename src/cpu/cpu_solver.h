@@ -74,11 +74,13 @@ private:
   CpuOptions options_;
   std::unique_ptr<WorkerPool> pool_;
   const SheetTopology* topo_ = nullptr;
-  std::vector<glm::vec4> pos_, prev_, rest_, normal_, delta_, reset_from_;
+  std::vector<glm::vec4> pos_, prev_, rest_, normal_, reset_from_;
+  std::vector<glm::vec4> delta_; // collision delta of each hash slot (hash order: no false sharing)
   std::vector<glm::vec2> uv_;
   std::vector<shaderio::Constraint> constraints_;
   std::vector<ColorRange> colors_;
-  std::vector<uint32_t> con_a_, con_b_, con_kind_; // constraints_ split into arrays (SIMD loads)
+  // constraints_ split into arrays for SIMD loads, each colour ordered by first particle
+  std::vector<uint32_t> con_a_, con_b_, con_kind_, con_id_;
   std::vector<float> con_rest_;
   bool avx_ = false; // the 8-wide kernels run on this CPU
   std::vector<uint32_t> torn_;
@@ -86,6 +88,7 @@ private:
   uint32_t triangle_count_ = 0;
   std::vector<uint32_t> adj_offsets_, adj_list_; // CSR adjacency (copied from the topology)
   std::vector<uint32_t> cell_count_, cell_start_, cell_particles_, particle_cell_;
+  std::vector<uint32_t> particle_slot_;               // hash slot of each particle (cell_particles_ inverted)
   std::vector<glm::ivec4> particle_coord_;            // integer cell of each particle
   std::vector<float> sorted_x_, sorted_y_, sorted_z_; // positions in hash order (SoA, padded)
   std::vector<glm::ivec4> sorted_coord_;              // cells in hash order

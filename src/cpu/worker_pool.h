@@ -1,8 +1,12 @@
 #pragma once
-/// A small persistent pool of worker threads that runs one parallel loop at a time.
-/// A loop is cut into chunks that the workers claim one by one (the calling thread takes part),
-/// so a helper the OS has not scheduled yet never holds up the loop: the others take its share.
-/// Helpers spin briefly between loops, then sleep on a condition variable.
+/// A small persistent pool of worker threads that runs one parallel job at a time.
+/// A job is a sequence of phases, each cut into chunks; a phase starts once every chunk of the
+/// previous one has returned (a barrier without a fork/join). The workers claim chunks one by
+/// one (the calling thread takes part), each preferring the chunk of its own number, so a worker
+/// stays on the same data from phase to phase, while a chunk no one has claimed yet is taken by
+/// whichever worker is free: a helper the OS has not scheduled never holds up a job unless it
+/// is running one of its chunks. Helpers spin briefly between jobs, then sleep on a condition
+/// variable; waits inside a job spin briefly, then yield the core.
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
@@ -25,26 +29,47 @@ public:
   /// Number of workers, the caller included.
   uint32_t size() const { return size_; }
 
-  /// Calls f(chunk) for every chunk in [0, chunks), spread over the workers, and returns when
-  /// every call has returned. With one chunk (or one worker) f runs on the caller alone.
+  /// Most chunks in one phase, and most phases in one job.
+  static constexpr uint32_t kMaxChunks = 32, kMaxPhases = 4096;
+
+  /// Calls f(phase, chunk) for every phase in [0, phases) and chunk in [0, chunks) (chunks is
+  /// clamped to kMaxChunks; phases must not exceed kMaxPhases). The calls of a phase start once
+  /// every call of the previous phase has returned, and their writes are visible to them. Returns
+  /// when every call has returned. With one chunk (or one worker) f runs on the caller alone.
   template <typename F>
-  void run(uint32_t chunks, F&& f) {
-    if (chunks <= 1 || size_ == 1) {
-      for (uint32_t c = 0; c < chunks; ++c) f(c);
+  void runPhases(uint32_t phases, uint32_t chunks, F&& f) {
+    chunks = std::min(chunks, kMaxChunks);
+    if (phases == 0 || chunks == 0) return;
+    if (chunks == 1 || size_ == 1) {
+      for (uint32_t p = 0; p < phases; ++p)
+        for (uint32_t c = 0; c < chunks; ++c) f(p, c);
       return;
     }
     using Fn = std::remove_reference_t<F>;
-    job_ = const_cast<void*>(static_cast<const void*>(&f));
-    call_ = [](void* ctx, uint32_t c) { (*static_cast<Fn*>(ctx))(c); };
-    dispatch(chunks);
+    dispatch(
+        const_cast<void*>(static_cast<const void*>(&f)),
+        [](void* ctx, uint32_t p, uint32_t c) { (*static_cast<Fn*>(ctx))(p, c); }, phases, chunks);
   }
 
-  /// Splits [0, n) into contiguous ranges of at least `grain` elements (kChunksPerWorker per worker) and
-  /// calls f(begin, end) for each; small loops run on the caller alone. Range bounds are
-  /// multiples of 4, so SIMD loops see whole groups.
+  /// Calls f(chunk) for every chunk in [0, chunks) (at most kMaxChunks), spread over the workers.
   template <typename F>
-  void parallelFor(uint32_t n, uint32_t grain, F&& f) {
-    const uint32_t chunks = std::min<uint32_t>(size_ * kChunksPerWorker, n / std::max(grain, 1u));
+  void run(uint32_t chunks, F&& f) {
+    runPhases(1, chunks, [&](uint32_t, uint32_t c) { f(c); });
+  }
+
+  /// Number of chunks parallelFor cuts [0, n) into: `per_worker` per worker, at least `grain`
+  /// elements each, at most kMaxChunks; 1 means the caller runs the loop alone.
+  uint32_t chunksFor(uint32_t n, uint32_t grain, uint32_t per_worker = 1) const {
+    return std::max(1u, std::min({size_ * per_worker, n / std::max(grain, 1u), kMaxChunks}));
+  }
+
+  /// Splits [0, n) into chunksFor(n, grain, per_worker) contiguous ranges and calls f(begin, end)
+  /// for each; small loops run on the caller alone. Range bounds are multiples of 4, so SIMD
+  /// loops see whole groups. One share per worker (the default) keeps a thread on the same
+  /// elements from loop to loop; more shares balance loops whose elements differ in cost.
+  template <typename F>
+  void parallelFor(uint32_t n, uint32_t grain, F&& f, uint32_t per_worker = 1) {
+    const uint32_t chunks = chunksFor(n, grain, per_worker);
     if (chunks <= 1 || size_ == 1) {
       if (n > 0) f(0u, n);
       return;
@@ -61,26 +86,27 @@ public:
     return uint32_t((uint64_t(n) * c / parts) & ~uint64_t(3));
   }
 
-  /// Chunks per worker in parallelFor. One contiguous share each keeps a thread on the same
-  /// particles from colour to colour (measured fastest: fewer cache lines move between cores);
-  /// a share no helper has claimed yet is still taken by whichever worker is free.
-  static constexpr uint32_t kChunksPerWorker = 1;
-
 private:
-  void dispatch(uint32_t chunks);
-  void work();
+  using Call = void (*)(void*, uint32_t, uint32_t);
+  void dispatch(void* ctx, Call call, uint32_t phases, uint32_t chunks);
+  void work(uint32_t worker);
   void wakeHelpers();
-  void helperLoop(uint32_t seen);
+  void helperLoop(uint32_t worker);
 
   uint32_t size_ = 1;
   std::vector<std::thread> helpers_;
-  void* job_ = nullptr;
-  void (*call_)(void*, uint32_t) = nullptr;
   uint64_t job_id_ = 0;
-  // The current loop in one word: job id << 40 | chunk count << 20 | next unclaimed chunk.
+  // The current job in one word: job id << 44 | phase << 32 | bit mask of its claimed chunks;
+  // job id 0 means no job (the word is closed while the next job's fields are written).
+  // A claim is a compare-exchange of this word, so a worker holding a stale copy (an earlier job)
+  // never claims anything; the fields below are read after loading it, and a claim that succeeds
+  // proves they belong to its job (they are rewritten only once every chunk has returned).
   std::atomic<uint64_t> claim_{0};
-  std::atomic<uint32_t> inflight_{0}; // helpers inside work()
-  std::atomic<uint32_t> ticket_{0};   // bumped once per loop to wake the helpers
+  std::atomic<void*> ctx_{nullptr};
+  std::atomic<Call> call_{nullptr};
+  std::atomic<uint32_t> phases_{0}, chunks_{1};
+  std::atomic<uint32_t> done_{0};     // chunks of the current job that have returned
+  std::atomic<uint32_t> ticket_{0};   // bumped once per job to wake the helpers
   std::atomic<uint32_t> sleepers_{0}; // helpers asleep on wake_
   std::mutex sleep_mutex_;
   std::condition_variable wake_;

@@ -87,6 +87,15 @@ TEST(CpuThreads, TunedChunkingIsIdenticalOnALargerSheet) {
   expectIdentical(one, two);
 }
 
+TEST(CpuThreads, FullAdjacencyAndFourThreadsAreIdentical) {
+  // Bend and triangle bend together: 16 neighbours per inner particle, the most the collision
+  // pass's adjacency test holds in registers; four workers split every loop and phase.
+  const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n30 release\n";
+  SimState one = run("tender", {"tri_bend=on"}, yank, 50, kOne);
+  EXPECT_GT(tornCount(one), 0u);
+  expectIdentical(one, run("tender", {"tri_bend=on"}, yank, 50, CpuOptions{4, 1}));
+}
+
 TEST(CpuThreads, ResetAndNoCollisionAreIdentical) {
   const std::string script = "0 grab particle 1535\n1 move 4 -4 6\n20 reset\n";
   expectIdentical(run("tender", {"collision=off"}, script, 40, kOne),
