@@ -57,13 +57,26 @@
 #define SIM_BIND_CELL_SCATTER 22
 #define SIM_BIND_COMPACT_TMP 23
 #define SIM_BIND_CELL_POS 24
+#define SIM_BIND_ADJ_MASK 25
+
+// Adjacency masks (SIM_BIND_ADJ_MASK): bit (dy + 2) * 5 + (dx + 2) is set when particle i is
+// connected to the particle dx columns and dy rows away; SIM_ADJ_FAR when it is connected to a
+// particle outside that 5 x 5 stencil (look those up in the adjacency list)
+#define SIM_ADJ_STENCIL 2
+#define SIM_ADJ_FAR 0x80000000u
 
 // Elements one workgroup of the block scan covers
 #define SIM_SCAN_BLOCK (SIM_WG_SCAN * SIM_SCAN_PER_THREAD)
-// Workgroup size of the fused small-sheet substep (integrate + every colour in one workgroup)
+// Workgroup size of the fused small-sheet tick (every pass of every substep in one workgroup);
+// the largest the tick is specialised to (specialization constant 0)
 #define SIM_WG_FUSED 256
-// Largest sheet the fused substep takes: its positions fill 32 KiB of shared memory (vec4 each)
+// Workgroup size of the fused tick on a CPU device: lavapipe runs a workgroup on one thread, its
+// SIMD groups taking turns at every barrier, so fewer invocations pay less for each barrier
+#define SIM_WG_FUSED_CPU 128
+// Largest sheet the fused tick takes: its positions fill 32 KiB of shared memory (vec4 each)
 #define SIM_FUSED_MAX_PARTICLES 2048
+// Largest hash table the fused tick takes (one workgroup scans it every substep)
+#define SIM_FUSED_MAX_BUCKETS 4096u
 
 // Largest workgroup count in X of one dispatch; bigger grids spill into Y
 #define SIM_MAX_GROUPS_X 65535u

@@ -16,37 +16,37 @@ struct Constraint {
 
 /// Per-tick inputs of the simulation (one uniform buffer, std140 == C++ layout).
 struct SimUniforms {
-  uint particle_count;   // N
-  uint cols;             // grid width
-  uint rows;             // grid height
-  uint substeps;         // substeps per tick (<= SIM_MAX_SUBSTEPS)
+  uint particle_count; // N
+  uint cols;           // grid width
+  uint rows;           // grid height
+  uint substeps;       // substeps per tick (<= SIM_MAX_SUBSTEPS)
 
   uint constraint_count; // original constraint count (size of `torn`)
   uint triangle_count;   // original triangle count
   uint hash_mask;        // hash table size - 1 (table size is a power of two >= 2N)
   uint color_count;      // number of colours
 
-  float dt;              // substep length in seconds
-  float damping;         // Verlet velocity factor per substep
-  float gravity;         // magnitude, pointing -Y
-  float floor_y;         // ground height
+  float dt;      // substep length in seconds
+  float damping; // Verlet velocity factor per substep
+  float gravity; // magnitude, pointing -Y
+  float floor_y; // ground height
 
-  float restitution;     // normal velocity kept on floor contact
-  float friction;        // tangential velocity removed on floor contact
+  float restitution;      // normal velocity kept on floor contact
+  float friction;         // tangential velocity removed on floor contact
   float collision_radius; // repulsion distance (1.2 x spacing)
-  float inv_cell;        // 1 / hash cell size
+  float inv_cell;         // 1 / hash cell size
 
   float collision_stiffness; // fraction of the overlap corrected per substep
-  float tear_factor;     // tear beyond tear_factor x rest; 0 disables tearing
-  uint tear_kinds;       // bit k set: constraints of kind k may tear
-  uint flags;            // SIM_FLAG_*
+  float tear_factor;         // tear beyond tear_factor x rest; 0 disables tearing
+  uint tear_kinds;           // bit k set: constraints of kind k may tear
+  uint flags;                // SIM_FLAG_*
 
-  vec4 stiffness;        // projection stiffness per kind (structural, shear, bend, tri-bend)
+  vec4 stiffness; // projection stiffness per kind (structural, shear, bend, tri-bend)
 
-  uint grab_index;       // grabbed particle or SIM_NONE
-  uint reset_active;     // 1 while the animated reset runs (physics passes are skipped)
-  float reset_alpha;     // reset interpolation factor of this frame, 0..1
-  uint iterations;       // constraint iterations per substep
+  uint grab_index;   // grabbed particle or SIM_NONE
+  uint reset_active; // 1 while the animated reset runs (physics passes are skipped)
+  float reset_alpha; // reset interpolation factor of this frame, 0..1
+  uint iterations;   // constraint iterations per substep
 
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
   vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet

@@ -77,9 +77,7 @@ SIM_INLINE PairDelta solveDistance(vec4 pa, vec4 pb, float rest, float stiffness
 }
 
 /// Integer cell of a position in the spatial hash.
-SIM_INLINE ivec3 cellOf(vec3 p, float inv_cell) {
-  return ivec3(floor(p * inv_cell));
-}
+SIM_INLINE ivec3 cellOf(vec3 p, float inv_cell) { return ivec3(floor(p * inv_cell)); }
 
 /// Hash bucket of a cell.
 SIM_INLINE uint hashCell(ivec3 c, uint mask) {

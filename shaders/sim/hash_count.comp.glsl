@@ -3,12 +3,11 @@
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
 #include "sim_common.glsl"
+#include "sim_elements.glsl"
 layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uint i = threadIndex();
   if (i >= p.count) return;
-  uint h = hashCell(cellOf(vec3(pos[i]), u.inv_cell), u.hash_mask);
-  particle_cell[i] = h;
-  atomicAdd(cell_count[h], 1u);
+  hashCount(i, vec3(pos[i]));
 }

@@ -10,7 +10,8 @@ void main() {
   uvec2 range = color_range[p.color];
   if (t >= range.y) return; // beyond the live count of this colour
   Constraint c = constraints[range.x + t];
-  PairDelta d = solveDistance(pos[c.a], pos[c.b], c.rest, u.stiffness[c.kind_id & SIM_KIND_MASK]);
-  pos[c.a] += vec4(d.da, 0.0f);
-  pos[c.b] += vec4(d.db, 0.0f);
+  vec4 pa = pos[c.a], pb = pos[c.b]; // a != b: each end is read once
+  PairDelta d = solveDistance(pa, pb, c.rest, u.stiffness[c.kind_id & SIM_KIND_MASK]);
+  pos[c.a] = pa + vec4(d.da, 0.0f);
+  pos[c.b] = pb + vec4(d.db, 0.0f);
 }

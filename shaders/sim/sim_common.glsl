@@ -7,43 +7,62 @@
 #ifndef SIM_LOCAL_SIZE
 #error "define SIM_LOCAL_SIZE before including sim_common.glsl"
 #endif
+#ifdef SIM_LOCAL_SIZE_SPECIALIZED
+// The workgroup size is specialization constant 0 (SIM_LOCAL_SIZE when not specialised)
+layout(local_size_x = SIM_LOCAL_SIZE, local_size_x_id = 0) in;
+#else
 layout(local_size_x = SIM_LOCAL_SIZE) in;
+#endif
+
+// A shader whose invocations exchange data through buffers inside one dispatch (the fused tick)
+// defines SIM_COHERENT as `coherent` before including this file.
+#ifndef SIM_COHERENT
+#define SIM_COHERENT
+#endif
 
 layout(std140, set = 0, binding = SIM_BIND_UNIFORMS) uniform UniformsBlock { SimUniforms u; };
-layout(std430, set = 0, binding = SIM_BIND_POS) buffer PosBuffer { vec4 pos[]; };
-layout(std430, set = 0, binding = SIM_BIND_PREV) buffer PrevBuffer { vec4 prev[]; };
+layout(std430, set = 0, binding = SIM_BIND_POS) SIM_COHERENT buffer PosBuffer { vec4 pos[]; };
+layout(std430, set = 0, binding = SIM_BIND_PREV) SIM_COHERENT buffer PrevBuffer { vec4 prev[]; };
 layout(std430, set = 0, binding = SIM_BIND_REST) readonly buffer RestBuffer { vec4 rest_pos[]; };
 layout(std430, set = 0, binding = SIM_BIND_UV) readonly buffer UvBuffer { vec2 uv[]; };
-layout(std430, set = 0, binding = SIM_BIND_NORMAL) buffer NormalBuffer { vec4 normal[]; };
-layout(std430, set = 0, binding = SIM_BIND_CONSTRAINTS) buffer ConstraintBuffer { Constraint constraints[]; };
-layout(std430, set = 0, binding = SIM_BIND_COLOR_RANGES) buffer ColorRangeBuffer { uvec2 color_range[]; };
+layout(std430, set = 0, binding = SIM_BIND_NORMAL) SIM_COHERENT buffer NormalBuffer { vec4 normal[]; };
+layout(std430, set = 0, binding = SIM_BIND_CONSTRAINTS) SIM_COHERENT buffer ConstraintBuffer {
+  Constraint constraints[];
+};
+layout(std430, set = 0, binding = SIM_BIND_COLOR_RANGES) SIM_COHERENT buffer ColorRangeBuffer { uvec2 color_range[]; };
 layout(std430, set = 0, binding = SIM_BIND_ADJ_OFFSETS) readonly buffer AdjOffsetBuffer { uint adj_offsets[]; };
 layout(std430, set = 0, binding = SIM_BIND_ADJ_LIST) readonly buffer AdjListBuffer { uint adj_list[]; };
-layout(std430, set = 0, binding = SIM_BIND_CELL_COUNT) buffer CellCountBuffer { uint cell_count[]; };
-layout(std430, set = 0, binding = SIM_BIND_CELL_START) buffer CellStartBuffer { uint cell_start[]; };
-layout(std430, set = 0, binding = SIM_BIND_CELL_PARTICLES) buffer CellParticleBuffer { uint cell_particles[]; };
-layout(std430, set = 0, binding = SIM_BIND_PARTICLE_CELL) buffer ParticleCellBuffer { uint particle_cell[]; };
-layout(std430, set = 0, binding = SIM_BIND_DELTA) buffer DeltaBuffer { vec4 delta[]; };
-layout(std430, set = 0, binding = SIM_BIND_TORN) buffer TornBuffer { uint torn[]; };
-layout(std430, set = 0, binding = SIM_BIND_TRIANGLES) buffer TriangleBuffer { uvec4 triangles[]; };
+layout(std430, set = 0, binding = SIM_BIND_ADJ_MASK) readonly buffer AdjMaskBuffer { uint adj_mask[]; };
+layout(std430, set = 0, binding = SIM_BIND_CELL_COUNT) SIM_COHERENT buffer CellCountBuffer { uint cell_count[]; };
+layout(std430, set = 0, binding = SIM_BIND_CELL_START) SIM_COHERENT buffer CellStartBuffer { uint cell_start[]; };
+layout(std430, set = 0, binding = SIM_BIND_CELL_PARTICLES) SIM_COHERENT buffer CellParticleBuffer {
+  uint cell_particles[];
+};
+layout(std430, set = 0, binding = SIM_BIND_PARTICLE_CELL) SIM_COHERENT buffer ParticleCellBuffer {
+  uint particle_cell[];
+};
+layout(std430, set = 0, binding = SIM_BIND_DELTA) SIM_COHERENT buffer DeltaBuffer { vec4 delta[]; };
+layout(std430, set = 0, binding = SIM_BIND_TORN) SIM_COHERENT buffer TornBuffer { uint torn[]; };
+layout(std430, set = 0, binding = SIM_BIND_TRIANGLES) SIM_COHERENT buffer TriangleBuffer { uvec4 triangles[]; };
 layout(std430, set = 0, binding = SIM_BIND_TRI_EDGES) readonly buffer TriEdgeBuffer { uvec2 tri_edges[]; };
-layout(std430, set = 0, binding = SIM_BIND_COUNTERS) buffer CounterBuffer { Counters counters; };
-layout(std430, set = 0, binding = SIM_BIND_SCRATCH) buffer ScratchBuffer { uint scratch[]; };
-layout(std430, set = 0, binding = SIM_BIND_PICK) buffer PickBuffer {
+layout(std430, set = 0, binding = SIM_BIND_COUNTERS) SIM_COHERENT buffer CounterBuffer { Counters counters; };
+layout(std430, set = 0, binding = SIM_BIND_SCRATCH) SIM_COHERENT buffer ScratchBuffer { uint scratch[]; };
+layout(std430, set = 0, binding = SIM_BIND_PICK) SIM_COHERENT buffer PickBuffer {
   uint pick_index;
   float pick_t;
   uint pick_d2;
   uint pick_pad;
 };
-layout(std430, set = 0, binding = SIM_BIND_RESET_FROM) buffer ResetFromBuffer { vec4 reset_from[]; };
-layout(std430, set = 0, binding = SIM_BIND_CELL_SCATTER) buffer CellScatterBuffer { uint cell_scatter[]; };
-layout(std430, set = 0, binding = SIM_BIND_COMPACT_TMP) buffer CompactTmpBuffer { uvec4 compact_tmp[]; };
-// Positions in bucket order (a copy of pos[cell_particles[k]]), so collide reads buckets contiguously
-layout(std430, set = 0, binding = SIM_BIND_CELL_POS) buffer CellPosBuffer { vec4 cell_pos[]; };
+layout(std430, set = 0, binding = SIM_BIND_RESET_FROM) SIM_COHERENT buffer ResetFromBuffer { vec4 reset_from[]; };
+layout(std430, set = 0, binding = SIM_BIND_CELL_SCATTER) SIM_COHERENT buffer CellScatterBuffer { uint cell_scatter[]; };
+layout(std430, set = 0, binding = SIM_BIND_COMPACT_TMP) SIM_COHERENT buffer CompactTmpBuffer { uvec4 compact_tmp[]; };
+// Bucket order: xyz the bits of pos[cell_particles[k]].xyz, w the particle cell_particles[k], so
+// collide reads buckets contiguously in one load per candidate
+layout(std430, set = 0, binding = SIM_BIND_CELL_POS) SIM_COHERENT buffer CellPosBuffer { uvec4 cell_pos[]; };
 
 // Linear index of this invocation; grids wider than SIM_MAX_GROUPS_X spill into Y.
 uint threadIndex() {
-  return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * SIM_LOCAL_SIZE + gl_LocalInvocationID.x;
+  return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
 }
 
 // Linear index of this workgroup.

@@ -4,6 +4,7 @@
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_TEAR
 #include "sim_common.glsl"
+#include "sim_elements.glsl"
 layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
@@ -13,12 +14,8 @@ void main() {
   // torn already (skipped here) or a copy of a live one (same ends, same verdict): the torn set
   // is the same as marking the live ranges only, without looking the ranges up.
   Constraint c = constraints[k];
-  uint id = c.kind_id >> SIM_KIND_BITS;
-  if (torn[id] != 0u) return;
-  if (!shouldTear(pos[c.a], pos[c.b], c.rest, c.kind_id & SIM_KIND_MASK, u.tear_factor, u.tear_kinds)) return;
-  if (atomicExchange(torn[id], 1u) != 0u) return; // a copy marked it first: count it once
-  atomicAdd(counters.torn_total, 1u);
-  if (atomicAdd(counters.torn_new, 1u) == 0u) {
+  if (torn[c.kind_id >> SIM_KIND_BITS] != 0u) return;
+  if (markTear(c, pos[c.a], pos[c.b])) {
     uint groups = (compactSlots() + SIM_WG_TEAR - 1u) / SIM_WG_TEAR;
     uint gx = min(groups, SIM_MAX_GROUPS_X);
     counters.compact_dispatch = uvec4(gx, (groups + gx - 1u) / gx, 1u, 0u);

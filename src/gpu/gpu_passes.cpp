@@ -97,13 +97,13 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
   anyToCompute(cmd); // earlier submissions (previous tick, copies, the renderer) are done
   bindSet(cmd, index);
   SimPush all{0, n, 0, 0};
-  for (uint32_t s = 0; s < key.substeps; ++s) {
-    all.substep = s;
-    if (key.fused) {
-      // 1 + 2. Small sheet: integration and all colours in one workgroup
-      dispatchWorkgroup(cmd, pipes_.substep_fused, all);
-      computeToCompute(cmd);
-    } else {
+  if (key.fused) {
+    // Small sheet: every pass of every substep in one workgroup
+    dispatchWorkgroup(cmd, pipes_.tick_fused, all);
+    timestamp(cmd, slot, kFused);
+  } else {
+    for (uint32_t s = 0; s < key.substeps; ++s) {
+      all.substep = s;
       // 1. Verlet integration
       dispatchThreads(cmd, pipes_.integrate, n, all);
       computeToCompute(cmd);
@@ -116,37 +116,37 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
           dispatchThreads(cmd, pipes_.project, range.count, SimPush{range.first, range.count, s, c});
           computeToCompute(cmd);
         }
+      timestamp(cmd, slot, kProject);
+      if (key.collision) {
+        // 3. Spatial hash: count, scan, scatter, order within bucket; then gather repulsion
+        dispatchThreads(cmd, pipes_.hash_count, n, all);
+        computeToCompute(cmd);
+        recordScan(cmd, SIM_SCAN_HASH, 0, topo_.hash_size, hash_sums_, false);
+        dispatchThreads(cmd, pipes_.hash_scatter, n, all);
+        computeToCompute(cmd);
+        dispatchThreads(cmd, pipes_.hash_sort, n, all);
+        computeToCompute(cmd);
+        timestamp(cmd, slot, kHash);
+        dispatchThreads(cmd, pipes_.collide, n, all);
+        computeToCompute(cmd);
+        timestamp(cmd, slot, kCollide);
+      }
+      // 4. Collision deltas and ground contact
+      dispatchThreads(cmd, pipes_.floor, n, all);
+      computeToCompute(cmd);
+      timestamp(cmd, slot, kFloor);
+      // 5. Tear marking; the compaction runs zero workgroups unless something tore this substep
+      if (m > 0) {
+        dispatchThreads(cmd, pipes_.tear_mark, m, SimPush{0, m, s, 0});
+        computeToCompute(cmd);
+        dispatchIndirect(cmd, pipes_.tear_flags, nullptr, 0);
+        computeToCompute(cmd);
+        recordScan(cmd, SIM_SCAN_SCRATCH, 0, tear_slots_, tear_sums_, true);
+        dispatchIndirect(cmd, pipes_.tear_compact, nullptr, 0);
+        computeToCompute(cmd);
+      }
+      timestamp(cmd, slot, kTear);
     }
-    timestamp(cmd, slot, kProject);
-    if (key.collision) {
-      // 3. Spatial hash: count, scan, scatter, order within bucket; then gather repulsion
-      dispatchThreads(cmd, pipes_.hash_count, n, all);
-      computeToCompute(cmd);
-      recordScan(cmd, SIM_SCAN_HASH, 0, topo_.hash_size, hash_sums_, false);
-      dispatchThreads(cmd, pipes_.hash_scatter, n, all);
-      computeToCompute(cmd);
-      dispatchThreads(cmd, pipes_.hash_sort, n, all);
-      computeToCompute(cmd);
-      timestamp(cmd, slot, kHash);
-      dispatchThreads(cmd, pipes_.collide, n, all);
-      computeToCompute(cmd);
-      timestamp(cmd, slot, kCollide);
-    }
-    // 4. Collision deltas and ground contact
-    dispatchThreads(cmd, pipes_.floor, n, all);
-    computeToCompute(cmd);
-    timestamp(cmd, slot, kFloor);
-    // 5. Tear marking; the compaction runs zero workgroups unless something tore this substep
-    if (m > 0) {
-      dispatchThreads(cmd, pipes_.tear_mark, m, SimPush{0, m, s, 0});
-      computeToCompute(cmd);
-      dispatchIndirect(cmd, pipes_.tear_flags, nullptr, 0);
-      computeToCompute(cmd);
-      recordScan(cmd, SIM_SCAN_SCRATCH, 0, tear_slots_, tear_sums_, true);
-      dispatchIndirect(cmd, pipes_.tear_compact, nullptr, 0);
-      computeToCompute(cmd);
-    }
-    timestamp(cmd, slot, kTear);
   }
   computeToAll(cmd); // the renderer and copies see this tick
   VK_CHECK(vkEndCommandBuffer(cmd));

@@ -1,5 +1,7 @@
 #include "gpu_solver.h"
 
+#include <algorithm>
+#include <cstdlib>
 #include <cstring>
 
 #include "gpu/barriers.h"
@@ -25,6 +27,23 @@ Counters initialCounters(uint32_t triangles) {
   c.compact_dispatch = uvec4(0u, 1u, 1u, 0u);
   c.draw_args = uvec4(3u * triangles, 1u, 0u, 0u);
   return c;
+}
+
+/// The adjacency of each particle as a mask over its 5 x 5 grid stencil (SIM_BIND_ADJ_MASK), so
+/// that the collision gather tests a neighbour with a bit instead of a search.
+std::vector<uint32_t> adjacencyMasks(const SheetTopology& topo) {
+  constexpr int kReach = SIM_ADJ_STENCIL;
+  std::vector<uint32_t> masks(topo.particleCount(), 0u);
+  for (uint32_t i = 0; i < masks.size(); ++i)
+    for (uint32_t k = topo.adj_offsets[i]; k < topo.adj_offsets[i + 1]; ++k) {
+      const uint32_t j = topo.adj_list[k];
+      const int dx = int(j % topo.cols) - int(i % topo.cols), dy = int(j / topo.cols) - int(i / topo.cols);
+      if (std::abs(dx) <= kReach && std::abs(dy) <= kReach)
+        masks[i] |= 1u << uint32_t((dy + kReach) * (2 * kReach + 1) + dx + kReach);
+      else
+        masks[i] |= SIM_ADJ_FAR;
+    }
+  return masks;
 }
 
 } // namespace
@@ -64,7 +83,7 @@ GpuSolver::~GpuSolver() {
   for (ComputePipeline* p :
        {&pipes_.integrate, &pipes_.project, &pipes_.hash_count, &pipes_.scan, &pipes_.scan_add, &pipes_.hash_scatter,
         &pipes_.hash_sort, &pipes_.collide, &pipes_.floor, &pipes_.tear_mark, &pipes_.tear_flags, &pipes_.tear_compact,
-        &pipes_.normals, &pipes_.reset, &pipes_.substep_fused, &pipes_.pick[0], &pipes_.pick[1], &pipes_.pick[2]})
+        &pipes_.normals, &pipes_.reset, &pipes_.tick_fused, &pipes_.pick[0], &pipes_.pick[1], &pipes_.pick[2]})
     destroy(*p);
   for (VkShaderModule m : modules_) vkDestroyShaderModule(dev, m, nullptr);
   if (layout_) vkDestroyPipelineLayout(dev, layout_, nullptr);
@@ -96,7 +115,8 @@ void GpuSolver::createPipelines() {
   pli.pPushConstantRanges = &range;
   VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &layout_));
 
-  auto make = [&](const char* key, uint32_t push_size, uint32_t workgroup, int step = -1) {
+  // spec: specialization constant 0 when >= 0 (the step of a pick pass, the fused tick's workgroup size)
+  auto make = [&](const char* key, uint32_t push_size, uint32_t workgroup, int spec = -1) {
     std::span<const uint32_t> code = simShader(key);
     if (code.empty()) vkCheckFailed(VK_ERROR_INITIALIZATION_FAILED, key, __FILE__, __LINE__);
     VkShaderModuleCreateInfo mi{};
@@ -106,9 +126,9 @@ void GpuSolver::createPipelines() {
     VkShaderModule module;
     VK_CHECK(vkCreateShaderModule(dev, &mi, nullptr, &module));
     modules_.push_back(module);
-    uint32_t step_value = step < 0 ? 0u : uint32_t(step);
+    uint32_t spec_value = spec < 0 ? 0u : uint32_t(spec);
     VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
-    VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &step_value};
+    VkSpecializationInfo spec_info{1, &entry, sizeof(uint32_t), &spec_value};
     VkComputePipelineCreateInfo ci{};
     ci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
     ci.stage = {};
@@ -116,7 +136,7 @@ void GpuSolver::createPipelines() {
     ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     ci.stage.module = module;
     ci.stage.pName = "main";
-    ci.stage.pSpecializationInfo = step >= 0 ? &spec : nullptr;
+    ci.stage.pSpecializationInfo = spec >= 0 ? &spec_info : nullptr;
     ci.layout = layout_;
     ComputePipeline p;
     VK_CHECK(vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &p.pipeline));
@@ -139,8 +159,11 @@ void GpuSolver::createPipelines() {
   pipes_.tear_compact = make("tear_compact.comp", 0, SIM_WG_TEAR);
   pipes_.normals = make("normals.comp", kSim, SIM_WG_PARTICLES);
   pipes_.reset = make("reset.comp", kSim, SIM_WG_PARTICLES);
+  // The fused tick keeps the positions in shared memory; its workgroup size suits the device.
+  const uint32_t fused_workgroup =
+      ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? SIM_WG_FUSED_CPU : SIM_WG_FUSED;
   if (ctx_.properties().limits.maxComputeSharedMemorySize >= 16u * SIM_FUSED_MAX_PARTICLES)
-    pipes_.substep_fused = make("substep_fused.comp", kSim, SIM_WG_FUSED);
+    pipes_.tick_fused = make("tick_fused.comp", kSim, fused_workgroup, int(fused_workgroup));
   for (int s = 0; s < 3; ++s) pipes_.pick[size_t(s)] = make("pick.comp", kPick, SIM_WG_PARTICLES, s);
 
   // Per-slot fences and timestamp pools (chain of timestamps at pass boundaries).
@@ -200,7 +223,9 @@ void GpuSolver::upload(const SheetTopology& topo) {
   tear_slots_ = m + t + 1;
   tear_sums_ = tear_slots_;
   hash_sums_ = tear_sums_ + scanSumsSize(tear_slots_);
-  const uint32_t scratch_size = hash_sums_ + scanSumsSize(cells);
+  // The fused tick's scans meet their per-invocation totals in the SIM_WG_FUSED slots after the
+  // compaction slots (the separate passes' block sums, unused on that path).
+  const uint32_t scratch_size = std::max(hash_sums_ + scanSumsSize(cells), tear_slots_ + SIM_WG_FUSED);
 
   // Buffers of DESIGN.md §2, sized from the topology.
   VkDeviceSize align = ctx_.properties().limits.minUniformBufferOffsetAlignment;
@@ -233,6 +258,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
   storage(SIM_BIND_CELL_SCATTER, 4ull * n);
   storage(SIM_BIND_COMPACT_TMP, 16ull * (m + t));
   storage(SIM_BIND_CELL_POS, 16ull * n);
+  storage(SIM_BIND_ADJ_MASK, 4ull * n);
 
   // Start state and the static arrays, in one submission.
   std::vector<Buffer> staging;
@@ -255,6 +281,8 @@ void GpuSolver::upload(const SheetTopology& topo) {
     stage(SIM_BIND_ADJ_OFFSETS, topo.adj_offsets.data(), 4ull * topo.adj_offsets.size(), cmd);
     stage(SIM_BIND_ADJ_LIST, topo.adj_list.data(), 4ull * topo.adj_list.size(), cmd);
     stage(SIM_BIND_TRI_EDGES, topo.tri_edges.data(), 8ull * topo.tri_edges.size(), cmd);
+    const std::vector<uint32_t> adj_mask = adjacencyMasks(topo);
+    stage(SIM_BIND_ADJ_MASK, adj_mask.data(), 4ull * n, cmd);
     stage(SIM_BIND_CELL_START, last_start.data(), 4, cmd, 4ull * cells); // cell_start[T] = N, always
     std::vector<glm::vec4> normals(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
     stage(SIM_BIND_NORMAL, normals.data(), 16ull * n, cmd);
@@ -535,14 +563,16 @@ PassTimes GpuSolver::passTimes() const {
     last_ms_[kNormals] = double(ts[1] - ts[0]) * ctx_.timestampPeriod() * 1e-6;
     normals_pending_ = false;
   }
-  static const char* kNames[kCategoryCount] = {"integrate", "project", "hash", "collide", "floor", "tear", "normals"};
+  static const char* kNames[kCategoryCount] = {"integrate", "project", "hash",    "collide",
+                                               "floor",     "tear",    "normals", "fused_tick"};
   PassTimes t;
   for (int c = 0; c < kCategoryCount; ++c) t.ms.emplace_back(kNames[c], last_ms_[size_t(c)]);
   return t;
 }
 
 bool GpuSolver::usesFusedPath() const {
-  return fused_allowed_ && pipes_.substep_fused.pipeline && topo_.particleCount() <= SIM_FUSED_MAX_PARTICLES;
+  return fused_allowed_ && pipes_.tick_fused.pipeline && topo_.particleCount() <= SIM_FUSED_MAX_PARTICLES &&
+         topo_.hash_size <= SIM_FUSED_MAX_BUCKETS;
 }
 
 uint64_t GpuSolver::memoryBytes() const {

@@ -35,13 +35,14 @@ struct ComputePipeline {
 struct SimPipelines {
   ComputePipeline integrate, project, hash_count, scan, scan_add, hash_scatter, hash_sort, collide, floor, tear_mark,
       tear_flags, tear_compact, normals, reset;
-  ComputePipeline substep_fused; ///< null when the device has under 32 KiB of shared memory
+  ComputePipeline tick_fused; ///< null when the device has under 32 KiB of shared memory
   std::array<ComputePipeline, 3> pick;
 };
 
-/// The Solver on Vulkan compute. Per substep: integrate, project (one dispatch per colour, or the
-/// fused one-workgroup substep for small sheets), hash count/scan/scatter/sort, collide, floor,
-/// tear mark, and the tear compaction as indirect dispatches (zero workgroups when nothing tore).
+/// The Solver on Vulkan compute. Per substep: integrate, project (one dispatch per colour), hash
+/// count/scan/scatter/sort, collide, floor, tear mark, and the tear compaction as indirect
+/// dispatches (zero workgroups when nothing tore). Small sheets run the whole tick, every pass of
+/// every substep, in one dispatch of one workgroup (tick_fused.comp).
 class GpuSolver final : public Solver {
 public:
   /// A solver on an existing context (the renderer's); the context must outlive the solver.
@@ -80,10 +81,11 @@ public:
   void readHash(std::vector<uint32_t>& cell_start, std::vector<uint32_t>& cell_particles);
   /// The buffer of a binding (SIM_BIND_*), for tests and tools.
   const Buffer& buffer(uint32_t binding) const { return buf_[binding]; }
-  /// Allows (default) or forbids the fused small-sheet substep; it is used when allowed, the
-  /// device has the shared memory, and the sheet has at most SIM_FUSED_MAX_PARTICLES particles.
+  /// Allows (default) or forbids the fused small-sheet tick; it is used when allowed, the device
+  /// supports it, the sheet has at most SIM_FUSED_MAX_PARTICLES particles and its hash table at
+  /// most SIM_FUSED_MAX_BUCKETS buckets.
   void setFusedPath(bool allowed) { fused_allowed_ = allowed; }
-  /// True when ticks run the fused small-sheet substep.
+  /// True when ticks run the fused small-sheet tick.
   bool usesFusedPath() const;
   /// Waits until every submitted tick has finished.
   void finish();
@@ -93,9 +95,10 @@ private:
   static constexpr uint32_t kSlots = 2;
   /// Uniform slot of the normals and pick passes (static: written at upload).
   static constexpr uint32_t kStaticSlot = kSlots;
-  static constexpr uint32_t kBindingCount = SIM_BIND_CELL_POS + 1;
+  static constexpr uint32_t kBindingCount = SIM_BIND_ADJ_MASK + 1;
   /// Timestamp categories, in passTimes() order.
-  enum Category : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kCategoryCount };
+  /// kFused: the fused small-sheet tick, every pass in one dispatch.
+  enum Category : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kFused, kCategoryCount };
 
   struct RecordKey {
     uint32_t substeps = 0, iterations = 0;

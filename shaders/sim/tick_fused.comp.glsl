@@ -1,0 +1,125 @@
+#version 460
+// Small sheets: a whole tick in one dispatch of one workgroup. Positions stay in shared memory
+// from the first substep to the last; a workgroup barrier replaces each dispatch and pipeline
+// barrier of the separate passes. Every substep runs the same per-particle and per-constraint
+// maths, in the same order, as integrate, project, hash_*, collide, floor and tear_*; the hash
+// is built in the same buffers. Each invocation owns the particles lid, lid + kInvocations, ...
+// (integration, collision and floor of a particle run on one invocation, so the collision delta
+// stays in a register).
+// Workgroup size: at most SIM_WG_FUSED, specialised per device (sim_common.glsl declares it)
+#define SIM_LOCAL_SIZE SIM_WG_FUSED
+#define SIM_LOCAL_SIZE_SPECIALIZED
+// Invocations exchange data through buffers between barriers
+#define SIM_COHERENT coherent
+#include "sim_common.glsl"
+#include "sim_elements.glsl"
+layout(push_constant) uniform PushBlock { SimPush p; };
+
+shared vec4 s_pos[SIM_FUSED_MAX_PARTICLES];
+
+// Invocations of the workgroup (specialised)
+const uint kInvocations = gl_WorkGroupSize.x;
+
+// Everything written before it, to shared memory and to buffers, is seen by the whole workgroup.
+void sync() {
+  memoryBarrierBuffer();
+  memoryBarrierShared();
+  barrier();
+}
+
+// Exclusive scan by the whole workgroup of cell_count into cell_start (SIM_SCAN_HASH) or of
+// scratch[0, count) in place (SIM_SCAN_SCRATCH). Each invocation scans a contiguous chunk after
+// adding up the totals of the chunks before its own, which meet in scratch[sums + invocation].
+void scanWorkgroup(uint mode, uint count, uint sums) {
+  uint lid = gl_LocalInvocationID.x;
+  uint chunk = (count + kInvocations - 1u) / kInvocations;
+  uint first = min(lid * chunk, count), last = min(first + chunk, count);
+  uint total = 0u;
+  for (uint k = first; k < last; ++k) total += mode == SIM_SCAN_HASH ? cell_count[k] : scratch[k];
+  scratch[sums + lid] = total;
+  sync();
+  uint run = 0u;
+  for (uint g = 0u; g < lid; ++g) run += scratch[sums + g];
+  for (uint k = first; k < last; ++k) {
+    if (mode == SIM_SCAN_HASH) {
+      cell_start[k] = run;
+      run += cell_count[k];
+    } else {
+      uint v = scratch[k];
+      scratch[k] = run;
+      run += v;
+    }
+  }
+  sync();
+}
+
+void main() {
+  uint lid = gl_LocalInvocationID.x;
+  uint n = p.count, m = u.constraint_count;
+  bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
+  bool tearing = u.tear_factor > 0.0f && m > 0u;
+  float dt2 = u.dt * u.dt;
+  for (uint i = lid; i < n; i += kInvocations) s_pos[i] = pos[i];
+  for (uint s = 0u; s < min(u.substeps, SIM_MAX_SUBSTEPS); ++s) {
+    // 1. Verlet integration (as integrate.comp)
+    for (uint i = lid; i < n; i += kInvocations) {
+      VerletState st =
+          integrateParticle(s_pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index, u.grab_target[s],
+                            u.grab_prev[s], u.flags, u.gravity, u.wind[s], u.wind_twist[s], u.damping, dt2);
+      s_pos[i] = st.pos;
+      prev[i] = st.prev;
+    }
+    sync();
+    // A new substep: no constraint torn in it yet (every invocation read the count of the last
+    // substep before the barrier above).
+    if (lid == 0u) counters.torn_new = 0u;
+    // 2. Gauss-Seidel over colours (as project.comp), a barrier after each colour
+    for (uint it = 0u; it < u.iterations; ++it)
+      for (uint c = 0u; c < u.color_count; ++c) {
+        uvec2 range = color_range[c];
+        for (uint t = lid; t < range.y; t += kInvocations) {
+          Constraint k = constraints[range.x + t];
+          vec4 pa = s_pos[k.a], pb = s_pos[k.b];
+          PairDelta d = solveDistance(pa, pb, k.rest, u.stiffness[k.kind_id & SIM_KIND_MASK]);
+          s_pos[k.a] = pa + vec4(d.da, 0.0f);
+          s_pos[k.b] = pb + vec4(d.db, 0.0f);
+        }
+        sync();
+      }
+    // 3. Spatial hash (count, scan, scatter, order within bucket), then 4. each particle gathers
+    // its repulsion and meets the floor (as floor.comp)
+    if (collision) {
+      for (uint i = lid; i < n; i += kInvocations) hashCount(i, vec3(s_pos[i]));
+      sync();
+      scanWorkgroup(SIM_SCAN_HASH, u.hash_mask + 1u, compactSlots());
+      for (uint i = lid; i < n; i += kInvocations) hashScatter(i);
+      sync();
+      for (uint i = lid; i < n; i += kInvocations) hashSort(i, vec3(s_pos[i]));
+      sync();
+    }
+    for (uint i = lid; i < n; i += kInvocations) {
+      vec4 q = s_pos[i];
+      vec3 repel = collision ? gatherRepulsion(i, vec3(q)) : vec3(0.0f);
+      VerletState st = floorParticle(q, prev[i], repel);
+      s_pos[i] = st.pos;
+      prev[i] = st.prev;
+    }
+    sync();
+    // 5. Tear marking (as tear_mark.comp); when something tore, the compaction (as tear_flags,
+    // scan, tear_compact) in the same workgroup
+    if (!tearing) continue;
+    for (uint k = lid; k < m; k += kInvocations) {
+      Constraint c = constraints[k];
+      if (torn[c.kind_id >> SIM_KIND_BITS] == 0u) markTear(c, s_pos[c.a], s_pos[c.b]);
+    }
+    sync();
+    if (counters.torn_new == 0u) continue;
+    uint slots = compactSlots();
+    for (uint k = lid; k < slots; k += kInvocations) tearFlags(k);
+    sync();
+    scanWorkgroup(SIM_SCAN_SCRATCH, slots, slots);
+    for (uint k = lid; k < slots; k += kInvocations) tearCompact(k);
+    sync();
+  }
+  for (uint i = lid; i < n; i += kInvocations) pos[i] = s_pos[i];
+}
