@@ -17,8 +17,15 @@ else
 import csv, json, sys
 j = json.load(open(sys.argv[1]))
 backends = sys.argv[3].split(",")
-for k in ["tool", "version", "machine", "preset", "ticks", "warmup", "sets", "results"]:
+for k in ["tool", "version", "machine", "preset", "ticks", "warmup", "sets", "peak_bandwidth", "results"]:
     assert k in j, k
+# The measured copy bandwidths (the device's may be skipped, with a reason).
+peaks = j["peak_bandwidth"]
+for key in ["cpu"] + (["gpu"] if any(b != "cpu" for b in backends) else []):
+    p = peaks[key]
+    if "skipped" in p:
+        assert key == "gpu", p; print("gpu peak skipped:", p["skipped"]); continue
+    assert p["gbps"] > 0 and p["buffer_bytes"] > 0 and p["repetitions"] > 0 and p["method"], p
 assert j["tool"] == "tender-bench" and j["ticks"] == 3 and j["warmup"] == 1, j
 assert "cpu_model" in j["machine"] and "cores" in j["machine"], j["machine"]
 rs = j["results"]
@@ -39,13 +46,33 @@ for r in rs:
     assert 0 < r["ms_min"] <= r["ms_median"] <= r["ms_p95"], r
     assert r["memory_bytes"] > r["particles"] * 32 and r["dispatches_per_tick"] > 0, r
     assert isinstance(r["pass_ms"], dict), r
+    # The traffic model: every pass, read and write, adding up to bytes_per_tick.
+    passes = {"integrate", "project", "hash", "collide", "floor", "tear"}
+    pb = r["pass_bytes"]
+    assert set(pb) == passes and all(v["read"] >= 0 and v["write"] >= 0 for v in pb.values()), pb
+    assert r["bytes_per_tick"] == sum(v["read"] + v["write"] for v in pb.values()) > r["particles"] * 32, r
+    assert pb["project"]["read"] > 0 and r["achieved_gbps"] > 0, r
+    assert set(r["pass_gbps"]) <= passes and all(v > 0 for v in r["pass_gbps"].values()), r
+    peak = peaks.get("gpu" if r["backend"].startswith("gpu") else "cpu", {})
+    if "gbps" in peak:
+        assert r["peak_gbps"] == peak["gbps"] and r["peak_pct"] > 0, r
     if r["backend"] == "gpu":
         assert len(r["pass_ms"]) > 0, r
 assert seen == {(s, b) for s in ["8x12", "12x16"] for b in backends}, seen
 rows = list(csv.DictReader(open(sys.argv[2])))
 assert len(rows) == len(rs) and "ms_median" in rows[0] and "particles" in rows[0], rows[:1]
+assert int(rows[0]["bytes_per_tick"]) > 0 and "peak_pct" in rows[0] and "pass_bytes" in rows[0], rows[:1]
 print("ok: JSON and CSV shape,", len(rs), "results")
 PY
+fi
+
+# --no-peak skips the bandwidth measurement: no peak, no percent, the traffic model still there.
+if "$B" --sizes 8x12 --backends cpu --ticks 3 --warmup 0 --no-peak --json "$tmp/n.json" >/dev/null 2>&1 &&
+    python3 -c 'import json, sys; j = json.load(open(sys.argv[1])); r = j["results"][0]
+assert j["peak_bandwidth"] == {} and "peak_pct" not in r and r["bytes_per_tick"] > 0' "$tmp/n.json"; then
+  echo "ok: --no-peak"
+else
+  echo "FAIL: --no-peak"; failures=$((failures + 1))
 fi
 
 # The plot script turns the JSON into a PNG (when gnuplot is installed).

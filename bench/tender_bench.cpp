@@ -1,8 +1,9 @@
 // tender-bench: scaling benchmark of the solvers. For each sheet size and backend it runs the full
 // physics (every substep, iteration, collision and tear check of the preset) and reports ms per
-// tick (median, p95), particle-substeps per second, dispatches per tick, memory and, on the GPU,
-// the time of each pass. Bench sizes keep the sheet's physical size: spacing and hash cell scale
-// with the grid (see bench/README.md).
+// tick (median, p95), particle-substeps per second, dispatches per tick, memory, the bytes a tick
+// must move (bench/traffic.h) and the bandwidth that achieves against the machine's measured copy
+// bandwidth and, on the GPU, the time and bandwidth of each pass. Bench sizes keep the sheet's
+// physical size: spacing and hash cell scale with the grid (see bench/README.md).
 #include <unistd.h>
 
 #include <algorithm>
@@ -23,6 +24,7 @@
 #include "core/simulation.h"
 #include "core/stats.h"
 #include "cpu/cpu_solver.h"
+#include "traffic.h"
 
 #ifdef TENDER_HAS_GPU
 #include "gpu/gpu_solver.h"
@@ -45,6 +47,12 @@ struct BenchOptions {
   std::string json, csv;
   uint64_t max_cpu_particles = 400000;
   double max_seconds = 30.0;
+  bool no_peak = false; ///< skip the copy-bandwidth measurement of the host and the device
+};
+
+/// Measured copy bandwidths that results are compared with (absent: not measured).
+struct Peaks {
+  std::optional<bench::PeakBandwidth> cpu, gpu;
 };
 
 /// One grid size.
@@ -178,8 +186,8 @@ void finishTick(Solver& solver) {
 }
 
 /// Runs one size on one backend and returns its JSON record.
-nlohmann::json runCase(const BenchOptions& o, const Size& size, const std::string& backend, const std::string& label,
-                       Progress& progress) {
+nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& size, const std::string& backend,
+                       const std::string& label, Progress& progress) {
   nlohmann::json r;
   r["size"] = size.text();
   r["cols"] = size.cols;
@@ -216,10 +224,14 @@ nlohmann::json runCase(const BenchOptions& o, const Size& size, const std::strin
   else
     r["threads"] = 0;
 #ifdef TENDER_HAS_GPU
+  bench::Layout layout = bench::Layout::Cpu;
   if (auto* gpu_solver = dynamic_cast<gpu::GpuSolver*>(solver.get())) {
     r["device"] = std::string(gpu_solver->context().properties().deviceName);
     r["fused"] = gpu_solver->usesFusedPath();
+    layout = gpu_solver->usesFusedPath() ? bench::Layout::GpuFused : bench::Layout::Gpu;
   }
+#else
+  const bench::Layout layout = bench::Layout::Cpu;
 #endif
 
   using Clock = std::chrono::steady_clock;
@@ -272,12 +284,35 @@ nlohmann::json runCase(const BenchOptions& o, const Size& size, const std::strin
   nlohmann::json passes = nlohmann::json::object();
   for (auto& [name, v] : pass_ms) passes[name] = percentile(v, 0.5);
   r["pass_ms"] = passes;
+
+  // Bandwidth: the bytes a tick must move over the median tick (and each timed pass over its own
+  // median), against the measured copy bandwidth of the device that ran it.
+  uint64_t bytes = 0;
+  nlohmann::json pass_bytes = nlohmann::json::object(), pass_gbps = nlohmann::json::object();
+  for (const bench::PassTraffic& t : bench::tickTraffic(sim->topology(), sim->makeUniforms(), layout)) {
+    bytes += t.bytes();
+    pass_bytes[t.name] = {{"read", t.read}, {"write", t.write}};
+    if (passes.contains(t.name) && passes[t.name].get<double>() > 0.0 && t.bytes() > 0)
+      pass_gbps[t.name] = double(t.bytes()) / (passes[t.name].get<double>() * 1e6);
+  }
+  const double gbps = median > 0.0 ? double(bytes) / (median * 1e6) : 0.0;
+  r["bytes_per_tick"] = bytes;
+  r["pass_bytes"] = pass_bytes;
+  r["achieved_gbps"] = gbps;
+  r["pass_gbps"] = pass_gbps;
+  const std::optional<bench::PeakBandwidth>& peak = backend == "cpu" ? peaks.cpu : peaks.gpu;
+  std::string vs_peak;
+  if (peak && peak->gbps > 0.0) {
+    r["peak_gbps"] = peak->gbps;
+    r["peak_pct"] = 100.0 * gbps / peak->gbps;
+    vs_peak = " = " + std::to_string(int(std::lround(100.0 * gbps / peak->gbps))) + "% of peak";
+  }
   r["torn"] = st.torn;
   r["nan_count"] = st.nan_count;
   r["state_hash"] = hex64(st.state_hash);
-  char buf[200];
-  std::snprintf(buf, sizeof(buf), "%s: %.3f ms/tick median, %.3f p95 (%zu ticks)", label.c_str(), median,
-                percentile(ms, 0.95), ms.size());
+  char buf[300];
+  std::snprintf(buf, sizeof(buf), "%s: %.3f ms/tick median, %.3f p95 (%zu ticks); %.1f MB/tick, %.2f GB/s%s",
+                label.c_str(), median, percentile(ms, 0.95), ms.size(), double(bytes) / 1e6, gbps, vs_peak.c_str());
   progress.update(buf, true);
   return r;
 }
@@ -294,8 +329,8 @@ std::string humanBytes(uint64_t b) {
 }
 
 void printTable(const nlohmann::json& results) {
-  std::printf("%-11s %-12s %9s %7s %10s %10s %14s %11s %10s\n", "size", "backend", "particles", "threads", "ms median",
-              "ms p95", "part-substep/s", "dispatches", "memory");
+  std::printf("%-11s %-12s %9s %7s %10s %10s %14s %11s %10s %10s %8s %6s\n", "size", "backend", "particles", "threads",
+              "ms median", "ms p95", "part-substep/s", "dispatches", "memory", "MB/tick", "GB/s", "%peak");
   for (const auto& r : results) {
     if (r["status"] != "ok") {
       std::printf("%-11s %-12s %9llu  skipped: %s\n", r["size"].get<std::string>().c_str(),
@@ -304,14 +339,19 @@ void printTable(const nlohmann::json& results) {
                   r["reason"].get<std::string>().c_str());
       continue;
     }
-    std::printf("%-11s %-12s %9llu %7u %10.3f %10.3f %14.3g %11u %10s\n", r["size"].get<std::string>().c_str(),
-                r["backend"].get<std::string>().c_str(),
+    const std::string pct = r.contains("peak_pct") ? std::to_string(std::lround(r["peak_pct"].get<double>())) : "-";
+    std::printf("%-11s %-12s %9llu %7u %10.3f %10.3f %14.3g %11u %10s %10.1f %8.2f %6s\n",
+                r["size"].get<std::string>().c_str(), r["backend"].get<std::string>().c_str(),
                 static_cast<unsigned long long>(r["particles"].get<uint64_t>()), r["threads"].get<uint32_t>(),
                 r["ms_median"].get<double>(), r["ms_p95"].get<double>(), r["particle_substeps_per_s"].get<double>(),
-                r["dispatches_per_tick"].get<uint32_t>(), humanBytes(r["memory_bytes"].get<uint64_t>()).c_str());
+                r["dispatches_per_tick"].get<uint32_t>(), humanBytes(r["memory_bytes"].get<uint64_t>()).c_str(),
+                double(r["bytes_per_tick"].get<uint64_t>()) / 1e6, r["achieved_gbps"].get<double>(), pct.c_str());
     if (!r["pass_ms"].empty()) {
-      std::printf("%-11s   passes (ms):", "");
-      for (auto& [name, v] : r["pass_ms"].items()) std::printf(" %s %.4f", name.c_str(), v.get<double>());
+      std::printf("%-11s   passes (ms, GB/s):", "");
+      for (auto& [name, v] : r["pass_ms"].items()) {
+        std::printf(" %s %.4f", name.c_str(), v.get<double>());
+        if (r["pass_gbps"].contains(name)) std::printf(" (%.2f)", r["pass_gbps"][name].get<double>());
+      }
       std::printf("\n");
     }
   }
@@ -320,18 +360,27 @@ void printTable(const nlohmann::json& results) {
 bool writeCsv(const std::string& path, const nlohmann::json& results) {
   std::ofstream f(path);
   f << "size,cols,rows,particles,backend,status,threads,ticks_measured,ms_median,ms_p95,ms_mean,ms_min,"
-       "particle_substeps_per_s,dispatches_per_tick,memory_bytes,torn,state_hash,passes\n";
+       "particle_substeps_per_s,dispatches_per_tick,memory_bytes,bytes_per_tick,achieved_gbps,peak_gbps,peak_pct,torn,"
+       "state_hash,passes,pass_bytes,pass_gbps\n";
   for (const auto& r : results) {
     auto num = [&](const char* k) -> std::string { return r.contains(k) ? r[k].dump() : ""; };
-    std::string passes;
-    if (r.contains("pass_ms"))
-      for (auto& [name, v] : r["pass_ms"].items()) passes += (passes.empty() ? "" : ";") + name + "=" + v.dump();
+    // name=value;name=value (pass_bytes: read + write)
+    auto list = [&](const char* k) {
+      std::string out;
+      if (r.contains(k))
+        for (auto& [name, v] : r[k].items())
+          out += (out.empty() ? "" : ";") + name + "=" +
+                 (v.is_object() ? std::to_string(v["read"].get<uint64_t>() + v["write"].get<uint64_t>()) : v.dump());
+      return out;
+    };
     f << r["size"].get<std::string>() << ',' << num("cols") << ',' << num("rows") << ',' << num("particles") << ','
       << r["backend"].get<std::string>() << ',' << r["status"].get<std::string>() << ',' << num("threads") << ','
       << num("ticks_measured") << ',' << num("ms_median") << ',' << num("ms_p95") << ',' << num("ms_mean") << ','
       << num("ms_min") << ',' << num("particle_substeps_per_s") << ',' << num("dispatches_per_tick") << ','
-      << num("memory_bytes") << ',' << num("torn") << ','
-      << (r.contains("state_hash") ? r["state_hash"].get<std::string>() : "") << ',' << passes << '\n';
+      << num("memory_bytes") << ',' << num("bytes_per_tick") << ',' << num("achieved_gbps") << ',' << num("peak_gbps")
+      << ',' << num("peak_pct") << ',' << num("torn") << ','
+      << (r.contains("state_hash") ? r["state_hash"].get<std::string>() : "") << ',' << list("pass_ms") << ','
+      << list("pass_bytes") << ',' << list("pass_gbps") << '\n';
   }
   return bool(f);
 }
@@ -360,6 +409,7 @@ int main(int argc, char** argv) {
   app.add_option("--max-seconds", o.max_seconds, "time budget of one case's timed ticks (at least 3 run)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
+  app.add_flag("--no-peak", o.no_peak, "skip the copy-bandwidth measurement (no percent of peak in the results)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -373,6 +423,7 @@ int main(int argc, char** argv) {
   }
 
   // Validate everything before running anything.
+  uint32_t cpu_threads = 0;
   std::vector<Size> sizes;
   if (auto err = parseSizes(o.sizes, sizes)) return fail(*err);
   std::vector<std::string> backends = split(o.backends, ',');
@@ -392,6 +443,7 @@ int main(int argc, char** argv) {
     for (const std::string& s : o.sets)
       if (auto err = applyOverride(*p, s)) return fail(*err);
     if (auto err = validate(*p)) return fail(*err);
+    cpu_threads = p->threads;
   }
 
   nlohmann::json out;
@@ -404,14 +456,46 @@ int main(int argc, char** argv) {
   out["sets"] = o.sets;
   out["results"] = nlohmann::json::array();
 
+  // The peaks: copy bandwidth over the CPU solver's threads and on the device.
   Progress progress;
+  Peaks peaks;
+  out["peak_bandwidth"] = nlohmann::json::object();
+  auto record = [&](const char* key, const bench::PeakBandwidth& b) {
+    out["peak_bandwidth"][key] = {{"gbps", b.gbps},
+                                  {"buffer_bytes", b.buffer_bytes},
+                                  {"repetitions", b.repetitions},
+                                  {"threads", b.threads},
+                                  {"method", b.method}};
+    char buf[200];
+    std::snprintf(buf, sizeof(buf), "peak %s: %.2f GB/s (%s, %s, best of %u)", key, b.gbps, b.method.c_str(),
+                  humanBytes(b.buffer_bytes).c_str(), b.repetitions);
+    progress.update(buf, true);
+  };
+  const bool any_cpu = std::find(backends.begin(), backends.end(), "cpu") != backends.end();
+  if (!o.no_peak && any_cpu) {
+    peaks.cpu = bench::measureHostCopy(cpu_threads);
+    record("cpu", *peaks.cpu);
+  }
+#ifdef TENDER_HAS_GPU
+  if (!o.no_peak && std::any_of(backends.begin(), backends.end(), [](const std::string& b) { return b != "cpu"; })) {
+    std::string error;
+    peaks.gpu = bench::measureDeviceCopy(o.device, error);
+    if (peaks.gpu) {
+      record("gpu", *peaks.gpu);
+    } else {
+      out["peak_bandwidth"]["gpu"] = {{"skipped", error}};
+      progress.update("peak gpu: skipped (" + error + ")", true);
+    }
+  }
+#endif
+
   const size_t total = sizes.size() * backends.size();
   size_t index = 0;
   for (const Size& size : sizes)
     for (const std::string& backend : backends) {
       const std::string label =
           "[" + std::to_string(++index) + "/" + std::to_string(total) + "] " + size.text() + " " + backend;
-      nlohmann::json r = runCase(o, size, backend, label, progress);
+      nlohmann::json r = runCase(o, peaks, size, backend, label, progress);
       if (r.contains("device")) out["machine"]["gpu"] = r["device"];
       out["results"].push_back(r);
     }
