@@ -15,12 +15,12 @@ constexpr int kExitBadInput = 2;
 /// Options every program shares.
 struct CommonOptions {
   std::string preset = "tender";
-  std::vector<std::string> sets;  ///< key=value overrides
-  std::string backend = "gpu";    ///< cpu or gpu
-  int device = -1;                ///< Vulkan device index, -1 = best
-  bool validation = false;        ///< VK_LAYER_KHRONOS_validation
-  std::string script;             ///< input script to replay
-  SimParams params;               ///< resolved preset + overrides
+  std::vector<std::string> sets; ///< key=value overrides
+  std::string backend = "gpu";   ///< cpu or gpu
+  int device = -1;               ///< Vulkan device index, -1 = best
+  bool validation = false;       ///< VK_LAYER_KHRONOS_validation
+  std::string script;            ///< input script to replay
+  SimParams params;              ///< resolved preset + overrides
 };
 
 struct SimOptions {

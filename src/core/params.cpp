@@ -20,8 +20,7 @@ std::optional<std::string> parseFloat(const std::string& s, float lo, float hi, 
   float v = 0.0f;
   const char* end = s.data() + s.size();
   auto [ptr, ec] = std::from_chars(s.data(), end, v);
-  if (s.empty() || ec != std::errc() || ptr != end || !std::isfinite(v))
-    return "'" + s + "' is not a number";
+  if (s.empty() || ec != std::errc() || ptr != end || !std::isfinite(v)) return "'" + s + "' is not a number";
   if (v < lo || v > hi) {
     char buf[128];
     snprintf(buf, sizeof(buf), "%s is out of range [%g, %g]", s.c_str(), double(lo), double(hi));
@@ -69,7 +68,8 @@ Param uintParam(const char* key, uint32_t SimParams::*m, uint32_t lo, uint32_t h
           [m](const SimParams& p) { return std::to_string(p.*m); }};
 }
 Param boolParam(const char* key, bool SimParams::*m, const char* help) {
-  return {{key, help}, [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); },
+  return {{key, help},
+          [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); },
           [m](const SimParams& p) { return std::string(p.*m ? "on" : "off"); }};
 }
 template <typename E>
@@ -109,8 +109,8 @@ const std::vector<Param>& params() {
       floatParam("gravity", &SimParams::gravity, 0.0f, 1000.0f, "gravity magnitude, pointing -Y"),
       floatParam("damping", &SimParams::damping, 0.0f, 1.0f, "velocity factor per substep"),
       boolParam("wind", &SimParams::wind, "wind on at start"),
-      enumParam("wind_kind", &SimParams::wind_kind,
-                {{"sinusoid", WindKind::Sinusoid}, {"noise", WindKind::Noise}}, "wind model: sinusoid, noise"),
+      enumParam("wind_kind", &SimParams::wind_kind, {{"sinusoid", WindKind::Sinusoid}, {"noise", WindKind::Noise}},
+                "wind model: sinusoid, noise"),
       floatParam("wind_strength", &SimParams::wind_strength, 0.0f, 100.0f, "wind multiplier"),
       floatParam("wind_scale", &SimParams::wind_scale, 0.0f, 1000.0f, "wind acceleration at strength 1"),
       floatParam("stiffness", &SimParams::stiffness, 0.0f, 1.0f, "structural and shear stiffness"),
@@ -165,7 +165,8 @@ std::optional<SimParams> presetParams(const std::string& name) {
     p.restitution = 0.3f;
     p.friction = 0.3f;
     p.release = ReleaseMode::DragVelocity;
-    if (name == "crumple-low") p.cols = 30, p.rows = 45, p.spacing = 0.15f * 39.0f / 29.0f, p.cell_size = 2.5f * p.spacing;
+    if (name == "crumple-low")
+      p.cols = 30, p.rows = 45, p.spacing = 0.15f * 39.0f / 29.0f, p.cell_size = 2.5f * p.spacing;
   } else {
     return std::nullopt;
   }

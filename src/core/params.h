@@ -18,36 +18,36 @@ enum class ReleaseMode { ZeroVelocity, DragVelocity };
 struct SimParams {
   std::string preset = "tender";
   // Sheet
-  uint32_t cols = 32;          ///< particles across
-  uint32_t rows = 48;          ///< particles down
-  float spacing = 0.18f;       ///< rest distance between neighbours
+  uint32_t cols = 32;    ///< particles across
+  uint32_t rows = 48;    ///< particles down
+  float spacing = 0.18f; ///< rest distance between neighbours
   PinMode pins = PinMode::Top3;
-  float top_y = 0.0f;          ///< y of the top edge; 0: centred on y = 1, above the floor
-  bool shear = true;           ///< diagonal constraints
-  bool bend = true;            ///< skip-one bend constraints (rest 2 x spacing)
-  bool tri_bend = false;       ///< bending across each pair of adjacent triangles
+  float top_y = 0.0f;    ///< y of the top edge; 0: centred on y = 1, above the floor
+  bool shear = true;     ///< diagonal constraints
+  bool bend = true;      ///< skip-one bend constraints (rest 2 x spacing)
+  bool tri_bend = false; ///< bending across each pair of adjacent triangles
   // Time
   float tick_hz = 120.0f;      ///< fixed ticks per second
   uint32_t substeps = 8;       ///< substeps per tick
   uint32_t iterations = 4;     ///< constraint iterations per substep
   float max_frame_dt = 0.033f; ///< frame dt clamp of the accumulator (s)
   // Forces
-  float gravity = 9.81f;       ///< magnitude, pointing -Y (units/s^2)
-  float damping = 0.99f;       ///< Verlet velocity factor per substep
-  bool wind = true;            ///< wind on at start
+  float gravity = 9.81f; ///< magnitude, pointing -Y (units/s^2)
+  float damping = 0.99f; ///< Verlet velocity factor per substep
+  bool wind = true;      ///< wind on at start
   WindKind wind_kind = WindKind::Sinusoid;
-  float wind_strength = 1.0f;  ///< multiplier of the wind
-  float wind_scale = 1.2f;     ///< wind acceleration at strength 1 (units/s^2)
+  float wind_strength = 1.0f; ///< multiplier of the wind
+  float wind_scale = 1.2f;    ///< wind acceleration at strength 1 (units/s^2)
   // Constraints
   float stiffness = 1.0f;      ///< structural and shear projection stiffness
   float bend_stiffness = 1.0f; ///< bend and tri-bend projection stiffness
   float tear_factor = 2.5f;    ///< tear beyond this x rest; 0 disables tearing
   bool tear_structural = true;
   bool tear_shear = false;
-  bool tear_bend = true;       ///< skip-one and tri-bend constraints
+  bool tear_bend = true; ///< skip-one and tri-bend constraints
   // Collision
   bool collision = true;
-  float cell_size = 0.45f;      ///< spatial hash cell
+  float cell_size = 0.45f;       ///< spatial hash cell
   float collision_factor = 1.2f; ///< repulsion radius = factor x spacing
   float collision_stiffness = 1.0f;
   // Ground
@@ -56,9 +56,9 @@ struct SimParams {
   float friction = 0.3f;
   // Interaction
   ReleaseMode release = ReleaseMode::ZeroVelocity;
-  float grab_radius = 0.6f;    ///< pick radius around the ray
+  float grab_radius = 0.6f; ///< pick radius around the ray
   // Performance
-  uint32_t threads = 0;        ///< CPU solver worker threads; 0 = one per hardware thread (results do not change)
+  uint32_t threads = 0; ///< CPU solver worker threads; 0 = one per hardware thread (results do not change)
 
   uint32_t particleCount() const { return cols * rows; }
   float tickDt() const { return 1.0f / tick_hz; }

@@ -10,10 +10,14 @@ namespace {
 bool readToggle(std::istringstream& in, Toggle& t) {
   std::string w;
   if (!(in >> w)) return false;
-  if (w == "on") t = Toggle::On;
-  else if (w == "off") t = Toggle::Off;
-  else if (w == "toggle") t = Toggle::Flip;
-  else return false;
+  if (w == "on")
+    t = Toggle::On;
+  else if (w == "off")
+    t = Toggle::Off;
+  else if (w == "toggle")
+    t = Toggle::Flip;
+  else
+    return false;
   return true;
 }
 
@@ -108,8 +112,8 @@ std::optional<InputScript> loadScript(const std::string& path, std::string& erro
 std::optional<std::string> checkScript(const InputScript& script, uint32_t particle_count) {
   for (const ScriptEvent& e : script.events)
     if (e.kind == EventKind::GrabParticle && e.particle >= particle_count)
-      return "tick " + std::to_string(e.tick) + ": particle " + std::to_string(e.particle) + " does not exist (the sheet has " +
-             std::to_string(particle_count) + ")";
+      return "tick " + std::to_string(e.tick) + ": particle " + std::to_string(e.particle) +
+             " does not exist (the sheet has " + std::to_string(particle_count) + ")";
   return std::nullopt;
 }
 
@@ -118,16 +122,30 @@ std::string formatEvent(const ScriptEvent& e) {
   o.precision(9);
   o << e.tick << ' ';
   switch (e.kind) {
-  case EventKind::GrabParticle: o << "grab particle " << e.particle; break;
+  case EventKind::GrabParticle:
+    o << "grab particle " << e.particle;
+    break;
   case EventKind::GrabRay:
     o << "grab ray " << e.a.x << ' ' << e.a.y << ' ' << e.a.z << ' ' << e.b.x << ' ' << e.b.y << ' ' << e.b.z;
     break;
-  case EventKind::Move: o << "move " << e.a.x << ' ' << e.a.y << ' ' << e.a.z; break;
-  case EventKind::Release: o << "release"; break;
-  case EventKind::Wind: o << "wind " << toggleName(e.toggle); break;
-  case EventKind::Pins: o << "pins " << toggleName(e.toggle); break;
-  case EventKind::Pause: o << "pause " << toggleName(e.toggle); break;
-  case EventKind::Reset: o << "reset"; break;
+  case EventKind::Move:
+    o << "move " << e.a.x << ' ' << e.a.y << ' ' << e.a.z;
+    break;
+  case EventKind::Release:
+    o << "release";
+    break;
+  case EventKind::Wind:
+    o << "wind " << toggleName(e.toggle);
+    break;
+  case EventKind::Pins:
+    o << "pins " << toggleName(e.toggle);
+    break;
+  case EventKind::Pause:
+    o << "pause " << toggleName(e.toggle);
+    break;
+  case EventKind::Reset:
+    o << "reset";
+    break;
   }
   return o.str();
 }

@@ -29,9 +29,9 @@ enum class Toggle { Off, On, Flip };
 struct ScriptEvent {
   uint64_t tick = 0;
   EventKind kind = EventKind::Release;
-  uint32_t particle = 0;   ///< GrabParticle
-  glm::vec3 a{0.0f};       ///< GrabRay origin, Move target
-  glm::vec3 b{0.0f};       ///< GrabRay direction
+  uint32_t particle = 0; ///< GrabParticle
+  glm::vec3 a{0.0f};     ///< GrabRay origin, Move target
+  glm::vec3 b{0.0f};     ///< GrabRay direction
   Toggle toggle = Toggle::Flip;
 };
 

@@ -18,16 +18,16 @@ struct ColorRange {
 /// Everything both solvers upload unchanged.
 struct SheetTopology {
   uint32_t cols = 0, rows = 0;
-  std::vector<glm::vec4> rest_pos;                 ///< xyz start position, w = 1 for a pin point
-  std::vector<glm::vec2> uv;                       ///< receipt texture coordinates
-  std::vector<shaderio::Constraint> constraints;   ///< sorted by colour
-  std::vector<ColorRange> colors;                  ///< ranges into `constraints`
-  std::array<uint32_t, 4> kind_counts{};           ///< constraints per kind
-  std::vector<uint32_t> adj_offsets;               ///< CSR: neighbours of i are adj_list[adj_offsets[i] .. [i+1])
-  std::vector<uint32_t> adj_list;                  ///< sorted ascending per particle
-  std::vector<glm::uvec4> triangles;               ///< xyz vertices (counter-clockwise from +z), w = triangle id
-  std::vector<glm::uvec2> tri_edges;               ///< per triangle id: original ids of its two structural edges
-  uint32_t hash_size = 0;                          ///< spatial hash buckets: power of two >= 2N
+  std::vector<glm::vec4> rest_pos;               ///< xyz start position, w = 1 for a pin point
+  std::vector<glm::vec2> uv;                     ///< receipt texture coordinates
+  std::vector<shaderio::Constraint> constraints; ///< sorted by colour
+  std::vector<ColorRange> colors;                ///< ranges into `constraints`
+  std::array<uint32_t, 4> kind_counts{};         ///< constraints per kind
+  std::vector<uint32_t> adj_offsets;             ///< CSR: neighbours of i are adj_list[adj_offsets[i] .. [i+1])
+  std::vector<uint32_t> adj_list;                ///< sorted ascending per particle
+  std::vector<glm::uvec4> triangles;             ///< xyz vertices (counter-clockwise from +z), w = triangle id
+  std::vector<glm::uvec2> tri_edges;             ///< per triangle id: original ids of its two structural edges
+  uint32_t hash_size = 0;                        ///< spatial hash buckets: power of two >= 2N
 
   uint32_t particleCount() const { return uint32_t(rest_pos.size()); }
   uint32_t constraintCount() const { return uint32_t(constraints.size()); }

@@ -46,9 +46,7 @@ WindSample windAt(WindKind kind, double t, float amplitude) {
   return w;
 }
 
-Simulation::Simulation(const SimParams& params, Solver& solver) : params_(params), solver_(solver) {
-  rebuild(params);
-}
+Simulation::Simulation(const SimParams& params, Solver& solver) : params_(params), solver_(solver) { rebuild(params); }
 
 void Simulation::setLiveParams(const SimParams& p) {
   bool wind_changed = p.wind != params_.wind;
@@ -80,13 +78,27 @@ void Simulation::apply(const ScriptEvent& e) {
   case EventKind::GrabParticle:
     if (e.particle < topo_.particleCount()) grabParticle(e.particle);
     break;
-  case EventKind::GrabRay: grabRay(e.a, e.b); break;
-  case EventKind::Move: moveGrab(e.a); break;
-  case EventKind::Release: release(); break;
-  case EventKind::Wind: wind_ = flip(e.toggle, wind_); break;
-  case EventKind::Pins: pins_ = flip(e.toggle, pins_); break;
-  case EventKind::Pause: paused_ = flip(e.toggle, paused_); break;
-  case EventKind::Reset: reset(); break;
+  case EventKind::GrabRay:
+    grabRay(e.a, e.b);
+    break;
+  case EventKind::Move:
+    moveGrab(e.a);
+    break;
+  case EventKind::Release:
+    release();
+    break;
+  case EventKind::Wind:
+    wind_ = flip(e.toggle, wind_);
+    break;
+  case EventKind::Pins:
+    pins_ = flip(e.toggle, pins_);
+    break;
+  case EventKind::Pause:
+    paused_ = flip(e.toggle, paused_);
+    break;
+  case EventKind::Reset:
+    reset();
+    break;
   }
 }
 

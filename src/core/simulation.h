@@ -88,9 +88,9 @@ private:
   glm::vec3 grab_from_{0.0f}, grab_to_{0.0f};
   std::array<glm::vec3, 4> grab_history_{}; ///< grab target at the last ticks, for the drag velocity
   uint32_t grab_ticks_ = 0;
-  uint32_t release_index_ = SIM_NONE;       ///< particle released with drag velocity at the next tick
+  uint32_t release_index_ = SIM_NONE; ///< particle released with drag velocity at the next tick
   glm::vec3 release_velocity_{0.0f};
-  uint32_t reset_frame_ = 0;                ///< frames left in the animated reset
+  uint32_t reset_frame_ = 0; ///< frames left in the animated reset
   uint64_t frame_ = 0, physics_ticks_ = 0;
   double accumulator_ = 0.0;
 };

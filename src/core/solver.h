@@ -11,12 +11,12 @@ namespace tender {
 
 /// A solver's full state, read back for tests, stats and files.
 struct SimState {
-  std::vector<glm::vec4> pos, prev;                 ///< w = inverse mass of the last substep
-  std::vector<glm::vec4> normal;                    ///< from the last normals pass
-  std::vector<shaderio::Constraint> constraints;    ///< live constraints, colour ranges compacted in place
-  std::vector<ColorRange> colors;                   ///< first stays, count shrinks as constraints tear
-  std::vector<uint32_t> torn;                       ///< per original constraint id: 1 when torn
-  std::vector<glm::uvec4> triangles;                ///< live triangles (first triangle_count entries)
+  std::vector<glm::vec4> pos, prev;              ///< w = inverse mass of the last substep
+  std::vector<glm::vec4> normal;                 ///< from the last normals pass
+  std::vector<shaderio::Constraint> constraints; ///< live constraints, colour ranges compacted in place
+  std::vector<ColorRange> colors;                ///< first stays, count shrinks as constraints tear
+  std::vector<uint32_t> torn;                    ///< per original constraint id: 1 when torn
+  std::vector<glm::uvec4> triangles;             ///< live triangles (first triangle_count entries)
   uint32_t triangle_count = 0;
 };
 

@@ -15,11 +15,11 @@ struct SheetStats {
   uint32_t colors = 0;
   uint32_t torn = 0;
   uint32_t triangles = 0;
-  uint64_t state_hash = 0;               ///< FNV-1a 64 of the position bytes
+  uint64_t state_hash = 0; ///< FNV-1a 64 of the position bytes
   glm::vec3 bbox_min{0.0f}, bbox_max{0.0f};
-  float max_stretch = 0.0f;              ///< largest length / rest over alive structural constraints
-  uint32_t nan_count = 0;                ///< non-finite position components
-  float max_speed = 0.0f;                ///< largest |pos - prev| / substep dt
+  float max_stretch = 0.0f; ///< largest length / rest over alive structural constraints
+  uint32_t nan_count = 0;   ///< non-finite position components
+  float max_speed = 0.0f;   ///< largest |pos - prev| / substep dt
 };
 
 /// Names of the constraint kinds, indexed by kind.

@@ -84,9 +84,8 @@ TEST(Script, ParsesEveryEvent) {
 }
 
 TEST(Script, RejectsMalformedLines) {
-  for (const char* bad : {"x grab particle 1", "1 jump", "1 grab", "1 grab particle -1", "1 move 1 2",
-                          "1 move 1 2 nan", "1 wind sideways", "1 reset now", "5 reset\n2 reset",
-                          "1 grab ray 0 0 0 0 0 0"}) {
+  for (const char* bad : {"x grab particle 1", "1 jump", "1 grab", "1 grab particle -1", "1 move 1 2", "1 move 1 2 nan",
+                          "1 wind sideways", "1 reset now", "5 reset\n2 reset", "1 grab ray 0 0 0 0 0 0"}) {
     std::string err;
     EXPECT_FALSE(parseScript(bad, err)) << bad;
     EXPECT_NE(err.find("line "), std::string::npos) << err;

@@ -40,23 +40,23 @@ InputScript script(const char* text) {
 
 TEST(Physics, FreeFallMatchesDampedVerlet) {
   // Positions near y = 0 keep float rounding of the Verlet velocity (a position difference) small.
-  SimParams p = preset("tender", {"pins=none", "wind=off", "collision=off", "tear_factor=0", "floor_y=-10000",
-                                  "cols=7", "rows=5", "top_y=0.36"});
+  SimParams p = preset("tender", {"pins=none", "wind=off", "collision=off", "tear_factor=0", "floor_y=-10000", "cols=7",
+                                  "rows=5", "top_y=0.36"});
   for (int ticks : {5, 60}) {
-  CpuSolver cpu;
-  Simulation sim(p, cpu);
-  SimState s = run(sim, ticks);
-  // Displacement per substep: D_n = g dt^2 (1 - d^n) / (1 - d); position after n substeps sums them.
-  const double g = p.gravity, dt = 1.0 / (double(p.tick_hz) * p.substeps), d = p.damping;
-  const double n = double(ticks) * p.substeps;
-  const double drop = g * dt * dt / (1.0 - d) * (n - d * (1.0 - std::pow(d, n)) / (1.0 - d));
-  const auto& topo = sim.topology();
-  for (uint32_t i = 0; i < topo.particleCount(); ++i) {
-    // 0.2% of the drop: an extra or missing substep alone is 2.5% at 5 ticks, 0.2% at 60.
-    EXPECT_NEAR(s.pos[i].y, topo.rest_pos[i].y - drop, 2e-3 * drop) << "particle " << i << ", " << ticks << " ticks";
-    EXPECT_NEAR(s.pos[i].x, topo.rest_pos[i].x, 1e-4);
-    EXPECT_NEAR(s.pos[i].z, 0.0f, 1e-6);
-  }
+    CpuSolver cpu;
+    Simulation sim(p, cpu);
+    SimState s = run(sim, ticks);
+    // Displacement per substep: D_n = g dt^2 (1 - d^n) / (1 - d); position after n substeps sums them.
+    const double g = p.gravity, dt = 1.0 / (double(p.tick_hz) * p.substeps), d = p.damping;
+    const double n = double(ticks) * p.substeps;
+    const double drop = g * dt * dt / (1.0 - d) * (n - d * (1.0 - std::pow(d, n)) / (1.0 - d));
+    const auto& topo = sim.topology();
+    for (uint32_t i = 0; i < topo.particleCount(); ++i) {
+      // 0.2% of the drop: an extra or missing substep alone is 2.5% at 5 ticks, 0.2% at 60.
+      EXPECT_NEAR(s.pos[i].y, topo.rest_pos[i].y - drop, 2e-3 * drop) << "particle " << i << ", " << ticks << " ticks";
+      EXPECT_NEAR(s.pos[i].x, topo.rest_pos[i].x, 1e-4);
+      EXPECT_NEAR(s.pos[i].z, 0.0f, 1e-6);
+    }
   }
 }
 
