@@ -444,6 +444,13 @@ void VulkanContext::submitOnce(const std::function<void(VkCommandBuffer)>& recor
   mb.dstStageMask |= VK_PIPELINE_STAGE_2_HOST_BIT;
   vkCmdPipelineBarrier2(cmd, &dep);
   VK_CHECK(vkEndCommandBuffer(cmd));
+  submit(cmd, once_fence_);
+  VK_CHECK(vkWaitForFences(device_, 1, &once_fence_, VK_TRUE, UINT64_MAX));
+  vkFreeCommandBuffers(device_, pool_, 1, &cmd);
+}
+
+void VulkanContext::submit(VkCommandBuffer cmd, VkFence fence) const {
+  VK_CHECK(vkResetFences(device_, 1, &fence));
   VkCommandBufferSubmitInfo cbi{};
   cbi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO;
   cbi.commandBuffer = cmd;
@@ -451,10 +458,7 @@ void VulkanContext::submitOnce(const std::function<void(VkCommandBuffer)>& recor
   si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2;
   si.commandBufferInfoCount = 1;
   si.pCommandBufferInfos = &cbi;
-  VK_CHECK(vkResetFences(device_, 1, &once_fence_));
-  VK_CHECK(vkQueueSubmit2(queue_, 1, &si, once_fence_));
-  VK_CHECK(vkWaitForFences(device_, 1, &once_fence_, VK_TRUE, UINT64_MAX));
-  vkFreeCommandBuffers(device_, pool_, 1, &cmd);
+  VK_CHECK(vkQueueSubmit2(queue_, 1, &si, fence));
 }
 
 void VulkanContext::waitIdle() { VK_CHECK(vkQueueWaitIdle(queue_)); }

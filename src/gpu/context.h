@@ -139,6 +139,8 @@ public:
   void download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset = 0);
   /// Records commands into a fresh command buffer, submits, and waits for the queue to finish them.
   void submitOnce(const std::function<void(VkCommandBuffer)>& record);
+  /// Resets `fence` and submits one recorded command buffer that signals it.
+  void submit(VkCommandBuffer cmd, VkFence fence) const;
   /// Waits until the queue is idle.
   void waitIdle();
   /// Memory type index with these properties, or UINT32_MAX.

@@ -397,18 +397,6 @@ void GpuSolver::collectTimes(const Slot& slot) const {
   last_ms_ = ms;
 }
 
-void GpuSolver::submit(VkCommandBuffer cmd, VkFence fence) {
-  VK_CHECK(vkResetFences(ctx_.device(), 1, &fence));
-  VkCommandBufferSubmitInfo cbi{};
-  cbi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO;
-  cbi.commandBuffer = cmd;
-  VkSubmitInfo2 si{};
-  si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2;
-  si.commandBufferInfoCount = 1;
-  si.pCommandBufferInfos = &cbi;
-  VK_CHECK(vkQueueSubmit2(ctx_.queue(), 1, &si, fence));
-}
-
 void GpuSolver::tick(const SimUniforms& u) {
   const uint32_t index = next_slot_;
   next_slot_ = (next_slot_ + 1) % kSlots;
@@ -417,7 +405,7 @@ void GpuSolver::tick(const SimUniforms& u) {
   waitSlot(slot);
   std::memcpy(static_cast<char*>(buf_[SIM_BIND_UNIFORMS].mapped) + index * uniform_stride_, &u, sizeof(u));
   if (u.reset_active) {
-    submit(slot.reset, slot.fence);
+    ctx_.submit(slot.reset, slot.fence);
     slot.pending = true;
     dispatches_per_tick_ = 1;
     return;
@@ -425,7 +413,7 @@ void GpuSolver::tick(const SimUniforms& u) {
   RecordKey key{std::min<uint32_t>(u.substeps, SIM_MAX_SUBSTEPS), u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u,
                 usesFusedPath()};
   if (slot.recorded != key) recordTick(slot, index, key);
-  submit(slot.tick, slot.fence);
+  ctx_.submit(slot.tick, slot.fence);
   slot.pending = true;
   slot.timed = true;
   last_tick_slot_ = int(index);
@@ -459,7 +447,7 @@ void GpuSolver::beginReset() {
 
 void GpuSolver::computeNormals() {
   if (normals_pending_) finish();
-  submit(normals_cmd_, normals_fence_);
+  ctx_.submit(normals_cmd_, normals_fence_);
   normals_pending_ = true;
 }
 

@@ -133,7 +133,6 @@ private:
   void timestamp(VkCommandBuffer cmd, Slot& slot, Category c);
   void waitSlot(Slot& slot) const;
   void collectTimes(const Slot& slot) const;
-  void submit(VkCommandBuffer cmd, VkFence fence);
   static uint32_t scanSumsSize(uint32_t count);
 
   std::unique_ptr<VulkanContext> owned_ctx_;
