@@ -61,10 +61,10 @@ std::unique_ptr<Solver> createGpuSolver(const GpuOptions& options, std::string& 
 }
 
 GpuSolver::GpuSolver(std::unique_ptr<VulkanContext> ctx) : owned_ctx_(std::move(ctx)), ctx_(*owned_ctx_) {
-  createPipelines();
+  createPipelines(0);
 }
 
-GpuSolver::GpuSolver(VulkanContext& ctx) : ctx_(ctx) { createPipelines(); }
+GpuSolver::GpuSolver(VulkanContext& ctx, uint32_t fused_workgroup) : ctx_(ctx) { createPipelines(fused_workgroup); }
 
 GpuSolver::~GpuSolver() {
   VkDevice dev = ctx_.device();
@@ -90,7 +90,7 @@ GpuSolver::~GpuSolver() {
   if (set_layout_) vkDestroyDescriptorSetLayout(dev, set_layout_, nullptr);
 }
 
-void GpuSolver::createPipelines() {
+void GpuSolver::createPipelines(uint32_t fused_workgroup) {
   VkDevice dev = ctx_.device();
   // One set layout: the uniforms (dynamic offset per tick slot) and every storage array.
   std::vector<VkDescriptorSetLayoutBinding> bindings(kBindingCount);
@@ -160,8 +160,9 @@ void GpuSolver::createPipelines() {
   pipes_.normals = make("normals.comp", kSim, SIM_WG_PARTICLES);
   pipes_.reset = make("reset.comp", kSim, SIM_WG_PARTICLES);
   // The fused tick keeps the positions in shared memory; its workgroup size suits the device.
-  const uint32_t fused_workgroup =
-      ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? SIM_WG_FUSED_CPU : SIM_WG_FUSED;
+  if (fused_workgroup == 0)
+    fused_workgroup = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? SIM_WG_FUSED_CPU : SIM_WG_FUSED;
+  fused_workgroup = std::min(fused_workgroup, uint32_t(SIM_WG_FUSED));
   if (ctx_.properties().limits.maxComputeSharedMemorySize >= 16u * SIM_FUSED_MAX_PARTICLES)
     pipes_.tick_fused = make("tick_fused.comp", kSim, fused_workgroup, int(fused_workgroup));
   for (int s = 0; s < 3; ++s) pipes_.pick[size_t(s)] = make("pick.comp", kPick, SIM_WG_PARTICLES, s);

@@ -46,7 +46,10 @@ struct SimPipelines {
 class GpuSolver final : public Solver {
 public:
   /// A solver on an existing context (the renderer's); the context must outlive the solver.
-  explicit GpuSolver(VulkanContext& ctx);
+  /// `fused_workgroup` overrides the fused tick's workgroup size (at most SIM_WG_FUSED; the
+  /// tests run SIM_WG_FUSED, a GPU's size, on lavapipe); 0 picks the device's: SIM_WG_FUSED_CPU
+  /// on a CPU device, else SIM_WG_FUSED.
+  explicit GpuSolver(VulkanContext& ctx, uint32_t fused_workgroup = 0);
   /// A solver that owns its context.
   explicit GpuSolver(std::unique_ptr<VulkanContext> ctx);
   ~GpuSolver() override;
@@ -117,7 +120,7 @@ private:
     uint32_t dispatches = 0;
   };
 
-  void createPipelines();
+  void createPipelines(uint32_t fused_workgroup);
   void destroySheet();
   void writeStaticUniforms();
   void uploadMutable(VkCommandBuffer cmd, std::vector<Buffer>& staging);

@@ -243,6 +243,38 @@ TEST_F(Parity, FusedSmallSheetPathMatchesSeparatePasses) {
   expectSameTopology(separate, fused);
 }
 
+TEST_F(Parity, FusedTickAtTheGpuWorkgroupSize) {
+  // Lavapipe (a CPU device) runs the fused tick with SIM_WG_FUSED_CPU invocations; a GPU runs it
+  // with SIM_WG_FUSED. Both sizes must compute what the CPU computes: a yank that tears, and
+  // buckets longer than the collision gather's window.
+  struct Case {
+    SimParams params;
+    const char* script;
+  };
+  const Case cases[] = {
+      {preset("tender", {"wind=on"}), "0 grab particle 1535\n1 move 6 -5 6\n25 release\n"},
+      {preset("tender", {"cols=24", "rows=30", "cell_size=1.8", "wind=on"}), "0 grab particle 719\n1 move 2 3 1\n"}};
+  for (const Case& c : cases) {
+    const SimParams& p = c.params;
+    gpu::GpuSolver gpu(ctx(), SIM_WG_FUSED);
+    Simulation gpu_sim(p, gpu);
+    ASSERT_TRUE(gpu.usesFusedPath());
+    gpu_sim.setScript(script(c.script));
+    SimState got = run(gpu_sim, 40);
+    CpuSolver cpu;
+    Simulation cpu_sim(p, cpu);
+    cpu_sim.setScript(script(c.script));
+    SimState ref = run(cpu_sim, 40);
+    const float diff = maxAbsDiff(got.pos, ref.pos);
+    const auto torn = uint32_t(std::count(ref.torn.begin(), ref.torn.end(), 1u));
+    std::printf("fused tick, %d invocations, %ux%u, 40 ticks: max |x_gpu - x_cpu| = %.3g, torn %u\n", SIM_WG_FUSED,
+                p.cols, p.rows, diff, torn);
+    EXPECT_GT(torn, 0u);
+    EXPECT_LE(diff, 1e-3f);
+    expectSameTopology(ref, got);
+  }
+}
+
 TEST_F(Parity, BucketsLongerThanTheGatherWindow) {
   // Cells 10 spacings wide: a bucket holds far more particles than the collision gather's
   // 32-slot window, so buckets are read in several windows.
