@@ -113,6 +113,14 @@ SIM_INLINE VerletState floorContact(vec4 pos, vec4 prev, float floor_y, float re
   return s;
 }
 
+/// The floor pass of one particle: its collision delta (when collision is on and the particle is
+/// free), then the ground contact.
+SIM_INLINE VerletState floorParticle(vec4 pos, vec4 prev, vec3 collision_delta, uint flags, float floor_y,
+                                     float restitution, float friction) {
+  if ((flags & SIM_FLAG_COLLISION) != 0u && pos.w > 0.0f) pos += vec4(collision_delta, 0.0f);
+  return floorContact(pos, prev, floor_y, restitution, friction);
+}
+
 /// True when a constraint of this kind is stretched beyond tear_factor x rest.
 SIM_INLINE bool shouldTear(vec4 pa, vec4 pb, float rest, uint kind, float tear_factor, uint tear_kinds) {
   bool tearable = tear_factor > 0.0f && (tear_kinds & (1u << kind)) != 0u;

@@ -9,7 +9,7 @@ layout(push_constant) uniform PushBlock { SimPush p; };
 void main() {
   uint i = threadIndex();
   if (i >= p.count) return;
-  VerletState st = floorParticle(pos[i], prev[i], vec3(delta[i]));
+  VerletState st = floorParticle(pos[i], prev[i], vec3(delta[i]), u.flags, u.floor_y, u.restitution, u.friction);
   pos[i] = st.pos;
   prev[i] = st.prev;
 }

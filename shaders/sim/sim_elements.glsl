@@ -132,12 +132,6 @@ vec3 gatherRepulsion(uint i, vec3 pi) {
   return sum;
 }
 
-// Collision deltas (when collision is on and the particle is free), then the ground contact.
-VerletState floorParticle(vec4 q, vec4 prev_q, vec3 collision_delta) {
-  if ((u.flags & SIM_FLAG_COLLISION) != 0u && q.w > 0.0f) q += vec4(collision_delta, 0.0f);
-  return floorContact(q, prev_q, u.floor_y, u.restitution, u.friction);
-}
-
 // Marks constraint c (ends at pa, pb; not torn yet) when stretched beyond the tear threshold and
 // counts it once; true for the first mark of the substep.
 bool markTear(Constraint c, vec4 pa, vec4 pb) {

@@ -100,7 +100,7 @@ void main() {
     for (uint i = lid; i < n; i += kInvocations) {
       vec4 q = s_pos[i];
       vec3 repel = collision ? gatherRepulsion(i, vec3(q)) : vec3(0.0f);
-      VerletState st = floorParticle(q, prev[i], repel);
+      VerletState st = floorParticle(q, prev[i], repel, u.flags, u.floor_y, u.restitution, u.friction);
       s_pos[i] = st.pos;
       prev[i] = st.prev;
     }

@@ -436,9 +436,8 @@ void CpuSolver::floorPass(const SimUniforms& u) {
     const vec4* delta = delta_.data();
     const uint32_t* slot = particle_slot_.data();
     for (uint32_t i = begin; i < end; ++i) {
-      vec4 p = pos[i];
-      if (collide && p.w > 0.0f) p += vec4(vec3(delta[slot[i]]), 0.0f);
-      VerletState st = floorContact(p, prev[i], u.floor_y, u.restitution, u.friction);
+      const vec3 d = collide ? vec3(delta[slot[i]]) : vec3(0.0f);
+      const VerletState st = floorParticle(pos[i], prev[i], d, u.flags, u.floor_y, u.restitution, u.friction);
       pos[i] = st.pos;
       prev[i] = st.prev;
     }
