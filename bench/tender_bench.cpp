@@ -227,8 +227,9 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   bench::Layout layout = bench::Layout::Cpu;
   if (auto* gpu_solver = dynamic_cast<gpu::GpuSolver*>(solver.get())) {
     r["device"] = std::string(gpu_solver->context().properties().deviceName);
-    r["fused"] = gpu_solver->usesFusedPath();
-    layout = gpu_solver->usesFusedPath() ? bench::Layout::GpuFused : bench::Layout::Gpu;
+    const bool fused = gpu_solver->usesFusedPath(sim->makeUniforms());
+    r["fused"] = fused;
+    layout = fused ? bench::Layout::GpuFused : bench::Layout::Gpu;
   }
 #else
   const bench::Layout layout = bench::Layout::Cpu;

@@ -71,8 +71,20 @@
 // the largest the tick is specialised to (specialization constant 0)
 #define SIM_WG_FUSED 256
 // Workgroup size of the fused tick on a CPU device: lavapipe runs a workgroup on one thread, its
-// SIMD groups taking turns at every barrier, so fewer invocations pay less for each barrier
-#define SIM_WG_FUSED_CPU 128
+// SIMD groups (8 invocations) taking turns at every barrier, and sets up each group's state at
+// every dispatch, so fewer invocations pay less per barrier and per dispatch; but each group
+// then runs more loop iterations (see SIM_FUSED_SUBSTEPS_CPU)
+#define SIM_WG_FUSED_CPU 64
+// Substeps one dispatch of the fused tick runs on a CPU device (on a GPU: the whole tick). Lavapipe
+// ends every loop of a shader once one SIMD group has run 65535 loop iterations in total, all
+// loops counted together (LP_MAX_TGSI_LOOP_ITERATIONS); a whole tick of a crumpled sheet in one
+// workgroup can run that many, so each substep gets a dispatch, and a fresh count, of its own.
+#define SIM_FUSED_SUBSTEPS_CPU 1
+// Largest hash cell, in grid spacings, with which a CPU device runs the fused tick (with collision
+// on). A SIMD group gathers the collisions of many particles one after the other, and a bucket of a
+// flat sheet holds about (cell / spacing)^2 of them: bigger cells could use up lavapipe's loop
+// count within one substep (the presets use 2.5; the per-colour passes stay within it at any size)
+#define SIM_FUSED_CPU_MAX_CELL_SPACINGS 4.0f
 // Largest sheet the fused tick takes: its positions fill 32 KiB of shared memory (vec4 each)
 #define SIM_FUSED_MAX_PARTICLES 2048
 // Largest hash table the fused tick takes (one workgroup scans it every substep)

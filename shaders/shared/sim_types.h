@@ -66,6 +66,15 @@ struct SimPush {
   uint color;   // colour index for projection and compaction
 };
 
+/// Push constants of the fused small-sheet tick: substeps [first_substep, first_substep + substeps)
+/// of the tick in one workgroup.
+struct FusedPush {
+  uint count;         // particles
+  uint first_substep; // first substep of this dispatch
+  uint substeps;      // substeps of this dispatch
+  uint pad;
+};
+
 /// GPU counters: tear bookkeeping and indirect arguments (one storage buffer).
 struct Counters {
   uint torn_total;     // constraints torn since the last reset

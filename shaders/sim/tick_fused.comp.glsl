@@ -1,7 +1,8 @@
 #version 460
-// Small sheets: a whole tick in one dispatch of one workgroup. Positions stay in shared memory
-// from the first substep to the last; a workgroup barrier replaces each dispatch and pipeline
-// barrier of the separate passes. Every substep runs the same per-particle and per-constraint
+// Small sheets: substeps p.first_substep .. + p.substeps of a tick (on a GPU the whole tick, on a
+// CPU device one substep) in one dispatch of one workgroup. Positions stay in shared memory from
+// the first substep to the last; a workgroup barrier replaces each dispatch and pipeline barrier
+// of the separate passes. Every substep runs the same per-particle and per-constraint
 // maths, in the same order, as integrate, project, hash_*, collide, floor and tear_*; the hash
 // is built in the same buffers. Each invocation owns the particles lid, lid + kInvocations, ...
 // (integration, collision and floor of a particle run on one invocation, so the collision delta
@@ -13,7 +14,7 @@
 #define SIM_COHERENT coherent
 #include "sim_common.glsl"
 #include "sim_elements.glsl"
-layout(push_constant) uniform PushBlock { SimPush p; };
+layout(push_constant) uniform PushBlock { FusedPush p; };
 
 shared vec4 s_pos[SIM_FUSED_MAX_PARTICLES];
 
@@ -60,7 +61,8 @@ void main() {
   bool tearing = u.tear_factor > 0.0f && m > 0u;
   float dt2 = u.dt * u.dt;
   for (uint i = lid; i < n; i += kInvocations) s_pos[i] = pos[i];
-  for (uint s = 0u; s < min(u.substeps, SIM_MAX_SUBSTEPS); ++s) {
+  uint end = min(p.first_substep + p.substeps, min(u.substeps, SIM_MAX_SUBSTEPS));
+  for (uint s = p.first_substep; s < end; ++s) {
     // 1. Verlet integration (as integrate.comp)
     for (uint i = lid; i < n; i += kInvocations) {
       VerletState st =

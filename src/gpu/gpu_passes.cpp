@@ -31,7 +31,7 @@ void GpuSolver::dispatchThreads(VkCommandBuffer cmd, const ComputePipeline& p, u
   ++recorded_dispatches_;
 }
 
-void GpuSolver::dispatchWorkgroup(VkCommandBuffer cmd, const ComputePipeline& p, const SimPush& push) {
+void GpuSolver::dispatchWorkgroup(VkCommandBuffer cmd, const ComputePipeline& p, const FusedPush& push) {
   if (sizeof(push) != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
   if (bound_ != p.pipeline) {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
@@ -98,8 +98,11 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
   bindSet(cmd, index);
   SimPush all{0, n, 0, 0};
   if (key.fused) {
-    // Small sheet: every pass of every substep in one workgroup
-    dispatchWorkgroup(cmd, pipes_.tick_fused, all);
+    // Small sheet: every pass of fused_substeps_ substeps (on a GPU: all) in one workgroup
+    for (uint32_t s = 0; s < key.substeps; s += fused_substeps_) {
+      if (s > 0) computeToCompute(cmd);
+      dispatchWorkgroup(cmd, pipes_.tick_fused, FusedPush{n, s, std::min(fused_substeps_, key.substeps - s), 0});
+    }
     timestamp(cmd, slot, kFused);
   } else {
     for (uint32_t s = 0; s < key.substeps; ++s) {

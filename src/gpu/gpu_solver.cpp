@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 
 #include "gpu/barriers.h"
 #include "gpu/shaders.h"
@@ -61,10 +62,10 @@ std::unique_ptr<Solver> createGpuSolver(const GpuOptions& options, std::string& 
 }
 
 GpuSolver::GpuSolver(std::unique_ptr<VulkanContext> ctx) : owned_ctx_(std::move(ctx)), ctx_(*owned_ctx_) {
-  createPipelines(0);
+  createPipelines({});
 }
 
-GpuSolver::GpuSolver(VulkanContext& ctx, uint32_t fused_workgroup) : ctx_(ctx) { createPipelines(fused_workgroup); }
+GpuSolver::GpuSolver(VulkanContext& ctx, FusedShape fused) : ctx_(ctx) { createPipelines(fused); }
 
 GpuSolver::~GpuSolver() {
   VkDevice dev = ctx_.device();
@@ -90,7 +91,7 @@ GpuSolver::~GpuSolver() {
   if (set_layout_) vkDestroyDescriptorSetLayout(dev, set_layout_, nullptr);
 }
 
-void GpuSolver::createPipelines(uint32_t fused_workgroup) {
+void GpuSolver::createPipelines(FusedShape fused) {
   VkDevice dev = ctx_.device();
   // One set layout: the uniforms (dynamic offset per tick slot) and every storage array.
   std::vector<VkDescriptorSetLayoutBinding> bindings(kBindingCount);
@@ -159,10 +160,16 @@ void GpuSolver::createPipelines(uint32_t fused_workgroup) {
   pipes_.tear_compact = make("tear_compact.comp", 0, SIM_WG_TEAR);
   pipes_.normals = make("normals.comp", kSim, SIM_WG_PARTICLES);
   pipes_.reset = make("reset.comp", kSim, SIM_WG_PARTICLES);
-  // The fused tick keeps the positions in shared memory; its workgroup size suits the device.
-  if (fused_workgroup == 0)
-    fused_workgroup = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? SIM_WG_FUSED_CPU : SIM_WG_FUSED;
+  // The fused tick keeps the positions in shared memory; its shape suits the device.
+  const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  uint32_t fused_workgroup = fused.workgroup ? fused.workgroup : cpu_device ? SIM_WG_FUSED_CPU : SIM_WG_FUSED;
   fused_workgroup = std::min(fused_workgroup, uint32_t(SIM_WG_FUSED));
+  fused_substeps_ = fused.substeps_per_dispatch ? fused.substeps_per_dispatch
+                    : cpu_device                ? SIM_FUSED_SUBSTEPS_CPU
+                                                : SIM_MAX_SUBSTEPS;
+  fused_max_cell_spacings_ = fused.max_cell_spacings != 0.0f ? fused.max_cell_spacings
+                             : cpu_device                    ? SIM_FUSED_CPU_MAX_CELL_SPACINGS
+                                                             : -1.0f;
   if (ctx_.properties().limits.maxComputeSharedMemorySize >= 16u * SIM_FUSED_MAX_PARTICLES)
     pipes_.tick_fused = make("tick_fused.comp", kSim, fused_workgroup, int(fused_workgroup));
   for (int s = 0; s < 3; ++s) pipes_.pick[size_t(s)] = make("pick.comp", kPick, SIM_WG_PARTICLES, s);
@@ -219,6 +226,9 @@ void GpuSolver::upload(const SheetTopology& topo) {
   VK_CHECK(vkDeviceWaitIdle(dev));
   destroySheet();
   topo_ = topo;
+  spacing_ = std::numeric_limits<float>::max();
+  for (const Constraint& k : topo.constraints)
+    if ((k.kind_id & SIM_KIND_MASK) == SIM_KIND_STRUCTURAL) spacing_ = std::min(spacing_, k.rest);
   const uint32_t n = topo.particleCount(), m = topo.constraintCount(), t = topo.triangleCount();
   const uint32_t cells = topo.hash_size;
   tear_slots_ = m + t + 1;
@@ -412,7 +422,7 @@ void GpuSolver::tick(const SimUniforms& u) {
     return;
   }
   RecordKey key{std::min<uint32_t>(u.substeps, SIM_MAX_SUBSTEPS), u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u,
-                usesFusedPath()};
+                usesFusedPath(u)};
   if (slot.recorded != key) recordTick(slot, index, key);
   ctx_.submit(slot.tick, slot.fence);
   slot.pending = true;
@@ -562,6 +572,12 @@ PassTimes GpuSolver::passTimes() const {
 bool GpuSolver::usesFusedPath() const {
   return fused_allowed_ && pipes_.tick_fused.pipeline && topo_.particleCount() <= SIM_FUSED_MAX_PARTICLES &&
          topo_.hash_size <= SIM_FUSED_MAX_BUCKETS;
+}
+
+bool GpuSolver::usesFusedPath(const SimUniforms& u) const {
+  if (!usesFusedPath()) return false;
+  if ((u.flags & SIM_FLAG_COLLISION) == 0u || fused_max_cell_spacings_ < 0.0f) return true;
+  return u.inv_cell * fused_max_cell_spacings_ * spacing_ >= 1.0f;
 }
 
 uint64_t GpuSolver::memoryBytes() const {

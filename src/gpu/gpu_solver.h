@@ -24,6 +24,16 @@ struct GpuOptions {
 /// Vulkan device exists.
 std::unique_ptr<Solver> createGpuSolver(const GpuOptions& options, std::string& error);
 
+/// Shape of the fused small-sheet tick; 0 picks the device's value. On a CPU device (lavapipe):
+/// SIM_WG_FUSED_CPU invocations, SIM_FUSED_SUBSTEPS_CPU substeps per dispatch, and only with hash
+/// cells of at most SIM_FUSED_CPU_MAX_CELL_SPACINGS grid spacings; on a GPU: SIM_WG_FUSED
+/// invocations, the whole tick in one dispatch, any cell.
+struct FusedShape {
+  uint32_t workgroup = 0;             ///< invocations of the workgroup, at most SIM_WG_FUSED
+  uint32_t substeps_per_dispatch = 0; ///< substeps each dispatch runs
+  float max_cell_spacings = 0.0f;     ///< largest hash cell (in grid spacings) with collision on; < 0: any
+};
+
 /// A compute pipeline and what dispatching it needs.
 struct ComputePipeline {
   VkPipeline pipeline = VK_NULL_HANDLE;
@@ -41,15 +51,14 @@ struct SimPipelines {
 
 /// The Solver on Vulkan compute. Per substep: integrate, project (one dispatch per colour), hash
 /// count/scan/scatter/sort, collide, floor, tear mark, and the tear compaction as indirect
-/// dispatches (zero workgroups when nothing tore). Small sheets run the whole tick, every pass of
-/// every substep, in one dispatch of one workgroup (tick_fused.comp).
+/// dispatches (zero workgroups when nothing tore). Small sheets run every pass of a substep in one
+/// workgroup (tick_fused.comp): on a GPU the whole tick in one dispatch, on a CPU device one
+/// dispatch per substep (see FusedShape).
 class GpuSolver final : public Solver {
 public:
   /// A solver on an existing context (the renderer's); the context must outlive the solver.
-  /// `fused_workgroup` overrides the fused tick's workgroup size (at most SIM_WG_FUSED; the
-  /// tests run SIM_WG_FUSED, a GPU's size, on lavapipe); 0 picks the device's: SIM_WG_FUSED_CPU
-  /// on a CPU device, else SIM_WG_FUSED.
-  explicit GpuSolver(VulkanContext& ctx, uint32_t fused_workgroup = 0);
+  /// `fused` overrides the shape of the fused tick (the tests run a GPU's shape on lavapipe).
+  explicit GpuSolver(VulkanContext& ctx, FusedShape fused = {});
   /// A solver that owns its context.
   explicit GpuSolver(std::unique_ptr<VulkanContext> ctx);
   ~GpuSolver() override;
@@ -88,8 +97,11 @@ public:
   /// supports it, the sheet has at most SIM_FUSED_MAX_PARTICLES particles and its hash table at
   /// most SIM_FUSED_MAX_BUCKETS buckets.
   void setFusedPath(bool allowed) { fused_allowed_ = allowed; }
-  /// True when ticks run the fused small-sheet tick.
+  /// True when the sheet is small enough for the fused small-sheet tick (and it is allowed).
   bool usesFusedPath() const;
+  /// True when a tick with these uniforms runs the fused tick: the sheet is small enough and, with
+  /// collision on, the hash cell is within the shape's limit.
+  bool usesFusedPath(const shaderio::SimUniforms& u) const;
   /// Waits until every submitted tick has finished.
   void finish();
 
@@ -120,7 +132,7 @@ private:
     uint32_t dispatches = 0;
   };
 
-  void createPipelines(uint32_t fused_workgroup);
+  void createPipelines(FusedShape fused);
   void destroySheet();
   void writeStaticUniforms();
   void uploadMutable(VkCommandBuffer cmd, std::vector<Buffer>& staging);
@@ -130,7 +142,7 @@ private:
   void bindSet(VkCommandBuffer cmd, uint32_t uniform_slot);
   template <class Push>
   void dispatchThreads(VkCommandBuffer cmd, const ComputePipeline& p, uint32_t count, const Push& push);
-  void dispatchWorkgroup(VkCommandBuffer cmd, const ComputePipeline& p, const shaderio::SimPush& push);
+  void dispatchWorkgroup(VkCommandBuffer cmd, const ComputePipeline& p, const shaderio::FusedPush& push);
   void dispatchIndirect(VkCommandBuffer cmd, const ComputePipeline& p, const void* push, uint32_t push_size);
   void recordScan(VkCommandBuffer cmd, uint32_t mode, uint32_t offset, uint32_t count, uint32_t sums, bool indirect);
   void timestamp(VkCommandBuffer cmd, Slot& slot, Category c);
@@ -167,7 +179,10 @@ private:
   uint32_t dispatches_per_tick_ = 0;
   VkPipeline bound_ = VK_NULL_HANDLE; ///< pipeline bound while recording
   uint32_t recorded_dispatches_ = 0;
-  bool fused_allowed_ = true; ///< dispatches recorded into the current command buffer
+  bool fused_allowed_ = true;
+  uint32_t fused_substeps_ = 1;           ///< substeps per dispatch of the fused tick
+  float fused_max_cell_spacings_ = -1.0f; ///< largest hash cell of the fused tick (< 0: any)
+  float spacing_ = 0.0f;                  ///< grid spacing: the shortest structural rest length
   mutable std::array<double, kCategoryCount> last_ms_{};
 };
 

@@ -17,15 +17,13 @@ namespace {
 class Parity : public GpuTest {};
 
 /// Runs the same parameters and script on both solvers; returns {cpu, gpu} states. `fused`
-/// allows the GPU's fused small-sheet substep (used when the sheet fits).
+/// allows the GPU's fused small-sheet tick (used when the sheet fits), in the given shape.
 std::pair<SimState, SimState> runBoth(gpu::VulkanContext& ctx, const SimParams& p, const char* text, int ticks,
-                                      bool fused = true) {
+                                      bool fused = true, gpu::FusedShape shape = {}) {
   CpuSolver cpu;
-  gpu::GpuSolver gpu(ctx);
+  gpu::GpuSolver gpu(ctx, shape);
   gpu.setFusedPath(fused);
   Simulation a(p, cpu), b(p, gpu);
-  a.setScript(script("0 grab particle 719\n1 move 2 3 1\n"));
-  b.setScript(script("0 grab particle 719\n1 move 2 3 1\n"));
   a.setScript(script(text));
   b.setScript(script(text));
   return {run(a, ticks), run(b, ticks)};
@@ -243,44 +241,59 @@ TEST_F(Parity, FusedSmallSheetPathMatchesSeparatePasses) {
   expectSameTopology(separate, fused);
 }
 
-TEST_F(Parity, FusedTickAtTheGpuWorkgroupSize) {
-  // Lavapipe (a CPU device) runs the fused tick with SIM_WG_FUSED_CPU invocations; a GPU runs it
-  // with SIM_WG_FUSED. Both sizes must compute what the CPU computes: a yank that tears, and
-  // buckets longer than the collision gather's window.
+TEST_F(Parity, FusedTickInTheShapesOfBothKindsOfDevice) {
+  // A CPU device (lavapipe) runs the fused tick as SIM_WG_FUSED_CPU invocations, one dispatch per
+  // substep, and only with hash cells of at most SIM_FUSED_CPU_MAX_CELL_SPACINGS spacings; a GPU
+  // runs SIM_WG_FUSED invocations, the whole tick in one dispatch, any cell. Both compute what
+  // the CPU computes: a yank that tears, and buckets longer than the collision gather's window
+  // (cells 10 spacings wide, which lavapipe leaves to the separate passes).
   struct Case {
     SimParams params;
     const char* script;
+    bool fused_on_cpu_device;
   };
   const Case cases[] = {
-      {preset("tender", {"wind=on"}), "0 grab particle 1535\n1 move 6 -5 6\n25 release\n"},
-      {preset("tender", {"cols=24", "rows=30", "cell_size=1.8", "wind=on"}), "0 grab particle 719\n1 move 2 3 1\n"}};
-  for (const Case& c : cases) {
-    const SimParams& p = c.params;
-    gpu::GpuSolver gpu(ctx(), SIM_WG_FUSED);
-    Simulation gpu_sim(p, gpu);
-    ASSERT_TRUE(gpu.usesFusedPath());
-    gpu_sim.setScript(script(c.script));
-    SimState got = run(gpu_sim, 40);
-    CpuSolver cpu;
-    Simulation cpu_sim(p, cpu);
-    cpu_sim.setScript(script(c.script));
-    SimState ref = run(cpu_sim, 40);
-    const float diff = maxAbsDiff(got.pos, ref.pos);
-    const auto torn = uint32_t(std::count(ref.torn.begin(), ref.torn.end(), 1u));
-    std::printf("fused tick, %d invocations, %ux%u, 40 ticks: max |x_gpu - x_cpu| = %.3g, torn %u\n", SIM_WG_FUSED,
-                p.cols, p.rows, diff, torn);
-    EXPECT_GT(torn, 0u);
-    EXPECT_LE(diff, 1e-3f);
-    expectSameTopology(ref, got);
-  }
+      {preset("tender", {"wind=on"}), "0 grab particle 1535\n1 move 6 -5 6\n25 release\n", true},
+      // just under the CPU device's cell limit (0.72): the densest buckets it fuses
+      {preset("tender", {"cell_size=0.7", "wind=on"}), "0 grab particle 1535\n1 move 6 -5 6\n25 release\n", true},
+      {preset("tender", {"cols=24", "rows=30", "cell_size=1.8", "wind=on"}), "0 grab particle 719\n1 move 2 3 1\n",
+       false}};
+  const gpu::FusedShape gpu_shape{SIM_WG_FUSED, SIM_MAX_SUBSTEPS, -1.0f};
+  for (const Case& c : cases)
+    for (bool gpu_like : {true, false}) {
+      const SimParams& p = c.params;
+      gpu::GpuSolver gpu(ctx(), gpu_like ? gpu_shape : gpu::FusedShape{});
+      Simulation gpu_sim(p, gpu);
+      const bool fused = gpu.usesFusedPath(gpu_sim.makeUniforms());
+      ASSERT_EQ(fused, gpu_like || c.fused_on_cpu_device);
+      gpu_sim.setScript(script(c.script));
+      SimState got = run(gpu_sim, 40);
+      const uint32_t dispatches = gpu.dispatchesPerTick();
+      if (fused) {
+        EXPECT_EQ(dispatches, gpu_like ? 1u : p.substeps);
+      }
+      CpuSolver cpu;
+      Simulation cpu_sim(p, cpu);
+      cpu_sim.setScript(script(c.script));
+      SimState ref = run(cpu_sim, 40);
+      const float diff = maxAbsDiff(got.pos, ref.pos);
+      const auto torn = uint32_t(std::count(ref.torn.begin(), ref.torn.end(), 1u));
+      std::printf("%s shape, %ux%u, cell %.2f, %u dispatches/tick, 40 ticks: max |x_gpu - x_cpu| = %.3g, torn %u\n",
+                  gpu_like ? "GPU" : "CPU-device", p.cols, p.rows, p.cell_size, dispatches, diff, torn);
+      EXPECT_GT(torn, 0u);
+      EXPECT_LE(diff, 1e-3f);
+      expectSameTopology(ref, got);
+    }
 }
 
 TEST_F(Parity, BucketsLongerThanTheGatherWindow) {
   // Cells 10 spacings wide: a bucket holds far more particles than the collision gather's
-  // 32-slot window, so buckets are read in several windows.
+  // 32-slot window, so buckets are read in several windows. The fused tick runs with any cell
+  // here, one substep per dispatch of SIM_WG_FUSED invocations (well within lavapipe's loop count).
   SimParams p = preset("tender", {"cols=24", "rows=30", "cell_size=1.8", "wind=on"});
   for (bool fused : {true, false}) {
-    auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 719\n1 move 2 3 1\n", 40, fused);
+    auto [cpu, gpu] =
+        runBoth(ctx(), p, "0 grab particle 719\n1 move 2 3 1\n", 40, fused, gpu::FusedShape{SIM_WG_FUSED, 1, -1.0f});
     float diff = maxAbsDiff(cpu.pos, gpu.pos);
     std::printf("cell_size=1.8, 40 ticks, %s: max |x_gpu - x_cpu| = %.3g\n", fused ? "fused" : "separate", diff);
     EXPECT_LE(diff, 1e-3f);
