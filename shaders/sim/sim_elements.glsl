@@ -19,16 +19,31 @@ void hashScatter(uint i) {
   cell_scatter[cell_start[h] + slot] = i;
 }
 
+// Grid column and row of particle j (index = row * cols + col); the float quotient is off by at
+// most one row, which the remainder corrects.
+ivec2 gridOf(uint j, float inv_cols) {
+  int row = int((float(j) + 0.5f) * inv_cols);
+  int col = int(j) - row * int(u.cols);
+  if (col < 0) return ivec2(col + int(u.cols), row - 1);
+  if (col >= int(u.cols)) return ivec2(col - int(u.cols), row + 1);
+  return ivec2(col, row);
+}
+
+// Grid place (column, row) of a particle packed in one word: row << 16 | column (sides < 2^16).
+uint packGrid(ivec2 g) { return uint(g.y) << 16u | uint(g.x); }
+ivec2 unpackGrid(uint g) { return ivec2(int(g & 0xFFFFu), int(g >> 16u)); }
+
 // Spatial hash, step 4: particle i (at p) goes to its place in its bucket ordered by particle
 // index: the number of bucket entries with a smaller index (ranks are unique, so no races). The
-// position and the index go along, so the collision gather reads buckets as one contiguous array.
+// position and the packed grid place go along, so the collision gather reads buckets as one
+// contiguous array and tests adjacency without dividing by the row length.
 void hashSort(uint i, vec3 p) {
   uint h = particle_cell[i];
   uint first = cell_start[h], end = cell_start[h + 1u];
   uint rank = 0u;
   for (uint k = first; k < end; ++k) rank += cell_scatter[k] < i ? 1u : 0u;
   cell_particles[first + rank] = i;
-  cell_pos[first + rank] = uvec4(floatBitsToUint(p), i);
+  cell_pos[first + rank] = uvec4(floatBitsToUint(p), packGrid(gridOf(i, 1.0f / float(u.cols))));
 }
 
 // True when particles i and j share a constraint (binary search in i's sorted adjacency list).
@@ -46,24 +61,14 @@ bool adjacentInList(uint i, uint j) {
   return false;
 }
 
-// Grid column and row of particle j (index = row * cols + col); the float quotient is off by at
-// most one row, which the remainder corrects.
-ivec2 gridOf(uint j, float inv_cols) {
-  int row = int((float(j) + 0.5f) * inv_cols);
-  int col = int(j) - row * int(u.cols);
-  if (col < 0) return ivec2(col + int(u.cols), row - 1);
-  if (col >= int(u.cols)) return ivec2(col - int(u.cols), row + 1);
-  return ivec2(col, row);
-}
-
 // Whether particles i (grid place gi, adjacency mask mask_i) and j share a constraint, from the
 // mask alone: SIM_CONNECTED, SIM_UNCONNECTED, or SIM_ASK_LIST when j is outside i's stencil and i
 // has farther neighbours (search the adjacency list).
 #define SIM_UNCONNECTED 0u
 #define SIM_CONNECTED 1u
 #define SIM_ASK_LIST 2u
-uint adjacencyOf(ivec2 gi, uint mask_i, uint j, float inv_cols) {
-  ivec2 off = gridOf(j, inv_cols) - gi;
+uint adjacencyOf(ivec2 gi, uint mask_i, uint grid_j) {
+  ivec2 off = unpackGrid(grid_j) - gi;
   if (all(lessThanEqual(abs(off), ivec2(SIM_ADJ_STENCIL)))) {
     uint bit = uint((off.y + SIM_ADJ_STENCIL) * (2 * SIM_ADJ_STENCIL + 1) + off.x + SIM_ADJ_STENCIL);
     return (mask_i >> bit) & 1u;
@@ -88,8 +93,8 @@ vec3 gatherRepulsion(uint i, vec3 pi) {
   ivec3 ci = cellOf(pi, u.inv_cell);
   vec3 scaled = pi * u.inv_cell;
   float reach = r * u.inv_cell + 1e-3f;
-  float inv_cols = 1.0f / float(u.cols);
-  ivec2 gi = gridOf(i, inv_cols);
+  ivec2 gi = gridOf(i, 1.0f / float(u.cols));
+  uint grid_i = packGrid(gi);
   uint mask_i = adj_mask[i];
   uint visit = 0x7FFFFFFu;
   for (int a = 0; a < 3; ++a) {
@@ -116,7 +121,7 @@ vec3 gatherRepulsion(uint i, vec3 pi) {
       for (uint k = first; k < min(first + 32u, end); ++k) {
         uvec4 q = cell_pos[k];
         vec3 d = pi - uintBitsToFloat(q.xyz);
-        bool may_repel = q.w != i && adjacencyOf(gi, mask_i, q.w, inv_cols) != SIM_CONNECTED;
+        bool may_repel = q.w != grid_i && adjacencyOf(gi, mask_i, q.w) != SIM_CONNECTED;
         near |= dot(d, d) < r2 && may_repel ? 1u << (k - first) : 0u;
       }
       for (; near != 0u; near &= near - 1u) {
@@ -124,7 +129,10 @@ vec3 gatherRepulsion(uint i, vec3 pi) {
         vec3 pj = uintBitsToFloat(q.xyz);
         // Count j once, from its own cell
         if (cellOf(pj, u.inv_cell) != c) continue;
-        if (adjacencyOf(gi, mask_i, q.w, inv_cols) == SIM_ASK_LIST && adjacentInList(i, q.w)) continue;
+        if (adjacencyOf(gi, mask_i, q.w) == SIM_ASK_LIST) {
+          ivec2 gj = unpackGrid(q.w);
+          if (adjacentInList(i, uint(gj.y) * u.cols + uint(gj.x))) continue;
+        }
         sum += repulsion(pi, pj, r, u.collision_stiffness);
       }
     }

@@ -107,12 +107,17 @@ void main() {
       prev[i] = st.prev;
     }
     sync();
-    // 5. Tear marking (as tear_mark.comp); when something tore, the compaction (as tear_flags,
-    // scan, tear_compact) in the same workgroup
+    // 5. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
+    // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
+    // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
+    // substep it tore in removed it), and kinds that cannot tear skip the position loads.
     if (!tearing) continue;
-    for (uint k = lid; k < m; k += kInvocations) {
-      Constraint c = constraints[k];
-      if (torn[c.kind_id >> SIM_KIND_BITS] == 0u) markTear(c, s_pos[c.a], s_pos[c.b]);
+    for (uint c = 0u; c < u.color_count; ++c) {
+      uvec2 range = color_range[c];
+      for (uint t = lid; t < range.y; t += kInvocations) {
+        Constraint k = constraints[range.x + t];
+        if ((u.tear_kinds & (1u << (k.kind_id & SIM_KIND_MASK))) != 0u) markTear(k, s_pos[k.a], s_pos[k.b]);
+      }
     }
     sync();
     if (counters.torn_new == 0u) continue;
