@@ -83,10 +83,15 @@ std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::
     // and its adjacency (offsets and list); write delta (in hash order).
     collide.read += n * (kSortedPos + kCoord + kIndex) + (buckets + 1) * kIndex + (n + 1) * kIndex + adjacency * kIndex;
     collide.write += n * kPos;
+  } else if (collision && fused) {
+    // The fused tick in its steady state, the candidate lists in use (a substep that rebuilds them
+    // runs the hash and the search below): each particle reads the position its list was built at
+    // (the travel test) and its list's count, then writes delta. The entries and their positions
+    // (in shared memory) depend on how close the sheet comes to itself and are not counted.
+    collide.read += n * (kPos + kIndex);
+    collide.write += n * kPos;
   } else if (collision) {
-    // hash, the GPU passes (scan_add runs when the scan has more than one block). The fused tick
-    // runs the same steps in one workgroup and is counted the same way (an upper bound: its
-    // positions come from shared memory).
+    // hash, the GPU passes (scan_add runs when the scan has more than one block).
     const uint64_t scans = buckets > SIM_SCAN_BLOCK ? 2 : 1;
     hash.read += n * (kPos + kIndex);       // hash_count: read pos and (atomic) the bucket's count,
     hash.write += n * 2 * kIndex;           //   write particle_cell and the count
@@ -110,11 +115,11 @@ std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::
 
   // tear marking: read the constraint records and every position (each particle ends several
   // constraints; counted once). The GPU pass runs over every slot and reads the torn flag of
-  // each; the CPU reads the live ranges of its split arrays only. Nothing is written unless something tears; the
-  // compaction then runs, which this steady-state model leaves out.
+  // each; the fused tick and the CPU read the live ranges only. Nothing is written unless
+  // something tears; the compaction then runs, which this steady-state model leaves out.
   if (tear) {
-    tear_pass.read += cpu ? live * kSplitConstraint : slots * (kConstraint + kIndex);
-    tear_pass.read += n * kPos;
+    tear_pass.read += cpu ? live * kSplitConstraint : fused ? live * kConstraint : slots * (kConstraint + kIndex);
+    tear_pass.read += fused ? 0 : n * kPos;
   }
 
   std::vector<PassTraffic> passes = {integrate, project, hash, collide, floor, tear_pass};

@@ -58,6 +58,8 @@
 #define SIM_BIND_COMPACT_TMP 23
 #define SIM_BIND_CELL_POS 24
 #define SIM_BIND_ADJ_MASK 25
+#define SIM_BIND_NEAR 26
+#define SIM_BIND_NEAR_BASE 27
 
 // Adjacency masks (SIM_BIND_ADJ_MASK): bit (dy + 2) * 5 + (dx + 2) is set when particle i is
 // connected to the particle dx columns and dy rows away; SIM_ADJ_FAR when it is connected to a
@@ -89,6 +91,26 @@
 #define SIM_FUSED_MAX_PARTICLES 2048
 // Largest hash table the fused tick takes (one workgroup scans it every substep)
 #define SIM_FUSED_MAX_BUCKETS 4096u
+
+// Candidate lists of the fused tick (SIM_BIND_NEAR): for each particle, the particles not
+// connected to it within collision radius + skin when the lists were built (SIM_BIND_NEAR_BASE
+// holds the positions then). While no particle has moved SIM_NEAR_TRAVEL x skin since, every pair
+// closer than the radius is in the lists, so a substep reads the lists instead of rebuilding the
+// hash and searching 27 cells. Record of particle i: SIM_NEAR_STRIDE words at i * SIM_NEAR_STRIDE,
+// the count then up to SIM_NEAR_CAPACITY particles in ascending order.
+#define SIM_NEAR_CAPACITY 15u
+#define SIM_NEAR_STRIDE 16u
+// Skin: this fraction of the collision radius, at most 0.99 x (cell - radius), so that the lists
+// come from the 27 cells around a particle; below SIM_NEAR_MIN_SKIN x radius no lists are kept
+#define SIM_NEAR_SKIN 0.5f
+#define SIM_NEAR_MIN_SKIN 0.05f
+// Lists are usable while every particle is within this fraction of the skin of where it was when
+// they were built (two particles then closed in by less than the skin, with room for rounding)
+#define SIM_NEAR_TRAVEL 0.45f
+// Lists outgrown within SIM_NEAR_MIN_AGE substeps, or overflowing, are not rebuilt for
+// SIM_NEAR_WAIT substeps: fast motion (a drag, a toss) uses the hash every substep instead
+#define SIM_NEAR_MIN_AGE 4u
+#define SIM_NEAR_WAIT 16u
 
 // Largest workgroup count in X of one dispatch; bigger grids spill into Y
 #define SIM_MAX_GROUPS_X 65535u

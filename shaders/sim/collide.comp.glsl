@@ -10,5 +10,6 @@ layout(push_constant) uniform PushBlock { SimPush p; };
 void main() {
   uint i = threadIndex();
   if (i >= p.count) return;
-  delta[i] = vec4(gatherRepulsion(i, vec3(pos[i])), 0.0f);
+  bool fits;
+  delta[i] = vec4(gatherRepulsion(i, vec3(pos[i]), u.collision_radius, SIM_NONE, fits), 0.0f);
 }

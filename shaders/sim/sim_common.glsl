@@ -59,6 +59,9 @@ layout(std430, set = 0, binding = SIM_BIND_COMPACT_TMP) SIM_COHERENT buffer Comp
 // Bucket order: xyz the bits of pos[cell_particles[k]].xyz, w the particle cell_particles[k], so
 // collide reads buckets contiguously in one load per candidate
 layout(std430, set = 0, binding = SIM_BIND_CELL_POS) SIM_COHERENT buffer CellPosBuffer { uvec4 cell_pos[]; };
+// Candidate lists of the fused tick and the positions they were built at (SIM_NEAR_* in sim_config.h)
+layout(std430, set = 0, binding = SIM_BIND_NEAR) SIM_COHERENT buffer NearBuffer { uint near_list[]; };
+layout(std430, set = 0, binding = SIM_BIND_NEAR_BASE) SIM_COHERENT buffer NearBaseBuffer { vec4 near_base[]; };
 
 // Linear index of this invocation; grids wider than SIM_MAX_GROUPS_X spill into Y.
 uint threadIndex() {

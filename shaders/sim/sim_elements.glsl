@@ -81,18 +81,24 @@ const uint kCellsWithOffset[9] = uint[9](0x1249249u, 0x2492492u, 0x4924924u,  //
                                          0x01C0E07u, 0x0E07038u, 0x70381C0u,  // y
                                          0x00001FFu, 0x003FE00u, 0x7FC0000u); // z
 
+// Neighbour cell code of a cell offset o in {-1, 0, 1}^3: the order (dz, dy, dx) in which the
+// collision gather visits cells.
+uint cellCode(ivec3 o) { return uint((o.z + 1) * 9 + (o.y + 1) * 3 + o.x + 1); }
+
 // Repulsion gathered by particle i at pi from the non-adjacent particles closer than the collision
 // radius, in the 27 cells around it (Jacobi: reads bucket-ordered positions only). Cells, and
 // particles within a cell, are summed in the CPU reference's order. A neighbour cell on one side
-// can hold a particle within the radius only when pi is closer than the radius to that side of
-// its own cell (the radius never exceeds a cell); the test is in cell units with a margin, so
-// the cells skipped add no term and the sum is unchanged.
-vec3 gatherRepulsion(uint i, vec3 pi) {
+// can hold a particle within `search` only when pi is closer than that to that side of its own
+// cell (`search`, at least the radius, never exceeds a cell); the test is in cell units with a
+// margin, so the cells skipped add no term and the sum is unchanged. Unless `list` is SIM_NONE,
+// the particles not connected to i closer than `search` also go to the candidate list record at
+// near_list[list] (ascending); `fits` is false when they are more than SIM_NEAR_CAPACITY.
+vec3 gatherRepulsion(uint i, vec3 pi, float search, uint list, out bool fits) {
   float r = u.collision_radius;
-  float r2 = r * r;
+  float r2 = r * r, search2 = search * search;
   ivec3 ci = cellOf(pi, u.inv_cell);
   vec3 scaled = pi * u.inv_cell;
-  float reach = r * u.inv_cell + 1e-3f;
+  float reach = search * u.inv_cell + 1e-3f;
   ivec2 gi = gridOf(i, 1.0f / float(u.cols));
   uint grid_i = packGrid(gi);
   uint mask_i = adj_mask[i];
@@ -105,11 +111,12 @@ vec3 gatherRepulsion(uint i, vec3 pi) {
     if (!sure || !(1.0f - f >= reach)) sides |= kCellsWithOffset[3 * a + 2];
     visit &= sides;
   }
-  // Each bucket is read in windows of 32 slots: a tight loop finds the slots within the radius
+  // Each bucket is read in windows of 32 slots: a tight loop finds the slots within `search`
   // that may repel (a bit each: not i, not a connected grid neighbour), then a second loop
   // visits those few in order. Kept apart, SIMD lanes do not step through the rest of the tests
   // and the repulsion for every candidate.
   vec3 sum = vec3(0.0f);
+  uint listed = 0u;
   while (visit != 0u) {
     int b = findLSB(visit); // ascending: dz, dy, dx order
     visit &= visit - 1u;
@@ -122,21 +129,32 @@ vec3 gatherRepulsion(uint i, vec3 pi) {
         uvec4 q = cell_pos[k];
         vec3 d = pi - uintBitsToFloat(q.xyz);
         bool may_repel = q.w != grid_i && adjacencyOf(gi, mask_i, q.w) != SIM_CONNECTED;
-        near |= dot(d, d) < r2 && may_repel ? 1u << (k - first) : 0u;
+        near |= dot(d, d) < search2 && may_repel ? 1u << (k - first) : 0u;
       }
       for (; near != 0u; near &= near - 1u) {
         uvec4 q = cell_pos[first + uint(findLSB(near))];
         vec3 pj = uintBitsToFloat(q.xyz);
         // Count j once, from its own cell
         if (cellOf(pj, u.inv_cell) != c) continue;
-        if (adjacencyOf(gi, mask_i, q.w) == SIM_ASK_LIST) {
-          ivec2 gj = unpackGrid(q.w);
-          if (adjacentInList(i, uint(gj.y) * u.cols + uint(gj.x))) continue;
+        ivec2 gj = unpackGrid(q.w);
+        uint j = uint(gj.y) * u.cols + uint(gj.x);
+        if (adjacencyOf(gi, mask_i, q.w) == SIM_ASK_LIST && adjacentInList(i, j)) continue;
+        if (list != SIM_NONE) {
+          // Insertion into the ascending list
+          if (listed < SIM_NEAR_CAPACITY) {
+            uint e = listed + 1u;
+            for (; e > 1u && near_list[list + e - 1u] > j; --e) near_list[list + e] = near_list[list + e - 1u];
+            near_list[list + e] = j;
+          }
+          ++listed;
         }
-        sum += repulsion(pi, pj, r, u.collision_stiffness);
+        vec3 d = pi - pj;
+        if (dot(d, d) < r2) sum += repulsion(pi, pj, r, u.collision_stiffness);
       }
     }
   }
+  fits = listed <= SIM_NEAR_CAPACITY;
+  if (list != SIM_NONE) near_list[list] = fits ? listed : 0u;
   return sum;
 }
 

@@ -21,6 +21,34 @@ shared vec4 s_pos[SIM_FUSED_MAX_PARTICLES];
 // Invocations of the workgroup (specialised)
 const uint kInvocations = gl_WorkGroupSize.x;
 
+// Repulsion on particle i at pi from its candidate list (lists in use): the candidates closer than
+// the radius, summed as the gather sums them, by neighbour cell (cellCode) and then by index (the
+// list is ascending), so the result is the gather's to the bit.
+vec3 listRepulsion(uint i, vec3 pi) {
+  uint list = i * SIM_NEAR_STRIDE, count = near_list[list];
+  float r = u.collision_radius, r2 = r * r;
+  ivec3 ci = cellOf(pi, u.inv_cell);
+  uint codes = 0u; // neighbour cells holding a candidate within the radius
+  for (uint e = 1u; e <= count; ++e) {
+    vec3 pj = vec3(s_pos[near_list[list + e]]);
+    vec3 d = pi - pj;
+    ivec3 o = cellOf(pj, u.inv_cell) - ci;
+    if (dot(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1)))) codes |= 1u << cellCode(o);
+  }
+  vec3 sum = vec3(0.0f);
+  for (; codes != 0u; codes &= codes - 1u) {
+    uint b = uint(findLSB(codes));
+    for (uint e = 1u; e <= count; ++e) {
+      vec3 pj = vec3(s_pos[near_list[list + e]]);
+      vec3 d = pi - pj;
+      ivec3 o = cellOf(pj, u.inv_cell) - ci;
+      if (dot(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1))) && cellCode(o) == b)
+        sum += repulsion(pi, pj, r, u.collision_stiffness);
+    }
+  }
+  return sum;
+}
+
 // Everything written before it, to shared memory and to buffers, is seen by the whole workgroup.
 void sync() {
   memoryBarrierBuffer();
@@ -88,20 +116,72 @@ void main() {
         }
         sync();
       }
-    // 3. Spatial hash (count, scan, scatter, order within bucket), then 4. each particle gathers
-    // its repulsion and meets the floor (as floor.comp)
+    // 3. Collision: each particle's repulsion to delta. From the candidate lists while they hold
+    // every pair that can touch (no particle has travelled SIM_NEAR_TRAVEL x skin since they were
+    // built); otherwise from the spatial hash (count, scan, scatter, order within bucket) and a
+    // search of the 27 cells around each particle, which rebuilds the lists as it goes unless
+    // they have been outgrown too fast of late (SIM_NEAR_MIN_AGE, SIM_NEAR_WAIT).
     if (collision) {
-      for (uint i = lid; i < n; i += kInvocations) hashCount(i, vec3(s_pos[i]));
+      float r = u.collision_radius;
+      float skin = min(SIM_NEAR_SKIN * r, 0.99f * (1.0f / u.inv_cell - r));
+      bool keep_lists = skin >= SIM_NEAR_MIN_SKIN * r;
+      float search = keep_lists ? r + skin : r;
+      uvec4 state = counters.near;
+      bool usable = keep_lists && state.x != 0u && state.w == floatBitsToUint(search);
+      if (lid == 0u) counters.near_flags = 0u;
       sync();
-      scanWorkgroup(SIM_SCAN_HASH, u.hash_mask + 1u, compactSlots());
-      for (uint i = lid; i < n; i += kInvocations) hashScatter(i);
+      if (usable) {
+        float travel2 = SIM_NEAR_TRAVEL * skin * SIM_NEAR_TRAVEL * skin;
+        bool far = false;
+        for (uint i = lid; i < n; i += kInvocations) {
+          vec3 d = vec3(s_pos[i]) - vec3(near_base[i]);
+          far = far || !(dot(d, d) < travel2);
+        }
+        if (far) atomicOr(counters.near_flags, 1u);
+        sync();
+        usable = counters.near_flags == 0u;
+      }
+      bool short_lived = state.x != 0u && !usable && state.y < SIM_NEAR_MIN_AGE;
+      bool build = keep_lists && !usable && state.z == 0u && !short_lived;
+      if (!usable) {
+        for (uint i = lid; i < n; i += kInvocations) hashCount(i, vec3(s_pos[i]));
+        sync();
+        scanWorkgroup(SIM_SCAN_HASH, u.hash_mask + 1u, compactSlots());
+        for (uint i = lid; i < n; i += kInvocations) hashScatter(i);
+        sync();
+        for (uint i = lid; i < n; i += kInvocations) hashSort(i, vec3(s_pos[i]));
+        sync();
+      }
+      for (uint i = lid; i < n; i += kInvocations) {
+        vec3 pi = vec3(s_pos[i]);
+        vec3 repel;
+        if (usable) {
+          repel = listRepulsion(i, pi);
+        } else {
+          bool fits;
+          repel = gatherRepulsion(i, pi, build ? search : r, build ? i * SIM_NEAR_STRIDE : SIM_NONE, fits);
+          if (build) {
+            near_base[i] = vec4(pi, 0.0f);
+            if (!fits) atomicOr(counters.near_flags, 2u);
+          }
+        }
+        delta[i] = vec4(repel, 0.0f);
+      }
       sync();
-      for (uint i = lid; i < n; i += kInvocations) hashSort(i, vec3(s_pos[i]));
-      sync();
+      if (lid == 0u) {
+        bool overflow = (counters.near_flags & 2u) != 0u;
+        if (usable)
+          counters.near = uvec4(1u, state.y + 1u, 0u, state.w);
+        else if (build)
+          counters.near = uvec4(overflow ? 0u : 1u, 0u, overflow ? SIM_NEAR_WAIT : 0u, floatBitsToUint(search));
+        else
+          counters.near = uvec4(0u, 0u, short_lived ? SIM_NEAR_WAIT : max(state.z, 1u) - 1u, 0u);
+      }
     }
+    // 4. Each particle takes its repulsion and meets the floor (as floor.comp)
     for (uint i = lid; i < n; i += kInvocations) {
       vec4 q = s_pos[i];
-      vec3 repel = collision ? gatherRepulsion(i, vec3(q)) : vec3(0.0f);
+      vec3 repel = collision ? vec3(delta[i]) : vec3(0.0f);
       VerletState st = floorParticle(q, prev[i], repel, u.flags, u.floor_y, u.restitution, u.friction);
       s_pos[i] = st.pos;
       prev[i] = st.prev;

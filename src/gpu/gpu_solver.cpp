@@ -270,6 +270,10 @@ void GpuSolver::upload(const SheetTopology& topo) {
   storage(SIM_BIND_COMPACT_TMP, 16ull * (m + t));
   storage(SIM_BIND_CELL_POS, 16ull * n);
   storage(SIM_BIND_ADJ_MASK, 4ull * n);
+  // Candidate lists: only the fused tick keeps them
+  const bool fusable = n <= SIM_FUSED_MAX_PARTICLES;
+  storage(SIM_BIND_NEAR, fusable ? 4ull * SIM_NEAR_STRIDE * n : 16);
+  storage(SIM_BIND_NEAR_BASE, fusable ? 16ull * n : 16);
 
   // Start state and the static arrays, in one submission.
   std::vector<Buffer> staging;

@@ -53,7 +53,9 @@ struct SimPipelines {
 /// count/scan/scatter/sort, collide, floor, tear mark, and the tear compaction as indirect
 /// dispatches (zero workgroups when nothing tore). Small sheets run every pass of a substep in one
 /// workgroup (tick_fused.comp): on a GPU the whole tick in one dispatch, on a CPU device one
-/// dispatch per substep (see FusedShape).
+/// dispatch per substep (see FusedShape). The fused tick keeps collision candidate lists with a
+/// skin (SIM_NEAR_* in sim_config.h) and rebuilds the hash only when a particle has travelled too
+/// far for them; the sums, and so the results, are those of the hash search.
 class GpuSolver final : public Solver {
 public:
   /// A solver on an existing context (the renderer's); the context must outlive the solver.
@@ -110,7 +112,7 @@ private:
   static constexpr uint32_t kSlots = 2;
   /// Uniform slot of the normals and pick passes (static: written at upload).
   static constexpr uint32_t kStaticSlot = kSlots;
-  static constexpr uint32_t kBindingCount = SIM_BIND_ADJ_MASK + 1;
+  static constexpr uint32_t kBindingCount = SIM_BIND_NEAR_BASE + 1;
   /// Timestamp categories, in passTimes() order.
   /// kFused: the fused small-sheet tick, every pass in one dispatch.
   enum Category : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kFused, kCategoryCount };

@@ -14,7 +14,11 @@ using namespace tender::test;
 
 namespace {
 
-class Parity : public GpuTest {};
+class Parity : public GpuTest {
+protected:
+  /// Runs p on the GPU (fused tick) and the CPU, checking the candidate lists whenever usable.
+  void checkCandidateLists(const SimParams& p, bool expect_entries);
+};
 
 /// Runs the same parameters and script on both solvers; returns {cpu, gpu} states. `fused`
 /// allows the GPU's fused small-sheet tick (used when the sheet fits), in the given shape.
@@ -59,6 +63,8 @@ TEST_F(Parity, HashBucketsMatchTheCpu) {
   gpu::GpuSolver gpu(ctx());
   Simulation sim(p, gpu);
   SimState s = run(sim, 30);
+  // The separate passes build the hash every substep (the fused tick may use its candidate lists)
+  gpu.setFusedPath(false);
   shaderio::SimUniforms u = sim.makeUniforms();
   u.substeps = 1;
   u.iterations = 0;
@@ -340,4 +346,117 @@ TEST_F(Parity, FarConnectedParticlesNeverRepel) {
     std::printf("far connections, folded strip, %s: max |x_gpu - x_cpu| = %.3g\n", fused ? "fused" : "separate", diff);
     EXPECT_LE(diff, 1e-3f);
   }
+}
+
+namespace {
+
+/// The fused tick's candidate-list state (Counters::near): x usable, y substeps since built, z
+/// substeps to wait before the next build.
+glm::uvec4 listState(gpu::GpuSolver& gpu) {
+  shaderio::Counters c{};
+  gpu.context().download(gpu.buffer(SIM_BIND_COUNTERS), &c, sizeof(c));
+  return c.near;
+}
+
+} // namespace
+
+TEST_F(Parity, CandidateListsHoldEveryCloseUnconnectedPair) {
+  // A sheet hanging in the wind moves little between substeps, so the fused tick gathers its
+  // collisions from the candidate lists most of the time. Whenever they are usable, each list
+  // holds exactly the particles not connected to its particle within radius + skin of where they
+  // were when the lists were built, in ascending order; and the run matches the CPU's. With a
+  // radius of 1.6 spacings (skin 0.8) the lists are not empty: the particles one column and two
+  // rows away (or two columns, one row) are unconnected and within 2.4 spacings.
+  for (const char* factor : {"collision_factor=1.2", "collision_factor=1.6"})
+    checkCandidateLists(preset("tender", {"wind=on", factor}), std::strcmp(factor, "collision_factor=1.6") == 0);
+}
+
+void Parity::checkCandidateLists(const SimParams& p, bool expect_entries) {
+  gpu::GpuSolver gpu(ctx());
+  Simulation sim(p, gpu);
+  ASSERT_TRUE(gpu.usesFusedPath(sim.makeUniforms()));
+  CpuSolver cpu;
+  Simulation ref(p, cpu);
+  const SheetTopology& topo = sim.topology();
+  const uint32_t n = topo.particleCount();
+  const shaderio::SimUniforms u = sim.makeUniforms();
+  const float r = u.collision_radius;
+  const float skin = std::min(SIM_NEAR_SKIN * r, 0.99f * (1.0f / u.inv_cell - r));
+  const float search2 = (r + skin) * (r + skin);
+  int whole_ticks_on_lists = 0, checked = 0;
+  size_t entries = 0;
+  const int ticks = 90;
+  for (int t = 0; t < ticks; ++t) {
+    run(sim, 1);
+    run(ref, 1);
+    const glm::uvec4 state = listState(gpu);
+    if (state.x == 1u && state.y >= p.substeps) ++whole_ticks_on_lists;
+    if (state.x != 1u || t % 15 != 0) continue;
+    ++checked;
+    std::vector<uint32_t> lists(size_t(SIM_NEAR_STRIDE) * n);
+    std::vector<glm::vec4> base(n);
+    gpu.context().download(gpu.buffer(SIM_BIND_NEAR), lists.data(), 4ull * lists.size());
+    gpu.context().download(gpu.buffer(SIM_BIND_NEAR_BASE), base.data(), 16ull * n);
+    size_t bad = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t* rec = &lists[size_t(SIM_NEAR_STRIDE) * i];
+      ASSERT_LE(rec[0], SIM_NEAR_CAPACITY);
+      entries += rec[0];
+      std::set<uint32_t> got(rec + 1, rec + 1 + rec[0]);
+      EXPECT_TRUE(std::is_sorted(rec + 1, rec + 1 + rec[0]));
+      for (uint32_t j = 0; j < n; ++j) {
+        if (j == i || topo.adjacent(i, j)) {
+          bad += got.count(j);
+          continue;
+        }
+        const glm::vec3 d = glm::vec3(base[i]) - glm::vec3(base[j]);
+        const float d2 = glm::dot(d, d);
+        // Pairs a rounding away from radius + skin may go either way
+        if (d2 < search2 * (1.0f - 1e-5f)) bad += got.count(j) ? 0 : 1;
+        if (d2 >= search2 * (1.0f + 1e-5f)) bad += got.count(j);
+      }
+    }
+    EXPECT_EQ(bad, 0u) << "tick " << t;
+  }
+  SimState a, b;
+  cpu.readback(a);
+  gpu.readback(b);
+  const float diff = maxAbsDiff(a.pos, b.pos);
+  std::printf("radius %.2f, %d ticks, %d of them wholly on candidate lists, %d list checks (%zu entries): "
+              "max |x_gpu - x_cpu| = %.3g\n",
+              r, ticks, whole_ticks_on_lists, checked, entries, diff);
+  EXPECT_GT(whole_ticks_on_lists, ticks / 2);
+  if (expect_entries) {
+    EXPECT_GT(entries, size_t(n));
+  }
+  EXPECT_GT(checked, 2);
+  EXPECT_LE(diff, 1e-4f);
+}
+
+TEST_F(Parity, OverflowingCandidateListsFallBackToTheHash) {
+  // A collision radius of 2.5 spacings reaches far past the connected neighbours: a particle has
+  // more unconnected candidates than a list holds. The fused tick then waits SIM_NEAR_WAIT
+  // substeps before trying again, gathering from the hash meanwhile, and matches the CPU.
+  SimParams p = preset("tender", {"cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9", "wind=on"});
+  gpu::GpuSolver gpu(ctx(), gpu::FusedShape{SIM_WG_FUSED, 1, -1.0f});
+  Simulation sim(p, gpu);
+  ASSERT_TRUE(gpu.usesFusedPath(sim.makeUniforms()));
+  CpuSolver cpu;
+  Simulation ref(p, cpu);
+  int waiting = 0;
+  const int ticks = 20;
+  for (int t = 0; t < ticks; ++t) {
+    run(sim, 1);
+    run(ref, 1);
+    const glm::uvec4 state = listState(gpu);
+    if (state.x == 0u && state.z > 0u) ++waiting;
+  }
+  SimState a, b;
+  cpu.readback(a);
+  gpu.readback(b);
+  const float diff = maxAbsDiff(a.pos, b.pos);
+  std::printf("radius 2.5 spacings, %d ticks, %d ending in a wait after an overflow: max |x_gpu - x_cpu| = %.3g\n",
+              ticks, waiting, diff);
+  EXPECT_GT(waiting, 0);
+  EXPECT_LE(diff, 1e-4f);
 }
