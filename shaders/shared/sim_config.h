@@ -110,7 +110,7 @@
 // Lists outgrown within SIM_NEAR_MIN_AGE substeps, or overflowing, are not rebuilt for
 // SIM_NEAR_WAIT substeps: fast motion (a drag, a toss) uses the hash every substep instead
 #define SIM_NEAR_MIN_AGE 4u
-#define SIM_NEAR_WAIT 16u
+#define SIM_NEAR_WAIT 32u
 
 // Largest workgroup count in X of one dispatch; bigger grids spill into Y
 #define SIM_MAX_GROUPS_X 65535u

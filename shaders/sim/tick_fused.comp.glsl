@@ -121,13 +121,14 @@ void main() {
     // built); otherwise from the spatial hash (count, scan, scatter, order within bucket) and a
     // search of the 27 cells around each particle, which rebuilds the lists as it goes unless
     // they have been outgrown too fast of late (SIM_NEAR_MIN_AGE, SIM_NEAR_WAIT).
+    float r = u.collision_radius;
+    float skin = min(SIM_NEAR_SKIN * r, 0.99f * (1.0f / u.inv_cell - r));
+    bool keep_lists = skin >= SIM_NEAR_MIN_SKIN * r;
+    float search = keep_lists ? r + skin : r;
+    uvec4 state = counters.near;
+    bool usable = false, short_lived = false, build = false;
     if (collision) {
-      float r = u.collision_radius;
-      float skin = min(SIM_NEAR_SKIN * r, 0.99f * (1.0f / u.inv_cell - r));
-      bool keep_lists = skin >= SIM_NEAR_MIN_SKIN * r;
-      float search = keep_lists ? r + skin : r;
-      uvec4 state = counters.near;
-      bool usable = keep_lists && state.x != 0u && state.w == floatBitsToUint(search);
+      usable = keep_lists && state.x != 0u && state.w == floatBitsToUint(search);
       if (lid == 0u) counters.near_flags = 0u;
       sync();
       if (usable) {
@@ -141,8 +142,8 @@ void main() {
         sync();
         usable = counters.near_flags == 0u;
       }
-      bool short_lived = state.x != 0u && !usable && state.y < SIM_NEAR_MIN_AGE;
-      bool build = keep_lists && !usable && state.z == 0u && !short_lived;
+      short_lived = state.x != 0u && !usable && state.y < SIM_NEAR_MIN_AGE;
+      build = keep_lists && !usable && state.z == 0u && !short_lived;
       if (!usable) {
         for (uint i = lid; i < n; i += kInvocations) hashCount(i, vec3(s_pos[i]));
         sync();
@@ -152,41 +153,42 @@ void main() {
         for (uint i = lid; i < n; i += kInvocations) hashSort(i, vec3(s_pos[i]));
         sync();
       }
-      for (uint i = lid; i < n; i += kInvocations) {
-        vec3 pi = vec3(s_pos[i]);
-        vec3 repel;
-        if (usable) {
-          repel = listRepulsion(i, pi);
-        } else {
-          bool fits;
-          repel = gatherRepulsion(i, pi, build ? search : r, build ? i * SIM_NEAR_STRIDE : SIM_NONE, fits);
-          if (build) {
-            near_base[i] = vec4(pi, 0.0f);
-            if (!fits) atomicOr(counters.near_flags, 2u);
-          }
-        }
-        delta[i] = vec4(repel, 0.0f);
-      }
-      sync();
-      if (lid == 0u) {
-        bool overflow = (counters.near_flags & 2u) != 0u;
-        if (usable)
-          counters.near = uvec4(1u, state.y + 1u, 0u, state.w);
-        else if (build)
-          counters.near = uvec4(overflow ? 0u : 1u, 0u, overflow ? SIM_NEAR_WAIT : 0u, floatBitsToUint(search));
-        else
-          counters.near = uvec4(0u, 0u, short_lived ? SIM_NEAR_WAIT : max(state.z, 1u) - 1u, 0u);
+      if (usable) {
+        // The lists read the positions of other particles: all of them before any moves
+        for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(listRepulsion(i, vec3(s_pos[i])), 0.0f);
+        sync();
       }
     }
-    // 4. Each particle takes its repulsion and meets the floor (as floor.comp)
+    // 4. Each particle takes its repulsion (from the lists, or gathered here from the hash's
+    // bucket-ordered copy of the positions) and meets the floor (as floor.comp)
     for (uint i = lid; i < n; i += kInvocations) {
       vec4 q = s_pos[i];
-      vec3 repel = collision ? vec3(delta[i]) : vec3(0.0f);
+      vec3 repel = vec3(0.0f);
+      bool fits = true;
+      if (!collision) {
+      } else if (usable) {
+        repel = vec3(delta[i]);
+      } else if (build) {
+        repel = gatherRepulsion(i, vec3(q), search, i * SIM_NEAR_STRIDE, fits);
+        near_base[i] = vec4(vec3(q), 0.0f);
+      } else {
+        repel = gatherRepulsion(i, vec3(q), r, SIM_NONE, fits);
+      }
+      if (!fits) atomicOr(counters.near_flags, 2u);
       VerletState st = floorParticle(q, prev[i], repel, u.flags, u.floor_y, u.restitution, u.friction);
       s_pos[i] = st.pos;
       prev[i] = st.prev;
     }
     sync();
+    if (collision && lid == 0u) {
+      bool overflow = (counters.near_flags & 2u) != 0u;
+      if (usable)
+        counters.near = uvec4(1u, state.y + 1u, 0u, state.w);
+      else if (build)
+        counters.near = uvec4(overflow ? 0u : 1u, 0u, overflow ? SIM_NEAR_WAIT : 0u, floatBitsToUint(search));
+      else
+        counters.near = uvec4(0u, 0u, short_lived ? SIM_NEAR_WAIT : max(state.z, 1u) - 1u, 0u);
+    }
     // 5. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
     // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
     // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
