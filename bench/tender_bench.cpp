@@ -225,14 +225,18 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
     r["threads"] = 0;
 #ifdef TENDER_HAS_GPU
   bench::Layout layout = bench::Layout::Cpu;
+  bool collision_lists = false;
   if (auto* gpu_solver = dynamic_cast<gpu::GpuSolver*>(solver.get())) {
     r["device"] = std::string(gpu_solver->context().properties().deviceName);
     const bool fused = gpu_solver->usesFusedPath(sim->makeUniforms());
     r["fused"] = fused;
     layout = fused ? bench::Layout::GpuFused : bench::Layout::Gpu;
+    collision_lists = gpu_solver->usesCollisionLists();
+    r["collision_lists"] = collision_lists;
   }
 #else
   const bench::Layout layout = bench::Layout::Cpu;
+  const bool collision_lists = false;
 #endif
 
   using Clock = std::chrono::steady_clock;
@@ -290,7 +294,8 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   // median), against the measured copy bandwidth of the device that ran it.
   uint64_t bytes = 0;
   nlohmann::json pass_bytes = nlohmann::json::object(), pass_gbps = nlohmann::json::object();
-  for (const bench::PassTraffic& t : bench::tickTraffic(sim->topology(), sim->makeUniforms(), layout)) {
+  for (const bench::PassTraffic& t :
+       bench::tickTraffic(sim->topology(), sim->makeUniforms(), layout, collision_lists)) {
     bytes += t.bytes();
     pass_bytes[t.name] = {{"read", t.read}, {"write", t.write}};
     if (passes.contains(t.name) && passes[t.name].get<double>() > 0.0 && t.bytes() > 0)

@@ -35,7 +35,8 @@ constexpr uint64_t kSortedPos = 3 * sizeof(float);
 
 } // namespace
 
-std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::SimUniforms& u, Layout layout) {
+std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::SimUniforms& u, Layout layout,
+                                     bool collision_lists) {
   const bool cpu = layout == Layout::Cpu, fused = layout == Layout::GpuFused;
   const bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u, tear = u.tear_factor > 0.0f;
   const uint64_t n = topo.particleCount();         // particles
@@ -83,12 +84,14 @@ std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::
     // and its adjacency (offsets and list); write delta (in hash order).
     collide.read += n * (kSortedPos + kCoord + kIndex) + (buckets + 1) * kIndex + (n + 1) * kIndex + adjacency * kIndex;
     collide.write += n * kPos;
-  } else if (collision && fused) {
-    // The fused tick in its steady state, the candidate lists in use (a substep that rebuilds them
-    // runs the hash and the search below): each particle reads the position its list was built at
-    // (the travel test) and its list's count, then writes delta. The entries and their positions
-    // (in shared memory) depend on how close the sheet comes to itself and are not counted.
-    collide.read += n * (kPos + kIndex);
+  } else if (collision && collision_lists) {
+    // The candidate lists in use (a substep that rebuilds them runs the hash and the search
+    // below): each particle reads the position its list was built at (near_check; and its current
+    // position, unless fused: shared memory), then its list's count (collide; and its position,
+    // unless fused), and writes delta. The entries and their positions depend on how close the
+    // sheet comes to itself and are not counted.
+    hash.read += n * (fused ? 1 : 2) * kPos;
+    collide.read += n * (kIndex + (fused ? 0 : kPos));
     collide.write += n * kPos;
   } else if (collision) {
     // hash, the GPU passes (scan_add runs when the scan has more than one block).

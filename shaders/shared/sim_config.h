@@ -60,6 +60,7 @@
 #define SIM_BIND_ADJ_MASK 25
 #define SIM_BIND_NEAR 26
 #define SIM_BIND_NEAR_BASE 27
+#define SIM_BIND_HASH_ARGS 28
 
 // Adjacency masks (SIM_BIND_ADJ_MASK): bit (dy + 2) * 5 + (dx + 2) is set when particle i is
 // connected to the particle dx columns and dy rows away; SIM_ADJ_FAR when it is connected to a
@@ -111,6 +112,10 @@
 // SIM_NEAR_WAIT substeps: fast motion (a drag, a toss) uses the hash every substep instead
 #define SIM_NEAR_MIN_AGE 4u
 #define SIM_NEAR_WAIT 32u
+// Indirect dispatches of the separate hash passes (SIM_BIND_HASH_ARGS holds this many live
+// arguments, then as many with every pass's full grid): near_decide zeroes the live ones in a
+// substep that sums from the lists
+#define SIM_HASH_DISPATCHES 16u
 
 // Largest workgroup count in X of one dispatch; bigger grids spill into Y
 #define SIM_MAX_GROUPS_X 65535u

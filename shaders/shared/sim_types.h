@@ -57,6 +57,8 @@ struct SimUniforms {
 // SimUniforms.flags bits
 #define SIM_FLAG_COLLISION 1u
 #define SIM_FLAG_PINS 2u
+// Set by the GPU solver when it keeps collision candidate lists (SIM_NEAR_* in sim_config.h)
+#define SIM_FLAG_NEAR 4u
 
 /// Push constants of every simulation dispatch.
 struct SimPush {
@@ -77,15 +79,17 @@ struct FusedPush {
 
 /// GPU counters: tear bookkeeping and indirect arguments (one storage buffer).
 struct Counters {
-  uint torn_total;        // constraints torn since the last reset
-  uint torn_new;          // constraints marked in the current substep
-  uint triangle_count;    // live triangles
-  uint near_flags;        // fused tick, this substep: bit 0 lists outgrown, bit 1 a list overflowed
+  uint torn_total;     // constraints torn since the last reset
+  uint torn_new;       // constraints marked in the current substep
+  uint triangle_count; // live triangles
+  uint pad0;
   uvec4 compact_dispatch; // indirect dispatch for compaction (x = 0 when nothing tore)
   uvec4 draw_args;        // indirect draw: vertexCount, instanceCount, firstVertex, firstInstance
-  // Candidate lists of the fused tick: x 1 when usable, y substeps since they were built, z
-  // substeps to wait before building them again, w the bits of the radius + skin they hold
+  // Collision candidate lists: x 1 when usable, y substeps since they were built, z substeps to
+  // wait before building them again, w the bits of the radius + skin they hold
   uvec4 near;
+  // This substep: x a particle travelled too far for the lists, y a list overflowed
+  uvec4 near_flags;
 };
 
 /// Result of a pick: nearest particle to a ray (8 bytes read back).

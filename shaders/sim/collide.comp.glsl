@@ -1,6 +1,7 @@
 #version 460
-// Gathers repulsion from non-adjacent neighbours in the surrounding cells (Jacobi: writes delta
-// only). Cells, and particles within a cell, are visited in the CPU reference's order.
+// Gathers repulsion from non-adjacent neighbours (Jacobi: writes delta only): from the candidate
+// lists, or from the surrounding cells of the hash, which may rebuild the lists (nearModeNow).
+// Cells, and particles within a cell, are summed in the CPU reference's order.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_COLLIDE
 #include "sim_common.glsl"
@@ -10,6 +11,10 @@ layout(push_constant) uniform PushBlock { SimPush p; };
 void main() {
   uint i = threadIndex();
   if (i >= p.count) return;
-  bool fits;
-  delta[i] = vec4(gatherRepulsion(i, vec3(pos[i]), u.collision_radius, SIM_NONE, fits), 0.0f);
+  uint mode = nearModeNow();
+  vec3 pi = vec3(pos[i]);
+  bool fits = true;
+  vec3 repel = mode == SIM_NEAR_LISTS ? listRepulsion(i, pi) : gatherParticle(i, pi, mode, fits);
+  if (!fits) atomicOr(counters.near_flags.y, 1u);
+  delta[i] = vec4(repel, 0.0f);
 }

@@ -4,6 +4,11 @@
 #ifndef SIM_ELEMENTS_GLSL
 #define SIM_ELEMENTS_GLSL
 
+// Position of particle j as the per-particle bodies read it (the fused tick: shared memory)
+#ifndef SIM_POSITION
+#define SIM_POSITION(j) pos[j]
+#endif
+
 // Spatial hash, step 1: the bucket of particle i (at p) and one more particle in that bucket.
 void hashCount(uint i, vec3 p) {
   uint h = hashCell(cellOf(p, u.inv_cell), u.hash_mask);
@@ -156,6 +161,45 @@ vec3 gatherRepulsion(uint i, vec3 pi, float search, uint list, out bool fits) {
   fits = listed <= SIM_NEAR_CAPACITY;
   if (list != SIM_NONE) near_list[list] = fits ? listed : 0u;
   return sum;
+}
+
+// Repulsion on particle i at pi from its candidate list (lists in use; positions by
+// SIM_POSITION, none moved yet this substep): the candidates closer than the radius, summed as
+// gatherRepulsion sums them, by neighbour cell (cellCode) and then by index (the list is
+// ascending), so the result is the gather's to the bit.
+vec3 listRepulsion(uint i, vec3 pi) {
+  uint list = i * SIM_NEAR_STRIDE, count = near_list[list];
+  float r = u.collision_radius, r2 = r * r;
+  ivec3 ci = cellOf(pi, u.inv_cell);
+  uint codes = 0u; // neighbour cells holding a candidate within the radius
+  for (uint e = 1u; e <= count; ++e) {
+    vec3 pj = vec3(SIM_POSITION(near_list[list + e]));
+    vec3 d = pi - pj;
+    ivec3 o = cellOf(pj, u.inv_cell) - ci;
+    if (dot(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1)))) codes |= 1u << cellCode(o);
+  }
+  vec3 sum = vec3(0.0f);
+  for (; codes != 0u; codes &= codes - 1u) {
+    uint b = uint(findLSB(codes));
+    for (uint e = 1u; e <= count; ++e) {
+      vec3 pj = vec3(SIM_POSITION(near_list[list + e]));
+      vec3 d = pi - pj;
+      ivec3 o = cellOf(pj, u.inv_cell) - ci;
+      if (dot(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1))) && cellCode(o) == b)
+        sum += repulsion(pi, pj, r, u.collision_stiffness);
+    }
+  }
+  return sum;
+}
+
+// Collision of particle i at pi in a substep of `mode` (SIM_NEAR_*, not SIM_NEAR_LISTS: the
+// lists read other particles, which must not have moved): its repulsion gathered from the hash; in
+// SIM_NEAR_BUILD also its candidate list and the position it was built at. False in `fits` when
+// the list overflowed.
+vec3 gatherParticle(uint i, vec3 pi, uint mode, out bool fits) {
+  if (mode != SIM_NEAR_BUILD) return gatherRepulsion(i, pi, u.collision_radius, SIM_NONE, fits);
+  near_base[i] = vec4(pi, 0.0f);
+  return gatherRepulsion(i, pi, nearSearch(), i * SIM_NEAR_STRIDE, fits);
 }
 
 // Marks constraint c (ends at pa, pb; not torn yet) when stretched beyond the tear threshold and

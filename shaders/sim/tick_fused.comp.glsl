@@ -13,41 +13,13 @@
 // Invocations exchange data through buffers between barriers
 #define SIM_COHERENT coherent
 #include "sim_common.glsl"
+shared vec4 s_pos[SIM_FUSED_MAX_PARTICLES];
+#define SIM_POSITION(j) s_pos[j]
 #include "sim_elements.glsl"
 layout(push_constant) uniform PushBlock { FusedPush p; };
 
-shared vec4 s_pos[SIM_FUSED_MAX_PARTICLES];
-
 // Invocations of the workgroup (specialised)
 const uint kInvocations = gl_WorkGroupSize.x;
-
-// Repulsion on particle i at pi from its candidate list (lists in use): the candidates closer than
-// the radius, summed as the gather sums them, by neighbour cell (cellCode) and then by index (the
-// list is ascending), so the result is the gather's to the bit.
-vec3 listRepulsion(uint i, vec3 pi) {
-  uint list = i * SIM_NEAR_STRIDE, count = near_list[list];
-  float r = u.collision_radius, r2 = r * r;
-  ivec3 ci = cellOf(pi, u.inv_cell);
-  uint codes = 0u; // neighbour cells holding a candidate within the radius
-  for (uint e = 1u; e <= count; ++e) {
-    vec3 pj = vec3(s_pos[near_list[list + e]]);
-    vec3 d = pi - pj;
-    ivec3 o = cellOf(pj, u.inv_cell) - ci;
-    if (dot(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1)))) codes |= 1u << cellCode(o);
-  }
-  vec3 sum = vec3(0.0f);
-  for (; codes != 0u; codes &= codes - 1u) {
-    uint b = uint(findLSB(codes));
-    for (uint e = 1u; e <= count; ++e) {
-      vec3 pj = vec3(s_pos[near_list[list + e]]);
-      vec3 d = pi - pj;
-      ivec3 o = cellOf(pj, u.inv_cell) - ci;
-      if (dot(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1))) && cellCode(o) == b)
-        sum += repulsion(pi, pj, r, u.collision_stiffness);
-    }
-  }
-  return sum;
-}
 
 // Everything written before it, to shared memory and to buffers, is seen by the whole workgroup.
 void sync() {
@@ -116,35 +88,28 @@ void main() {
         }
         sync();
       }
-    // 3. Collision: each particle's repulsion to delta. From the candidate lists while they hold
-    // every pair that can touch (no particle has travelled SIM_NEAR_TRAVEL x skin since they were
-    // built); otherwise from the spatial hash (count, scan, scatter, order within bucket) and a
-    // search of the 27 cells around each particle, which rebuilds the lists as it goes unless
-    // they have been outgrown too fast of late (SIM_NEAR_MIN_AGE, SIM_NEAR_WAIT).
-    float r = u.collision_radius;
-    float skin = min(SIM_NEAR_SKIN * r, 0.99f * (1.0f / u.inv_cell - r));
-    bool keep_lists = skin >= SIM_NEAR_MIN_SKIN * r;
-    float search = keep_lists ? r + skin : r;
+    // 3. Collision (as near_check, hash_*, collide and near_finish). From the candidate lists
+    // while they hold every pair that can touch (no particle has travelled SIM_NEAR_TRAVEL x skin
+    // since they were built); otherwise from the spatial hash (count, scan, scatter, order within
+    // bucket) and a search of the 27 cells around each particle, which rebuilds the lists as it
+    // goes unless they were outgrown too fast of late (SIM_NEAR_MIN_AGE, SIM_NEAR_WAIT).
     uvec4 state = counters.near;
-    bool usable = false, short_lived = false, build = false;
+    uint mode = SIM_NEAR_HASH;
     if (collision) {
-      usable = keep_lists && state.x != 0u && state.w == floatBitsToUint(search);
-      if (lid == 0u) counters.near_flags = 0u;
+      if (lid == 0u) counters.near_flags = uvec4(0u);
       sync();
-      if (usable) {
-        float travel2 = SIM_NEAR_TRAVEL * skin * SIM_NEAR_TRAVEL * skin;
+      if (nearListsCurrent(state)) {
+        float travel = SIM_NEAR_TRAVEL * nearSkin();
         bool far = false;
         for (uint i = lid; i < n; i += kInvocations) {
           vec3 d = vec3(s_pos[i]) - vec3(near_base[i]);
-          far = far || !(dot(d, d) < travel2);
+          far = far || !(dot(d, d) < travel * travel);
         }
-        if (far) atomicOr(counters.near_flags, 1u);
+        if (far) atomicOr(counters.near_flags.x, 1u);
         sync();
-        usable = counters.near_flags == 0u;
       }
-      short_lived = state.x != 0u && !usable && state.y < SIM_NEAR_MIN_AGE;
-      build = keep_lists && !usable && state.z == 0u && !short_lived;
-      if (!usable) {
+      mode = nearMode(state, counters.near_flags.x != 0u);
+      if (mode != SIM_NEAR_LISTS) {
         for (uint i = lid; i < n; i += kInvocations) hashCount(i, vec3(s_pos[i]));
         sync();
         scanWorkgroup(SIM_SCAN_HASH, u.hash_mask + 1u, compactSlots());
@@ -152,8 +117,7 @@ void main() {
         sync();
         for (uint i = lid; i < n; i += kInvocations) hashSort(i, vec3(s_pos[i]));
         sync();
-      }
-      if (usable) {
+      } else {
         // The lists read the positions of other particles: all of them before any moves
         for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(listRepulsion(i, vec3(s_pos[i])), 0.0f);
         sync();
@@ -165,30 +129,14 @@ void main() {
       vec4 q = s_pos[i];
       vec3 repel = vec3(0.0f);
       bool fits = true;
-      if (!collision) {
-      } else if (usable) {
-        repel = vec3(delta[i]);
-      } else if (build) {
-        repel = gatherRepulsion(i, vec3(q), search, i * SIM_NEAR_STRIDE, fits);
-        near_base[i] = vec4(vec3(q), 0.0f);
-      } else {
-        repel = gatherRepulsion(i, vec3(q), r, SIM_NONE, fits);
-      }
-      if (!fits) atomicOr(counters.near_flags, 2u);
+      if (collision) repel = mode == SIM_NEAR_LISTS ? vec3(delta[i]) : gatherParticle(i, vec3(q), mode, fits);
+      if (!fits) atomicOr(counters.near_flags.y, 1u);
       VerletState st = floorParticle(q, prev[i], repel, u.flags, u.floor_y, u.restitution, u.friction);
       s_pos[i] = st.pos;
       prev[i] = st.prev;
     }
     sync();
-    if (collision && lid == 0u) {
-      bool overflow = (counters.near_flags & 2u) != 0u;
-      if (usable)
-        counters.near = uvec4(1u, state.y + 1u, 0u, state.w);
-      else if (build)
-        counters.near = uvec4(overflow ? 0u : 1u, 0u, overflow ? SIM_NEAR_WAIT : 0u, floatBitsToUint(search));
-      else
-        counters.near = uvec4(0u, 0u, short_lived ? SIM_NEAR_WAIT : max(state.z, 1u) - 1u, 0u);
-    }
+    if (collision && lid == 0u) counters.near = nearNextState(state, mode, counters.near_flags.y != 0u);
     // 5. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
     // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
     // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the

@@ -14,7 +14,7 @@ using uint = glm::uint;
 
 static_assert(sizeof(Constraint) == 16);
 static_assert(sizeof(SimPush) == 16);
-static_assert(sizeof(Counters) == 64);
+static_assert(sizeof(Counters) == 80);
 static_assert(sizeof(FusedPush) == 16);
 static_assert(offsetof(Counters, compact_dispatch) == 16);
 static_assert(offsetof(Counters, draw_args) == 32);

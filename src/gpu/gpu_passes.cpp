@@ -53,22 +53,44 @@ void GpuSolver::dispatchIndirect(VkCommandBuffer cmd, const ComputePipeline& p, 
   ++recorded_dispatches_;
 }
 
+template <class Push>
+void GpuSolver::dispatchHash(VkCommandBuffer cmd, const ComputePipeline& p, uint32_t count, const Push& push) {
+  if (sizeof(Push) != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
+  const uint32_t groups = (count + p.workgroup - 1) / p.workgroup;
+  const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X);
+  const glm::uvec4 grid(gx, (groups + gx - 1) / gx, 1u, 0u);
+  // Every substep records the same hash passes into the same live slots
+  const uint32_t slot = hash_slot_++;
+  if (slot >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
+  if (slot == hash_grids_.size()) hash_grids_.push_back(grid);
+  if (hash_grids_[slot] != grid) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
+  if (bound_ != p.pipeline) {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+    bound_ = p.pipeline;
+  }
+  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Push), &push);
+  vkCmdDispatchIndirect(cmd, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * slot);
+  ++recorded_dispatches_;
+}
+
 void GpuSolver::recordScan(VkCommandBuffer cmd, uint32_t mode, uint32_t offset, uint32_t count, uint32_t sums,
-                           bool indirect) {
+                           Grid grid) {
   // Exclusive scan: block scans, then (several blocks) scan the block sums and add them back.
   const uint32_t blocks = (count + SIM_SCAN_BLOCK - 1) / SIM_SCAN_BLOCK;
   ScanPush push{mode, offset, count, sums};
-  if (indirect)
-    dispatchIndirect(cmd, pipes_.scan, &push, sizeof(push));
-  else
-    dispatchThreads(cmd, pipes_.scan, count, push);
+  auto dispatch = [&](const ComputePipeline& p) {
+    if (grid == Grid::Compaction)
+      dispatchIndirect(cmd, p, &push, sizeof(push));
+    else if (grid == Grid::Hash)
+      dispatchHash(cmd, p, count, push);
+    else
+      dispatchThreads(cmd, p, count, push);
+  };
+  dispatch(pipes_.scan);
   computeToCompute(cmd);
   if (blocks <= 1) return;
-  recordScan(cmd, SIM_SCAN_SCRATCH, sums, blocks, sums + blocks, indirect);
-  if (indirect)
-    dispatchIndirect(cmd, pipes_.scan_add, &push, sizeof(push));
-  else
-    dispatchThreads(cmd, pipes_.scan_add, count, push);
+  recordScan(cmd, SIM_SCAN_SCRATCH, sums, blocks, sums + blocks, grid);
+  dispatch(pipes_.scan_add);
   computeToCompute(cmd);
 }
 
@@ -121,16 +143,25 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
         }
       timestamp(cmd, slot, kProject);
       if (key.collision) {
-        // 3. Spatial hash: count, scan, scatter, order within bucket; then gather repulsion
-        dispatchThreads(cmd, pipes_.hash_count, n, all);
+        // 3. Candidate lists still good? Spatial hash: count, scan, scatter, order within bucket
+        // (each pass does nothing when the lists stand in for it); then gather repulsion and
+        // update the lists' state
+        dispatchThreads(cmd, pipes_.near_check, n, all);
         computeToCompute(cmd);
-        recordScan(cmd, SIM_SCAN_HASH, 0, topo_.hash_size, hash_sums_, false);
-        dispatchThreads(cmd, pipes_.hash_scatter, n, all);
+        dispatchThreads(cmd, pipes_.near_decide, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0});
         computeToCompute(cmd);
-        dispatchThreads(cmd, pipes_.hash_sort, n, all);
+        hash_slot_ = 0;
+        dispatchHash(cmd, pipes_.hash_count, n, all);
+        computeToCompute(cmd);
+        recordScan(cmd, SIM_SCAN_HASH, 0, topo_.hash_size, hash_sums_, Grid::Hash);
+        dispatchHash(cmd, pipes_.hash_scatter, n, all);
+        computeToCompute(cmd);
+        dispatchHash(cmd, pipes_.hash_sort, n, all);
         computeToCompute(cmd);
         timestamp(cmd, slot, kHash);
         dispatchThreads(cmd, pipes_.collide, n, all);
+        computeToCompute(cmd);
+        dispatchThreads(cmd, pipes_.near_finish, 1, all);
         computeToCompute(cmd);
         timestamp(cmd, slot, kCollide);
       }
@@ -144,7 +175,7 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
         computeToCompute(cmd);
         dispatchIndirect(cmd, pipes_.tear_flags, nullptr, 0);
         computeToCompute(cmd);
-        recordScan(cmd, SIM_SCAN_SCRATCH, 0, tear_slots_, tear_sums_, true);
+        recordScan(cmd, SIM_SCAN_SCRATCH, 0, tear_slots_, tear_sums_, Grid::Compaction);
         dispatchIndirect(cmd, pipes_.tear_compact, nullptr, 0);
         computeToCompute(cmd);
       }
@@ -154,6 +185,14 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
   computeToAll(cmd); // the renderer and copies see this tick
   VK_CHECK(vkEndCommandBuffer(cmd));
   slot.recorded = key;
+  // The full grids of the hash passes, which near_decide copies to the live slots
+  if (hash_grids_ != hash_grids_uploaded_) {
+    ctx_.submitOnce([&](VkCommandBuffer up) {
+      vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * SIM_HASH_DISPATCHES,
+                        16 * hash_grids_.size(), hash_grids_.data());
+    });
+    hash_grids_uploaded_ = hash_grids_;
+  }
   slot.dispatches = recorded_dispatches_;
 }
 

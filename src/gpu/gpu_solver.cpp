@@ -82,9 +82,11 @@ GpuSolver::~GpuSolver() {
     if (p.pipeline) vkDestroyPipeline(dev, p.pipeline, nullptr);
   };
   for (ComputePipeline* p :
-       {&pipes_.integrate, &pipes_.project, &pipes_.hash_count, &pipes_.scan, &pipes_.scan_add, &pipes_.hash_scatter,
-        &pipes_.hash_sort, &pipes_.collide, &pipes_.floor, &pipes_.tear_mark, &pipes_.tear_flags, &pipes_.tear_compact,
-        &pipes_.normals, &pipes_.reset, &pipes_.tick_fused, &pipes_.pick[0], &pipes_.pick[1], &pipes_.pick[2]})
+       {&pipes_.integrate,    &pipes_.project,   &pipes_.hash_count, &pipes_.scan,       &pipes_.scan_add,
+        &pipes_.hash_scatter, &pipes_.hash_sort, &pipes_.collide,    &pipes_.near_check, &pipes_.near_finish,
+        &pipes_.near_decide,  &pipes_.floor,     &pipes_.tear_mark,  &pipes_.tear_flags, &pipes_.tear_compact,
+        &pipes_.normals,      &pipes_.reset,     &pipes_.tick_fused, &pipes_.pick[0],    &pipes_.pick[1],
+        &pipes_.pick[2]})
     destroy(*p);
   for (VkShaderModule m : modules_) vkDestroyShaderModule(dev, m, nullptr);
   if (layout_) vkDestroyPipelineLayout(dev, layout_, nullptr);
@@ -154,6 +156,9 @@ void GpuSolver::createPipelines(FusedShape fused) {
   pipes_.hash_scatter = make("hash_scatter.comp", kSim, SIM_WG_PARTICLES);
   pipes_.hash_sort = make("hash_sort.comp", kSim, SIM_WG_PARTICLES);
   pipes_.collide = make("collide.comp", kSim, SIM_WG_COLLIDE);
+  pipes_.near_check = make("near_check.comp", kSim, SIM_WG_PARTICLES);
+  pipes_.near_finish = make("near_finish.comp", kSim, 1);
+  pipes_.near_decide = make("near_decide.comp", kSim, 1);
   pipes_.floor = make("floor.comp", kSim, SIM_WG_PARTICLES);
   pipes_.tear_mark = make("tear_mark.comp", kSim, SIM_WG_TEAR);
   pipes_.tear_flags = make("tear_flags.comp", 0, SIM_WG_TEAR);
@@ -270,10 +275,14 @@ void GpuSolver::upload(const SheetTopology& topo) {
   storage(SIM_BIND_COMPACT_TMP, 16ull * (m + t));
   storage(SIM_BIND_CELL_POS, 16ull * n);
   storage(SIM_BIND_ADJ_MASK, 4ull * n);
-  // Candidate lists: only the fused tick keeps them
-  const bool fusable = n <= SIM_FUSED_MAX_PARTICLES;
-  storage(SIM_BIND_NEAR, fusable ? 4ull * SIM_NEAR_STRIDE * n : 16);
-  storage(SIM_BIND_NEAR_BASE, fusable ? 16ull * n : 16);
+  // Collision candidate lists, when the largest binding holds them
+  const VkDeviceSize list_bytes = 4ull * SIM_NEAR_STRIDE * n;
+  lists_fit_ = list_bytes <= ctx_.properties().limits.maxStorageBufferRange;
+  storage(SIM_BIND_NEAR, lists_fit_ ? list_bytes : 16);
+  storage(SIM_BIND_NEAR_BASE, lists_fit_ ? 16ull * n : 16);
+  storage(SIM_BIND_HASH_ARGS, 16ull * 2 * SIM_HASH_DISPATCHES);
+  hash_grids_.clear();
+  hash_grids_uploaded_.clear();
 
   // Start state and the static arrays, in one submission.
   std::vector<Buffer> staging;
@@ -418,7 +427,9 @@ void GpuSolver::tick(const SimUniforms& u) {
   Slot& slot = slots_[index];
   // The slot's previous tick has finished: its uniforms and command buffer may be reused.
   waitSlot(slot);
-  std::memcpy(static_cast<char*>(buf_[SIM_BIND_UNIFORMS].mapped) + index * uniform_stride_, &u, sizeof(u));
+  SimUniforms gpu_u = u;
+  if (usesCollisionLists()) gpu_u.flags |= SIM_FLAG_NEAR;
+  std::memcpy(static_cast<char*>(buf_[SIM_BIND_UNIFORMS].mapped) + index * uniform_stride_, &gpu_u, sizeof(gpu_u));
   if (u.reset_active) {
     ctx_.submit(slot.reset, slot.fence);
     slot.pending = true;

@@ -43,8 +43,8 @@ struct ComputePipeline {
 
 /// Every pipeline of the simulation (one file per shader in shaders/sim/).
 struct SimPipelines {
-  ComputePipeline integrate, project, hash_count, scan, scan_add, hash_scatter, hash_sort, collide, floor, tear_mark,
-      tear_flags, tear_compact, normals, reset;
+  ComputePipeline integrate, project, near_check, near_decide, hash_count, scan, scan_add, hash_scatter, hash_sort,
+      collide, near_finish, floor, tear_mark, tear_flags, tear_compact, normals, reset;
   ComputePipeline tick_fused; ///< null when the device has under 32 KiB of shared memory
   std::array<ComputePipeline, 3> pick;
 };
@@ -101,6 +101,12 @@ public:
   void setFusedPath(bool allowed) { fused_allowed_ = allowed; }
   /// True when the sheet is small enough for the fused small-sheet tick (and it is allowed).
   bool usesFusedPath() const;
+  /// Keeps (default) or drops the collision candidate lists (SIM_NEAR_* in sim_config.h); without
+  /// them every substep with collision builds the hash and searches it. Lists are kept only when
+  /// their buffer fits the device (one SIM_NEAR_STRIDE record per particle).
+  void setCollisionLists(bool keep) { lists_allowed_ = keep; }
+  /// True when ticks keep collision candidate lists.
+  bool usesCollisionLists() const { return lists_allowed_ && lists_fit_; }
   /// True when a tick with these uniforms runs the fused tick: the sheet is small enough and, with
   /// collision on, the hash cell is within the shape's limit.
   bool usesFusedPath(const shaderio::SimUniforms& u) const;
@@ -112,7 +118,10 @@ private:
   static constexpr uint32_t kSlots = 2;
   /// Uniform slot of the normals and pick passes (static: written at upload).
   static constexpr uint32_t kStaticSlot = kSlots;
-  static constexpr uint32_t kBindingCount = SIM_BIND_NEAR_BASE + 1;
+  static constexpr uint32_t kBindingCount = SIM_BIND_HASH_ARGS + 1;
+  /// How a dispatch gets its grid: from the host, from the tear compaction's arguments (zero
+  /// workgroups unless something tore), or from the next live hash-pass argument.
+  enum class Grid : uint8_t { Direct, Compaction, Hash };
   /// Timestamp categories, in passTimes() order.
   /// kFused: the fused small-sheet tick, every pass in one dispatch.
   enum Category : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kFused, kCategoryCount };
@@ -146,7 +155,11 @@ private:
   void dispatchThreads(VkCommandBuffer cmd, const ComputePipeline& p, uint32_t count, const Push& push);
   void dispatchWorkgroup(VkCommandBuffer cmd, const ComputePipeline& p, const shaderio::FusedPush& push);
   void dispatchIndirect(VkCommandBuffer cmd, const ComputePipeline& p, const void* push, uint32_t push_size);
-  void recordScan(VkCommandBuffer cmd, uint32_t mode, uint32_t offset, uint32_t count, uint32_t sums, bool indirect);
+  /// A hash pass over `count` elements, its grid read from the next live SIM_BIND_HASH_ARGS slot
+  /// (near_decide fills it from the full grid recorded here, or zeroes it).
+  template <class Push>
+  void dispatchHash(VkCommandBuffer cmd, const ComputePipeline& p, uint32_t count, const Push& push);
+  void recordScan(VkCommandBuffer cmd, uint32_t mode, uint32_t offset, uint32_t count, uint32_t sums, Grid grid);
   void timestamp(VkCommandBuffer cmd, Slot& slot, Category c);
   void waitSlot(Slot& slot) const;
   void collectTimes(const Slot& slot) const;
@@ -182,9 +195,14 @@ private:
   VkPipeline bound_ = VK_NULL_HANDLE; ///< pipeline bound while recording
   uint32_t recorded_dispatches_ = 0;
   bool fused_allowed_ = true;
-  uint32_t fused_substeps_ = 1;           ///< substeps per dispatch of the fused tick
-  float fused_max_cell_spacings_ = -1.0f; ///< largest hash cell of the fused tick (< 0: any)
-  float spacing_ = 0.0f;                  ///< grid spacing: the shortest structural rest length
+  uint32_t fused_substeps_ = 1;                 ///< substeps per dispatch of the fused tick
+  float fused_max_cell_spacings_ = -1.0f;       ///< largest hash cell of the fused tick (< 0: any)
+  float spacing_ = 0.0f;                        ///< grid spacing: the shortest structural rest length
+  bool lists_allowed_ = true;                   ///< setCollisionLists
+  bool lists_fit_ = false;                      ///< the candidate-list buffer fits the device
+  std::vector<glm::uvec4> hash_grids_;          ///< full grids of the hash passes, in recording order
+  std::vector<glm::uvec4> hash_grids_uploaded_; ///< what SIM_BIND_HASH_ARGS holds of them
+  uint32_t hash_slot_ = 0;                      ///< next live hash-pass argument while recording
   mutable std::array<double, kCategoryCount> last_ms_{};
 };
 

@@ -16,8 +16,9 @@ namespace {
 
 class Parity : public GpuTest {
 protected:
-  /// Runs p on the GPU (fused tick) and the CPU, checking the candidate lists whenever usable.
-  void checkCandidateLists(const SimParams& p, bool expect_entries);
+  /// Runs p on the GPU (the fused tick, or the separate passes) and the CPU, checking the
+  /// candidate lists whenever usable.
+  void checkCandidateLists(const SimParams& p, bool fused, bool expect_entries);
 };
 
 /// Runs the same parameters and script on both solvers; returns {cpu, gpu} states. `fused`
@@ -63,8 +64,8 @@ TEST_F(Parity, HashBucketsMatchTheCpu) {
   gpu::GpuSolver gpu(ctx());
   Simulation sim(p, gpu);
   SimState s = run(sim, 30);
-  // The separate passes build the hash every substep (the fused tick may use its candidate lists)
-  gpu.setFusedPath(false);
+  // A hash in every substep: no candidate lists
+  gpu.setCollisionLists(false);
   shaderio::SimUniforms u = sim.makeUniforms();
   u.substeps = 1;
   u.iterations = 0;
@@ -102,6 +103,7 @@ TEST_F(Parity, HugeHashTableUsesThreeScanLevelsAndTallGrids) {
   CpuSolver scratch_solver;
   Simulation sim(p, scratch_solver); // only for the uniforms of a tick
   gpu::GpuSolver gpu(ctx());
+  gpu.setCollisionLists(false); // a hash in every substep
   CpuSolver cpu;
   gpu.upload(topo);
   cpu.upload(topo);
@@ -361,20 +363,24 @@ glm::uvec4 listState(gpu::GpuSolver& gpu) {
 } // namespace
 
 TEST_F(Parity, CandidateListsHoldEveryCloseUnconnectedPair) {
-  // A sheet hanging in the wind moves little between substeps, so the fused tick gathers its
+  // A sheet hanging in the wind moves little between substeps, so both GPU paths gather their
   // collisions from the candidate lists most of the time. Whenever they are usable, each list
   // holds exactly the particles not connected to its particle within radius + skin of where they
   // were when the lists were built, in ascending order; and the run matches the CPU's. With a
   // radius of 1.6 spacings (skin 0.8) the lists are not empty: the particles one column and two
   // rows away (or two columns, one row) are unconnected and within 2.4 spacings.
-  for (const char* factor : {"collision_factor=1.2", "collision_factor=1.6"})
-    checkCandidateLists(preset("tender", {"wind=on", factor}), std::strcmp(factor, "collision_factor=1.6") == 0);
+  for (bool fused : {true, false})
+    for (const char* factor : {"collision_factor=1.2", "collision_factor=1.6"})
+      checkCandidateLists(preset("tender", {"wind=on", factor}), fused,
+                          std::strcmp(factor, "collision_factor=1.6") == 0);
 }
 
-void Parity::checkCandidateLists(const SimParams& p, bool expect_entries) {
+void Parity::checkCandidateLists(const SimParams& p, bool fused, bool expect_entries) {
   gpu::GpuSolver gpu(ctx());
+  gpu.setFusedPath(fused);
   Simulation sim(p, gpu);
-  ASSERT_TRUE(gpu.usesFusedPath(sim.makeUniforms()));
+  ASSERT_EQ(gpu.usesFusedPath(sim.makeUniforms()), fused);
+  ASSERT_TRUE(gpu.usesCollisionLists());
   CpuSolver cpu;
   Simulation ref(p, cpu);
   const SheetTopology& topo = sim.topology();
@@ -422,9 +428,9 @@ void Parity::checkCandidateLists(const SimParams& p, bool expect_entries) {
   cpu.readback(a);
   gpu.readback(b);
   const float diff = maxAbsDiff(a.pos, b.pos);
-  std::printf("radius %.2f, %d ticks, %d of them wholly on candidate lists, %d list checks (%zu entries): "
+  std::printf("%s, radius %.2f, %d ticks, %d of them wholly on candidate lists, %d list checks (%zu entries): "
               "max |x_gpu - x_cpu| = %.3g\n",
-              r, ticks, whole_ticks_on_lists, checked, entries, diff);
+              fused ? "fused" : "separate passes", r, ticks, whole_ticks_on_lists, checked, entries, diff);
   EXPECT_GT(whole_ticks_on_lists, ticks / 2);
   if (expect_entries) {
     EXPECT_GT(entries, size_t(n));
@@ -435,28 +441,32 @@ void Parity::checkCandidateLists(const SimParams& p, bool expect_entries) {
 
 TEST_F(Parity, OverflowingCandidateListsFallBackToTheHash) {
   // A collision radius of 2.5 spacings reaches far past the connected neighbours: a particle has
-  // more unconnected candidates than a list holds. The fused tick then waits SIM_NEAR_WAIT
-  // substeps before trying again, gathering from the hash meanwhile, and matches the CPU.
+  // more unconnected candidates than a list holds. Both GPU paths then wait SIM_NEAR_WAIT
+  // substeps before trying again, gathering from the hash meanwhile, and match the CPU.
   SimParams p = preset("tender", {"cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9", "wind=on"});
-  gpu::GpuSolver gpu(ctx(), gpu::FusedShape{SIM_WG_FUSED, 1, -1.0f});
-  Simulation sim(p, gpu);
-  ASSERT_TRUE(gpu.usesFusedPath(sim.makeUniforms()));
-  CpuSolver cpu;
-  Simulation ref(p, cpu);
-  int waiting = 0;
-  const int ticks = 20;
-  for (int t = 0; t < ticks; ++t) {
-    run(sim, 1);
-    run(ref, 1);
-    const glm::uvec4 state = listState(gpu);
-    if (state.x == 0u && state.z > 0u) ++waiting;
+  for (bool fused : {true, false}) {
+    gpu::GpuSolver gpu(ctx(), gpu::FusedShape{SIM_WG_FUSED, 1, -1.0f});
+    gpu.setFusedPath(fused);
+    Simulation sim(p, gpu);
+    ASSERT_EQ(gpu.usesFusedPath(sim.makeUniforms()), fused);
+    CpuSolver cpu;
+    Simulation ref(p, cpu);
+    int waiting = 0;
+    const int ticks = 20;
+    for (int t = 0; t < ticks; ++t) {
+      run(sim, 1);
+      run(ref, 1);
+      const glm::uvec4 state = listState(gpu);
+      if (state.x == 0u && state.z > 0u) ++waiting;
+    }
+    SimState a, b;
+    cpu.readback(a);
+    gpu.readback(b);
+    const float diff = maxAbsDiff(a.pos, b.pos);
+    std::printf(
+        "%s, radius 2.5 spacings, %d ticks, %d ending in a wait after an overflow: max |x_gpu - x_cpu| = %.3g\n",
+        fused ? "fused" : "separate passes", ticks, waiting, diff);
+    EXPECT_GT(waiting, 0);
+    EXPECT_LE(diff, 1e-4f);
   }
-  SimState a, b;
-  cpu.readback(a);
-  gpu.readback(b);
-  const float diff = maxAbsDiff(a.pos, b.pos);
-  std::printf("radius 2.5 spacings, %d ticks, %d ending in a wait after an overflow: max |x_gpu - x_cpu| = %.3g\n",
-              ticks, waiting, diff);
-  EXPECT_GT(waiting, 0);
-  EXPECT_LE(diff, 1e-4f);
 }

@@ -1,0 +1,12 @@
+#version 460
+// Collision candidate lists, after near_check (one invocation): the indirect arguments of the
+// hash passes of this substep, their full grids, or none when the lists stand in for the hash.
+// Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
+#define SIM_LOCAL_SIZE 1
+#include "sim_common.glsl"
+layout(push_constant) uniform PushBlock { SimPush p; };
+
+void main() {
+  bool skip = nearModeNow() == SIM_NEAR_LISTS;
+  for (uint k = 0u; k < p.count; ++k) hash_args[k] = skip ? uvec4(0u, 1u, 1u, 0u) : hash_args[SIM_HASH_DISPATCHES + k];
+}

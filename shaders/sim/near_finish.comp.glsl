@@ -1,0 +1,13 @@
+#version 460
+// Collision candidate lists, after a substep's collide pass (one invocation): the lists' state
+// for the next substep, and the substep's flags cleared.
+// Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
+#define SIM_LOCAL_SIZE 1
+#include "sim_common.glsl"
+layout(push_constant) uniform PushBlock { SimPush p; };
+
+void main() {
+  uvec4 flags = counters.near_flags;
+  counters.near = nearNextState(counters.near, nearMode(counters.near, flags.x != 0u), flags.y != 0u);
+  counters.near_flags = uvec4(0u);
+}
