@@ -111,6 +111,11 @@
 // Lists outgrown within SIM_NEAR_MIN_AGE substeps, or overflowing, are not rebuilt for
 // SIM_NEAR_WAIT substeps: fast motion (a drag, a toss) uses the hash every substep instead
 #define SIM_NEAR_MIN_AGE 4u
+// How a substep finds its collisions: build the hash and search the 27 cells within the radius;
+// sum from the candidate lists; or build the hash, search within radius + skin, build the lists
+#define SIM_NEAR_HASH 0u
+#define SIM_NEAR_LISTS 1u
+#define SIM_NEAR_BUILD 2u
 #define SIM_NEAR_WAIT 32u
 // Indirect dispatches of the separate hash passes (SIM_BIND_HASH_ARGS holds this many live
 // arguments, then as many with every pass's full grid): near_decide zeroes the live ones in a

@@ -128,6 +128,42 @@ SIM_INLINE bool shouldTear(vec4 pa, vec4 pb, float rest, uint kind, float tear_f
   return tearable && sqrt(dot(d, d)) > rest * tear_factor;
 }
 
+/// Skin of the collision candidate lists (SIM_NEAR_* in sim_config.h) for radius r and cells of
+/// 1 / inv_cell: SIM_NEAR_SKIN x r, at most 0.99 x (cell - r) so that the lists come from the 27
+/// cells around a particle; 0 (no lists) below SIM_NEAR_MIN_SKIN x r.
+SIM_INLINE float listSkin(float r, float inv_cell) {
+  float skin = min(SIM_NEAR_SKIN * r, 0.99f * (1.0f / inv_cell - r));
+  return skin >= SIM_NEAR_MIN_SKIN * r ? skin : 0.0f;
+}
+
+/// True when the lists of `state` (x usable, y substeps since built, z substeps to wait, w the
+/// bits of the search radius they were built with) hold the pairs within `search` (skin > 0).
+SIM_INLINE bool listsCurrent(uvec4 state, float skin, float search) {
+  return skin > 0.0f && state.x != 0u && state.w == floatBitsToUint(search);
+}
+
+/// True when the lists of `state` were outgrown within SIM_NEAR_MIN_AGE substeps.
+SIM_INLINE bool listsShortLived(uvec4 state) { return state.x != 0u && state.y < SIM_NEAR_MIN_AGE; }
+
+/// How a substep finds its collisions (SIM_NEAR_HASH, _LISTS or _BUILD), given the lists' state
+/// and whether a particle has travelled SIM_NEAR_TRAVEL x skin or more since they were built.
+SIM_INLINE uint listMode(uvec4 state, bool travelled, float skin, float search) {
+  if (listsCurrent(state, skin, search) && !travelled) return SIM_NEAR_LISTS;
+  return skin > 0.0f && state.z == 0u && !listsShortLived(state) ? SIM_NEAR_BUILD : SIM_NEAR_HASH;
+}
+
+/// The lists' state after a substep in `mode` (overflow: a list outgrew SIM_NEAR_CAPACITY).
+SIM_INLINE uvec4 listNextState(uvec4 state, uint mode, bool overflow, float search) {
+  if (mode == SIM_NEAR_LISTS) return uvec4(1u, state.y + 1u, 0u, state.w);
+  if (mode == SIM_NEAR_BUILD)
+    return uvec4(overflow ? 0u : 1u, 0u, overflow ? SIM_NEAR_WAIT : 0u, floatBitsToUint(search));
+  return uvec4(0u, 0u, listsShortLived(state) ? SIM_NEAR_WAIT : max(state.z, 1u) - 1u, 0u);
+}
+
+/// Neighbour cell code of a cell offset o in {-1, 0, 1}^3: the order (dz, dy, dx) in which the
+/// collision gather visits cells.
+SIM_INLINE uint cellCode(ivec3 o) { return uint((o.z + 1) * 9 + (o.y + 1) * 3 + o.x + 1); }
+
 /// Smooth normal of grid particle (i, j) from central differences of its neighbours.
 SIM_INLINE vec3 gridNormal(vec3 left, vec3 right, vec3 up, vec3 down) {
   vec3 n = cross(right - left, up - down);

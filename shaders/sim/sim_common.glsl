@@ -86,42 +86,14 @@ uint colorOf(uint k) {
   return lo;
 }
 
-// How a substep finds its collisions (the candidate lists: SIM_NEAR_* in sim_config.h)
-#define SIM_NEAR_HASH 0u  // build the hash, search the 27 cells within the radius
-#define SIM_NEAR_LISTS 1u // sum from the candidate lists
-#define SIM_NEAR_BUILD 2u // build the hash, search within radius + skin, and build the lists
-
-// Skin of the candidate lists for the current radius and cell; 0 when no lists are kept.
-float nearSkin() {
-  float r = u.collision_radius;
-  float skin = min(SIM_NEAR_SKIN * r, 0.99f * (1.0f / u.inv_cell - r));
-  return (u.flags & SIM_FLAG_NEAR) != 0u && skin >= SIM_NEAR_MIN_SKIN * r ? skin : 0.0f;
-}
-
-// Radius the candidate lists are built with.
+// Collision candidate lists (SIM_NEAR_* in sim_config.h, listMode and the rest in xpbd.h) with
+// the current parameters: their skin (0: none kept), search radius, mode and next state.
+float nearSkin() { return (u.flags & SIM_FLAG_NEAR) != 0u ? listSkin(u.collision_radius, u.inv_cell) : 0.0f; }
 float nearSearch() { return u.collision_radius + nearSkin(); }
-
-// True when the lists of `state` (Counters.near) were built for the current parameters.
-bool nearListsCurrent(uvec4 state) {
-  return nearSkin() > 0.0f && state.x != 0u && state.w == floatBitsToUint(nearSearch());
-}
-
-// True when the lists of `state` were outgrown within SIM_NEAR_MIN_AGE substeps.
-bool nearShortLived(uvec4 state) { return state.x != 0u && state.y < SIM_NEAR_MIN_AGE; }
-
-// The mode of a substep (SIM_NEAR_*) from the lists' state and whether a particle has travelled
-// too far for them.
-uint nearMode(uvec4 state, bool travelled) {
-  if (nearListsCurrent(state) && !travelled) return SIM_NEAR_LISTS;
-  return nearSkin() > 0.0f && state.z == 0u && !nearShortLived(state) ? SIM_NEAR_BUILD : SIM_NEAR_HASH;
-}
-
-// The lists' state after a substep in `mode` (overflow: a list outgrew SIM_NEAR_CAPACITY).
+bool nearListsCurrent(uvec4 state) { return listsCurrent(state, nearSkin(), nearSearch()); }
+uint nearMode(uvec4 state, bool travelled) { return listMode(state, travelled, nearSkin(), nearSearch()); }
 uvec4 nearNextState(uvec4 state, uint mode, bool overflow) {
-  if (mode == SIM_NEAR_LISTS) return uvec4(1u, state.y + 1u, 0u, state.w);
-  if (mode == SIM_NEAR_BUILD)
-    return uvec4(overflow ? 0u : 1u, 0u, overflow ? SIM_NEAR_WAIT : 0u, floatBitsToUint(nearSearch()));
-  return uvec4(0u, 0u, nearShortLived(state) ? SIM_NEAR_WAIT : max(state.z, 1u) - 1u, 0u);
+  return listNextState(state, mode, overflow, nearSearch());
 }
 
 // The mode of this substep in the separate passes (near_check has run).

@@ -86,10 +86,6 @@ const uint kCellsWithOffset[9] = uint[9](0x1249249u, 0x2492492u, 0x4924924u,  //
                                          0x01C0E07u, 0x0E07038u, 0x70381C0u,  // y
                                          0x00001FFu, 0x003FE00u, 0x7FC0000u); // z
 
-// Neighbour cell code of a cell offset o in {-1, 0, 1}^3: the order (dz, dy, dx) in which the
-// collision gather visits cells.
-uint cellCode(ivec3 o) { return uint((o.z + 1) * 9 + (o.y + 1) * 3 + o.x + 1); }
-
 // Repulsion gathered by particle i at pi from the non-adjacent particles closer than the collision
 // radius, in the 27 cells around it (Jacobi: reads bucket-ordered positions only). Cells, and
 // particles within a cell, are summed in the CPU reference's order. A neighbour cell on one side

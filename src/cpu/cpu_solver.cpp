@@ -155,6 +155,10 @@ void CpuSolver::upload(const SheetTopology& topo) {
   sorted_y_.assign(n + kSortedPad, 0.0f);
   sorted_z_.assign(n + kSortedPad, 0.0f);
   sorted_coord_.assign(n, glm::ivec4(0));
+  near_list_.assign(options_.collision_lists ? size_t(SIM_NEAR_STRIDE) * n : 0, 0u);
+  near_base_.assign(options_.collision_lists ? n : 0, glm::vec3(0.0f));
+  near_state_ = glm::uvec4(0u);
+  delta_by_particle_ = false;
 }
 
 void CpuSolver::integrate(const SimUniforms& u, uint32_t s) {
@@ -296,9 +300,11 @@ void CpuSolver::buildHash(const SimUniforms& u) {
 
 // Collision gather for the particles in hash slots [begin, end). Each particle sums the
 // repulsion of its neighbours in the same order as the GPU: cells in dz, dy, dx order, the
-// particles of a bucket in ascending index.
-void CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end) {
-  const float r = u.collision_radius, r2 = r * r;
+// particles of a bucket in ascending index. With `build`, the unconnected particles within
+// `search` also go to its candidate list (ascending).
+bool CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end, float search, bool build) {
+  const float r = u.collision_radius, r2 = r * r, search2 = search * search;
+  bool fits = true;
   const float *sx = sorted_x_.data(), *sy = sorted_y_.data(), *sz = sorted_z_.data();
   const uint32_t* slots = cell_particles_.data();
   const ivec4* coords = sorted_coord_.data();
@@ -312,10 +318,10 @@ void CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end)
   bool cached = false;
   uint32_t known = 0;    // bit b: bucket b is looked up for the current cell
   uint32_t nonempty = 0; // bit b: bucket b holds particles (among the known)
-  // A neighbour cell on one side can hold a particle within the radius only when the particle
-  // is closer than the radius to that side of its own cell (the radius never exceeds a cell).
-  // The test is in cell units with a generous margin, so no contributing cell is ever skipped.
-  const float reach = r * u.inv_cell + 1e-3f;
+  // A neighbour cell on one side can hold a particle within `search` only when the particle is
+  // closer than that to that side of its own cell (`search` never exceeds a cell). The test is
+  // in cell units with a generous margin, so no contributing cell is ever skipped.
+  const float reach = search * u.inv_cell + 1e-3f;
   // Bucket masks (bit dz*9 + dy*3 + dx, offsets +1) selected by the needed -1/0/+1 sides of an axis.
   static constexpr auto kAxisMasks = [] {
     std::array<std::array<uint32_t, 8>, 3> m{};
@@ -365,18 +371,30 @@ void CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end)
     const Adjacency adjacency(adj_list_.data() + adj_offsets_[i], adj_offsets_[i + 1] - adj_offsets_[i]);
     vec3 sum(0.0f);
     uint32_t hit_count = 0;
-    // Sums the hits so far. Skips the particle itself (slot k), particles of other cells sharing
-    // a bucket (each is counted from its own cell) and connected particles.
+    uint32_t* list = build ? near_list_.data() + size_t(SIM_NEAR_STRIDE) * i : nullptr;
+    uint32_t listed = 0;
+    // Sums the hits so far (and lists them). Skips the particle itself (slot k), particles of
+    // other cells sharing a bucket (each is counted from its own cell) and connected particles.
     auto flush = [&] {
       for (uint32_t t = 0; t < hit_count; ++t) {
         const uint32_t m = hit_slot[t];
         if (m == k || coords[m] != bucket_cell[hit_bucket[t]] || adjacency.contains(slots[m])) continue;
-        sum += repulsion(pi, vec3(sx[m], sy[m], sz[m]), r, u.collision_stiffness);
+        const vec3 pj(sx[m], sy[m], sz[m]);
+        if (list) {
+          if (listed < SIM_NEAR_CAPACITY) {
+            uint32_t e = listed + 1;
+            for (; e > 1 && list[e - 1] > slots[m]; --e) list[e] = list[e - 1];
+            list[e] = slots[m];
+          }
+          ++listed;
+        }
+        const vec3 d = pi - pj;
+        if (dot(d, d) < r2) sum += repulsion(pi, pj, r, u.collision_stiffness);
       }
       hit_count = 0;
     };
 #if defined(__SSE2__)
-    const __m128 px = _mm_set1_ps(pi.x), py = _mm_set1_ps(pi.y), pz = _mm_set1_ps(pi.z), vr2 = _mm_set1_ps(r2);
+    const __m128 px = _mm_set1_ps(pi.x), py = _mm_set1_ps(pi.y), pz = _mm_set1_ps(pi.z), vr2 = _mm_set1_ps(search2);
 #endif
     while (visit) { // ascending bucket index: dz, dy, dx order
       const uint32_t b = uint32_t(__builtin_ctz(visit));
@@ -394,7 +412,7 @@ void CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end)
         uint32_t hits = 0;
         for (uint32_t lane = 0; lane < 4 && m + lane < last; ++lane) {
           const vec3 d = pi - vec3(sx[m + lane], sy[m + lane], sz[m + lane]);
-          hits |= dot(d, d) < r2 ? 1u << lane : 0u;
+          hits |= dot(d, d) < search2 ? 1u << lane : 0u;
         }
 #endif
         if (last - m < 4) hits &= (1u << (last - m)) - 1u;
@@ -418,14 +436,89 @@ void CpuSolver::collideRange(const SimUniforms& u, uint32_t begin, uint32_t end)
     }
     flush();
     delta_[k] = vec4(sum, 0.0f);
+    if (list) {
+      list[0] = listed <= SIM_NEAR_CAPACITY ? listed : 0u;
+      near_base_[i] = pi;
+      fits = fits && listed <= SIM_NEAR_CAPACITY;
+    }
   }
+  return fits;
 }
 
 void CpuSolver::collide(const SimUniforms& u) {
   // Several shares per worker: the cost of a particle varies with the crowd around it.
   pool_->parallelFor(
-      uint32_t(pos_.size()), grain(kGrainCollide), [&](uint32_t begin, uint32_t end) { collideRange(u, begin, end); },
+      uint32_t(pos_.size()), grain(kGrainCollide),
+      [&](uint32_t begin, uint32_t end) { collideRange(u, begin, end, u.collision_radius, false); },
       kCollideChunksPerWorker);
+  delta_by_particle_ = false;
+}
+
+// Repulsion on particle i from its candidate list: the candidates closer than the radius, summed
+// as the gather sums them, by neighbour cell and then by index (the list is ascending).
+vec3 CpuSolver::listRepulsion(const SimUniforms& u, uint32_t i) const {
+  const uint32_t* list = near_list_.data() + size_t(SIM_NEAR_STRIDE) * i;
+  const uint32_t count = list[0];
+  vec3 sum(0.0f);
+  if (count == 0) return sum;
+  const float r = u.collision_radius, r2 = r * r;
+  const vec3 pi(pos_[i]);
+  const ivec3 ci = cellOf(pi, u.inv_cell);
+  uint32_t code[SIM_NEAR_CAPACITY]; // neighbour cell of each candidate within the radius; 27: none
+  for (uint32_t e = 0; e < count; ++e) {
+    const vec3 pj(pos_[list[e + 1]]);
+    const vec3 d = pi - pj;
+    const ivec3 o = cellOf(pj, u.inv_cell) - ci;
+    const bool in_reach = dot(d, d) < r2 && std::abs(o.x) <= 1 && std::abs(o.y) <= 1 && std::abs(o.z) <= 1;
+    code[e] = in_reach ? cellCode(o) : 27u;
+  }
+  for (uint32_t b = 0; b < 27; ++b)
+    for (uint32_t e = 0; e < count; ++e)
+      if (code[e] == b) sum += repulsion(pi, vec3(pos_[list[e + 1]]), r, u.collision_stiffness);
+  return sum;
+}
+
+uint32_t CpuSolver::collideSubstep(const SimUniforms& u) {
+  const uint32_t n = uint32_t(pos_.size());
+  const float skin = options_.collision_lists ? listSkin(u.collision_radius, u.inv_cell) : 0.0f;
+  const float search = u.collision_radius + skin;
+  // Has a particle travelled too far for the lists?
+  std::atomic<bool> travelled{false};
+  if (listsCurrent(near_state_, skin, search)) {
+    const float travel = SIM_NEAR_TRAVEL * skin;
+    pool_->parallelFor(n, grain(kGrainParticles), [&](uint32_t begin, uint32_t end) {
+      bool far = false;
+      for (uint32_t i = begin; i < end; ++i) {
+        const vec3 d = vec3(pos_[i]) - near_base_[i];
+        far = far || !(dot(d, d) < travel * travel);
+      }
+      if (far) travelled.store(true, std::memory_order_relaxed);
+    });
+  }
+  const uint32_t mode = listMode(near_state_, travelled.load(), skin, search);
+  std::atomic<bool> overflow{false};
+  if (mode == SIM_NEAR_LISTS) {
+    pool_->parallelFor(
+        n, grain(kGrainCollide),
+        [&](uint32_t begin, uint32_t end) {
+          for (uint32_t i = begin; i < end; ++i) delta_[i] = vec4(listRepulsion(u, i), 0.0f);
+        },
+        kCollideChunksPerWorker);
+    delta_by_particle_ = true;
+  } else {
+    buildHash(u);
+    const bool build = mode == SIM_NEAR_BUILD;
+    pool_->parallelFor(
+        n, grain(kGrainCollide),
+        [&](uint32_t begin, uint32_t end) {
+          if (!collideRange(u, begin, end, build ? search : u.collision_radius, build))
+            overflow.store(true, std::memory_order_relaxed);
+        },
+        kCollideChunksPerWorker);
+    delta_by_particle_ = false;
+  }
+  near_state_ = listNextState(near_state_, mode, overflow.load(), search);
+  return mode;
 }
 
 void CpuSolver::floorPass(const SimUniforms& u) {
@@ -436,7 +529,7 @@ void CpuSolver::floorPass(const SimUniforms& u) {
     const vec4* delta = delta_.data();
     const uint32_t* slot = particle_slot_.data();
     for (uint32_t i = begin; i < end; ++i) {
-      const vec3 d = collide ? vec3(delta[slot[i]]) : vec3(0.0f);
+      const vec3 d = collide ? vec3(delta[delta_by_particle_ ? i : slot[i]]) : vec3(0.0f);
       const VerletState st = floorParticle(pos[i], prev[i], d, u.flags, u.floor_y, u.restitution, u.friction);
       pos[i] = st.pos;
       prev[i] = st.prev;
@@ -540,10 +633,7 @@ void CpuSolver::tick(const SimUniforms& u) {
   for (uint32_t s = 0; s < u.substeps; ++s) {
     integrate(u, s);
     project(u, u.iterations);
-    if (collision) {
-      buildHash(u);
-      collide(u);
-    }
+    if (collision) collideSubstep(u);
     floorPass(u);
     if (markTears(u) > 0) compact();
     passes += 1 + u.iterations * uint32_t(colors_.size()) + (collision ? 2 : 0) + 2;

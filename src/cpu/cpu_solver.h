@@ -17,6 +17,10 @@ class WorkerPool;
 struct CpuOptions {
   uint32_t threads = 1;   ///< worker threads, the caller included; 0 = one per hardware thread
   uint32_t min_chunk = 0; ///< smallest loop share worth a thread; 0 = tuned defaults, 1 = split every loop (tests)
+  /// Keep collision candidate lists (SIM_NEAR_* in sim_config.h, as the GPU solver): a substep
+  /// whose particles have not travelled too far since the lists were built sums its repulsion
+  /// from them instead of building the hash. The results are the same either way.
+  bool collision_lists = true;
 };
 
 class CpuSolver final : public Solver {
@@ -49,6 +53,10 @@ public:
   void buildHash(const shaderio::SimUniforms& u);
   /// Gathers repulsion from non-adjacent neighbours into the delta array (Jacobi); needs buildHash.
   void collide(const shaderio::SimUniforms& u);
+  /// The collision of one substep: from the candidate lists when they hold every pair that can
+  /// touch, else buildHash and the gather, which rebuilds the lists unless they were outgrown too
+  /// fast of late. Returns the mode (SIM_NEAR_*).
+  uint32_t collideSubstep(const shaderio::SimUniforms& u);
   /// Applies the collision deltas, then the ground contact.
   void floorPass(const shaderio::SimUniforms& u);
   /// Marks constraints beyond the tear threshold; returns how many tore.
@@ -63,10 +71,15 @@ public:
   std::vector<glm::vec4>& previous() { return prev_; }
   const std::vector<uint32_t>& cellStart() const { return cell_start_; }
   const std::vector<uint32_t>& cellParticles() const { return cell_particles_; }
+  /// The candidate lists' state (as the GPU's Counters::near).
+  glm::uvec4 listState() const { return near_state_; }
 
 private:
   void projectRange(const float stiffness[4], uint32_t begin, uint32_t end);
-  void collideRange(const shaderio::SimUniforms& u, uint32_t begin, uint32_t end);
+  /// Gather for hash slots [begin, end) within `search` (>= the radius); with `build`, also the
+  /// candidate lists of those particles; true when every list fits.
+  bool collideRange(const shaderio::SimUniforms& u, uint32_t begin, uint32_t end, float search, bool build);
+  glm::vec3 listRepulsion(const shaderio::SimUniforms& u, uint32_t i) const;
   uint32_t markTearsRange(const shaderio::SimUniforms& u, uint32_t begin, uint32_t end);
   void splitConstraints();
   uint32_t grain(uint32_t tuned) const { return options_.min_chunk ? options_.min_chunk : tuned; }
@@ -92,6 +105,10 @@ private:
   std::vector<glm::ivec4> particle_coord_;            // integer cell of each particle
   std::vector<float> sorted_x_, sorted_y_, sorted_z_; // positions in hash order (SoA, padded)
   std::vector<glm::ivec4> sorted_coord_;              // cells in hash order
+  bool delta_by_particle_ = false;                    // delta_ indexed by particle (lists), not hash slot
+  std::vector<uint32_t> near_list_;                   // candidate lists, SIM_NEAR_STRIDE words per particle
+  std::vector<glm::vec3> near_base_;                  // positions the lists were built at
+  glm::uvec4 near_state_{0u};                         // x usable, y age, z wait, w search bits
   uint32_t passes_per_tick_ = 0;
 };
 

@@ -1,4 +1,5 @@
-// The CPU solver gives bitwise identical results on any number of threads.
+// The CPU solver gives bitwise identical results on any number of threads, and with or without
+// its collision candidate lists.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -55,6 +56,8 @@ uint32_t tornCount(const SimState& s) {
 
 // min_chunk = 1 splits every loop, however small, so the small sheets exercise every parallel path.
 constexpr CpuOptions kOne{1, 1}, kTwo{2, 1}, kThree{3, 1};
+// Without collision candidate lists: the hash and the 27-cell search in every substep.
+constexpr CpuOptions kOneNoLists{1, 1, false};
 
 } // namespace
 
@@ -114,4 +117,38 @@ TEST(CpuThreads, MemoryIsReported) {
   Simulation sim(p, solver);
   // At least pos, prev, rest, normal (16 bytes each) per particle, and the constraints.
   EXPECT_GE(solver.memoryBytes(), 1536u * 64u + 8818u * 16u);
+}
+
+TEST(CpuCollisionLists, ListsAreUsedAndChangeNothing) {
+  // A sheet hanging in the wind: most substeps sum from the lists.
+  SimParams p = *presetParams("tender");
+  ASSERT_FALSE(applyOverride(p, "wind=on").has_value());
+  CpuSolver solver(kTwo);
+  Simulation sim(p, solver);
+  uint32_t on_lists = 0;
+  for (int t = 0; t < 60; ++t) {
+    sim.tick();
+    on_lists += solver.listState().x == 1u && solver.listState().y >= p.substeps ? 1u : 0u;
+  }
+  EXPECT_GT(on_lists, 30u);
+  solver.computeNormals();
+  SimState with;
+  solver.readback(with);
+  expectIdentical(with, run("tender", {"wind=on"}, "", 60, kOneNoLists));
+}
+
+TEST(CpuCollisionLists, DragTossAndCrowdsAreIdenticalWithoutLists) {
+  // A drag that tears (lists outgrown, then waiting), a crumple toss, a radius of 1.6 spacings
+  // (lists of several candidates each) and one of 2.5 spacings (lists overflow).
+  const std::string drag = "0 grab particle 1535\n1 move 1 2 1\n10 move 2 0 2\n20 move 4 -4 6\n40 release\n";
+  SimState a = run("tender", {"wind=on"}, drag, 80, kTwo);
+  EXPECT_GT(tornCount(a), 0u);
+  expectIdentical(a, run("tender", {"wind=on"}, drag, 80, kOneNoLists));
+  const std::string toss = "0 grab particle 100\n1 move 1 2 3\n10 release\n";
+  expectIdentical(run("crumple", {"cols=37", "rows=53"}, toss, 40, kThree),
+                  run("crumple", {"cols=37", "rows=53"}, toss, 40, kOneNoLists));
+  expectIdentical(run("tender", {"collision_factor=1.6", "wind=on"}, drag, 40, kTwo),
+                  run("tender", {"collision_factor=1.6", "wind=on"}, drag, 40, kOneNoLists));
+  expectIdentical(run("tender", {"cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9"}, "", 20, kTwo),
+                  run("tender", {"cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9"}, "", 20, kOneNoLists));
 }

@@ -104,7 +104,9 @@ TEST_F(Parity, HugeHashTableUsesThreeScanLevelsAndTallGrids) {
   Simulation sim(p, scratch_solver); // only for the uniforms of a tick
   gpu::GpuSolver gpu(ctx());
   gpu.setCollisionLists(false); // a hash in every substep
-  CpuSolver cpu;
+  CpuOptions no_lists;
+  no_lists.collision_lists = false;
+  CpuSolver cpu(no_lists);
   gpu.upload(topo);
   cpu.upload(topo);
   shaderio::SimUniforms u = sim.makeUniforms();
