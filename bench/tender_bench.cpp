@@ -219,13 +219,16 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   } catch (const std::exception& e) { // e.g. the device cannot hold the sheet
     return skip(e.what());
   }
-  if (auto* cpu = dynamic_cast<CpuSolver*>(solver.get()))
+  bool collision_lists = false;
+  if (auto* cpu = dynamic_cast<CpuSolver*>(solver.get())) {
     r["threads"] = cpu->threadCount();
-  else
+    collision_lists = cpu->usesCollisionLists();
+    r["collision_lists"] = collision_lists;
+  } else {
     r["threads"] = 0;
+  }
 #ifdef TENDER_HAS_GPU
   bench::Layout layout = bench::Layout::Cpu;
-  bool collision_lists = false;
   if (auto* gpu_solver = dynamic_cast<gpu::GpuSolver*>(solver.get())) {
     r["device"] = std::string(gpu_solver->context().properties().deviceName);
     const bool fused = gpu_solver->usesFusedPath(sim->makeUniforms());
@@ -236,7 +239,6 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   }
 #else
   const bench::Layout layout = bench::Layout::Cpu;
-  const bool collision_lists = false;
 #endif
 
   using Clock = std::chrono::steady_clock;

@@ -67,7 +67,17 @@ std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::
       project.write += fused ? 0 : c.count * 2 * kPos;
     }
 
-  if (collision && cpu) {
+  if (collision && collision_lists) {
+    // The candidate lists in use (a substep that rebuilds them runs the hash and the search
+    // below): each particle reads the position its list was built at and its current one (the
+    // travel test; fused: the current one in shared memory), then its list's count and its
+    // position (fused: shared memory), and writes delta. The entries and their positions depend
+    // on how close the sheet comes to itself and are not counted.
+    const uint64_t base = cpu ? kSortedPos : kPos; // CpuSolver::near_base_ holds xyz only
+    hash.read += n * (base + (fused ? 0 : kPos));
+    collide.read += n * (kIndex + (fused ? 0 : kPos));
+    collide.write += n * kPos;
+  } else if (collision && cpu) {
     // hash (CpuSolver::buildHash), step by step:
     hash.read += n * kPos;                     // cell of each particle: read pos,
     hash.write += n * (kCoord + kIndex);       //   write particle_coord_, particle_cell_
@@ -83,15 +93,6 @@ std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::
     // (cell_particles_), the bucket starts (27 lookups per particle spread over the whole table)
     // and its adjacency (offsets and list); write delta (in hash order).
     collide.read += n * (kSortedPos + kCoord + kIndex) + (buckets + 1) * kIndex + (n + 1) * kIndex + adjacency * kIndex;
-    collide.write += n * kPos;
-  } else if (collision && collision_lists) {
-    // The candidate lists in use (a substep that rebuilds them runs the hash and the search
-    // below): each particle reads the position its list was built at (near_check; and its current
-    // position, unless fused: shared memory), then its list's count (collide; and its position,
-    // unless fused), and writes delta. The entries and their positions depend on how close the
-    // sheet comes to itself and are not counted.
-    hash.read += n * (fused ? 1 : 2) * kPos;
-    collide.read += n * (kIndex + (fused ? 0 : kPos));
     collide.write += n * kPos;
   } else if (collision) {
     // hash, the GPU passes (scan_add runs when the scan has more than one block).
@@ -113,7 +114,7 @@ std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::
   }
 
   // floor: read pos, prev and (with collision) delta (on the CPU through particle_slot_); write pos, prev.
-  floor.read += n * (collision ? 3 : 2) * kPos + (collision && cpu ? n * kIndex : 0);
+  floor.read += n * (collision ? 3 : 2) * kPos + (collision && cpu && !collision_lists ? n * kIndex : 0);
   floor.write += n * 2 * kPos;
 
   // tear marking: read the constraint records and every position (each particle ends several

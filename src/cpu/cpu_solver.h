@@ -42,6 +42,8 @@ public:
   uint64_t memoryBytes() const override;
   /// Worker threads in use, the caller included.
   uint32_t threadCount() const;
+  /// True when the solver keeps collision candidate lists (CpuOptions::collision_lists).
+  bool usesCollisionLists() const { return options_.collision_lists; }
 
   // The passes of one substep, public so tests can drive them one by one.
   /// Verlet integration with gravity, wind, damping; pins and the grab hold their particles.
