@@ -691,7 +691,7 @@ uint64_t CpuSolver::memoryBytes() const {
          bytesOf(con_kind_) + bytesOf(con_id_) + bytesOf(con_rest_) + bytesOf(triangles_) + bytesOf(adj_offsets_) +
          bytesOf(adj_list_) + bytesOf(cell_count_) + bytesOf(cell_start_) + bytesOf(cell_particles_) +
          bytesOf(particle_slot_) + bytesOf(particle_cell_) + bytesOf(particle_coord_) + bytesOf(sorted_x_) +
-         bytesOf(sorted_y_) + bytesOf(sorted_z_) + bytesOf(sorted_coord_);
+         bytesOf(sorted_y_) + bytesOf(sorted_z_) + bytesOf(sorted_coord_) + bytesOf(near_list_) + bytesOf(near_base_);
 }
 
 } // namespace tender
