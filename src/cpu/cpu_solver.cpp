@@ -498,8 +498,9 @@ uint32_t CpuSolver::collideSubstep(const SimUniforms& u) {
   const uint32_t mode = listMode(near_state_, travelled.load(), skin, search);
   std::atomic<bool> overflow{false};
   if (mode == SIM_NEAR_LISTS) {
+    // Mostly empty lists: a few ns per particle, shared out like the per-particle passes
     pool_->parallelFor(
-        n, grain(kGrainCollide),
+        n, grain(kGrainParticles),
         [&](uint32_t begin, uint32_t end) {
           for (uint32_t i = begin; i < end; ++i) delta_[i] = vec4(listRepulsion(u, i), 0.0f);
         },
