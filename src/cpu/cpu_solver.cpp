@@ -28,6 +28,9 @@ constexpr uint32_t kGrainParticles = 4096;   // integrate, floor, hash, reset: a
 constexpr uint32_t kGrainConstraints = 1024; // projection of one colour, tear marking: ~2 ns each
 constexpr uint32_t kGrainCollide = 256;      // collision gather: ~100 ns per particle
 constexpr uint32_t kCollideChunksPerWorker = 4;
+// Below this many particles a whole substep takes tens of microseconds, and sharing its loops
+// costs more in hand-offs than it saves: every loop runs on the calling thread.
+constexpr uint32_t kSmallSheet = 4096;
 
 // Extra slots after the sorted position arrays and the adjacency list, so 4-wide loads never
 // leave them.
@@ -128,6 +131,7 @@ uint32_t CpuSolver::threadCount() const { return pool_->size(); }
 void CpuSolver::upload(const SheetTopology& topo) {
   topo_ = &topo;
   const uint32_t n = topo.particleCount();
+  small_sheet_ = n < kSmallSheet;
   rest_ = topo.rest_pos;
   uv_ = topo.uv;
   pos_.resize(n);

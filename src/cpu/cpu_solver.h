@@ -84,7 +84,9 @@ private:
   glm::vec3 listRepulsion(const shaderio::SimUniforms& u, uint32_t i) const;
   uint32_t markTearsRange(const shaderio::SimUniforms& u, uint32_t begin, uint32_t end);
   void splitConstraints();
-  uint32_t grain(uint32_t tuned) const { return options_.min_chunk ? options_.min_chunk : tuned; }
+  /// Smallest loop share worth a thread: options_.min_chunk when set; no sharing at all on a sheet
+  /// too small to pay for the hand-offs (kSmallSheet in cpu_solver.cpp); else the tuned value.
+  uint32_t grain(uint32_t tuned) const { return options_.min_chunk ? options_.min_chunk : small_sheet_ ? ~0u : tuned; }
 
   CpuOptions options_;
   std::unique_ptr<WorkerPool> pool_;
@@ -112,6 +114,7 @@ private:
   std::vector<glm::vec3> near_base_;                  // positions the lists were built at
   glm::uvec4 near_state_{0u};                         // x usable, y age, z wait, w search bits
   uint32_t passes_per_tick_ = 0;
+  bool small_sheet_ = false; // every loop on the calling thread (see grain)
 };
 
 } // namespace tender
