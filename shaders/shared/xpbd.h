@@ -142,6 +142,14 @@ SIM_INLINE bool listsCurrent(uvec4 state, float skin, float search) {
   return skin > 0.0f && state.x != 0u && state.w == floatBitsToUint(search);
 }
 
+/// True when a particle at p has travelled SIM_NEAR_TRAVEL x skin or more from `base`, where it
+/// was when the lists were built (the lists may then miss a pair).
+SIM_INLINE bool travelledTooFar(vec3 p, vec3 base, float skin) {
+  vec3 d = p - base;
+  float travel = SIM_NEAR_TRAVEL * skin;
+  return !(dot(d, d) < travel * travel);
+}
+
 /// True when the lists of `state` were outgrown within SIM_NEAR_MIN_AGE substeps.
 SIM_INLINE bool listsShortLived(uvec4 state) { return state.x != 0u && state.y < SIM_NEAR_MIN_AGE; }
 

@@ -8,6 +8,6 @@ layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uint i = threadIndex();
-  if (i >= p.count || nearModeNow() == SIM_NEAR_LISTS) return; // the lists stand in for the hash
+  if (i >= p.count) return;
   hashSort(i, vec3(pos[i]));
 }

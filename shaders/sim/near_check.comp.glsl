@@ -10,7 +10,5 @@ layout(push_constant) uniform PushBlock { SimPush p; };
 void main() {
   uint i = threadIndex();
   if (i >= p.count || !nearListsCurrent(counters.near)) return;
-  float travel = SIM_NEAR_TRAVEL * nearSkin();
-  vec3 d = vec3(pos[i]) - vec3(near_base[i]);
-  if (!(dot(d, d) < travel * travel)) atomicOr(counters.near_flags.x, 1u);
+  if (travelledTooFar(vec3(pos[i]), vec3(near_base[i]), nearSkin())) atomicOr(counters.near_flags.x, 1u);
 }

@@ -23,8 +23,7 @@ void store(uint i, uint v) {
 
 void main() {
   uint block = groupIndex();
-  if (block * SIM_SCAN_BLOCK >= p.count) return;                          // the whole workgroup leaves together
-  if (p.mode == SIM_SCAN_HASH && nearModeNow() == SIM_NEAR_LISTS) return; // no hash this substep
+  if (block * SIM_SCAN_BLOCK >= p.count) return; // the whole workgroup leaves together
   uint lid = gl_LocalInvocationID.x;
   uint base = block * SIM_SCAN_BLOCK + lid * SIM_SCAN_PER_THREAD;
   // Each thread scans its own elements

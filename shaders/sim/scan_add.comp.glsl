@@ -7,7 +7,7 @@ layout(push_constant) uniform PushBlock { ScanPush p; };
 
 void main() {
   uint i = threadIndex();
-  if (i >= p.count || (p.mode == SIM_SCAN_HASH && nearModeNow() == SIM_NEAR_LISTS)) return;
+  if (i >= p.count) return;
   uint add = scratch[p.sums + i / SIM_SCAN_BLOCK];
   if (p.mode == SIM_SCAN_HASH)
     cell_start[i] += add;

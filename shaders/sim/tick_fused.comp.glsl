@@ -99,12 +99,10 @@ void main() {
       if (lid == 0u) counters.near_flags = uvec4(0u);
       sync();
       if (nearListsCurrent(state)) {
-        float travel = SIM_NEAR_TRAVEL * nearSkin();
+        float skin = nearSkin();
         bool far = false;
-        for (uint i = lid; i < n; i += kInvocations) {
-          vec3 d = vec3(s_pos[i]) - vec3(near_base[i]);
-          far = far || !(dot(d, d) < travel * travel);
-        }
+        for (uint i = lid; i < n; i += kInvocations)
+          far = far || travelledTooFar(vec3(s_pos[i]), vec3(near_base[i]), skin);
         if (far) atomicOr(counters.near_flags.x, 1u);
         sync();
       }

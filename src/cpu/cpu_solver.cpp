@@ -489,13 +489,9 @@ uint32_t CpuSolver::collideSubstep(const SimUniforms& u) {
   // Has a particle travelled too far for the lists?
   std::atomic<bool> travelled{false};
   if (listsCurrent(near_state_, skin, search)) {
-    const float travel = SIM_NEAR_TRAVEL * skin;
     pool_->parallelFor(n, grain(kGrainParticles), [&](uint32_t begin, uint32_t end) {
       bool far = false;
-      for (uint32_t i = begin; i < end; ++i) {
-        const vec3 d = vec3(pos_[i]) - near_base_[i];
-        far = far || !(dot(d, d) < travel * travel);
-      }
+      for (uint32_t i = begin; i < end; ++i) far = far || travelledTooFar(vec3(pos_[i]), near_base_[i], skin);
       if (far) travelled.store(true, std::memory_order_relaxed);
     });
   }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/free_fall.h"
 #include "core/simulation.h"
 #include "core/stats.h"
 #include "cpu/cpu_solver.h"
@@ -46,10 +47,7 @@ TEST(Physics, FreeFallMatchesDampedVerlet) {
     CpuSolver cpu;
     Simulation sim(p, cpu);
     SimState s = run(sim, ticks);
-    // Displacement per substep: D_n = g dt^2 (1 - d^n) / (1 - d); position after n substeps sums them.
-    const double g = p.gravity, dt = 1.0 / (double(p.tick_hz) * p.substeps), d = p.damping;
-    const double n = double(ticks) * p.substeps;
-    const double drop = g * dt * dt / (1.0 - d) * (n - d * (1.0 - std::pow(d, n)) / (1.0 - d));
+    const double drop = test::dampedVerletDrop(p, ticks);
     const auto& topo = sim.topology();
     for (uint32_t i = 0; i < topo.particleCount(); ++i) {
       // 0.2% of the drop: an extra or missing substep alone is 2.5% at 5 ticks, 0.2% at 60.

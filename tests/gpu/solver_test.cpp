@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/free_fall.h"
 #include "core/stats.h"
 #include "cpu/cpu_solver.h"
 #include "gpu/gpu_solver.h"
@@ -51,10 +52,7 @@ TYPED_TEST(BothSolvers, FreeFallMatchesDampedVerlet) {
   auto solver = this->make();
   Simulation sim(p, *solver);
   SimState s = run(sim, ticks);
-  // Displacement per substep: D_n = g dt^2 (1 - d^n) / (1 - d); position after n substeps sums them.
-  const double g = p.gravity, dt = 1.0 / (double(p.tick_hz) * p.substeps), d = p.damping;
-  const double n = double(ticks) * p.substeps;
-  const double drop = g * dt * dt / (1.0 - d) * (n - d * (1.0 - std::pow(d, n)) / (1.0 - d));
+  const double drop = test::dampedVerletDrop(p, ticks);
   const auto& topo = sim.topology();
   for (uint32_t i = 0; i < topo.particleCount(); ++i) {
     EXPECT_NEAR(s.pos[i].y, topo.rest_pos[i].y - drop, 2e-3 * drop) << "particle " << i;
