@@ -104,6 +104,19 @@ expect_bad --set nope=1
 expect_bad --set damping=2
 expect_bad --ticks 0
 expect_bad --bogus
+expect_bad --sizes 8x12 --max-seconds nan
+expect_bad --sizes 8x12 --max-cpu-particles -1
+expect_bad --sizes 4294967328x48
+expect_bad --sizes 8x12 --backends cpu --json /nonexistent/dir/b.json
+# A write error after the sweep (progress lines come first on stderr) ends with the error, exit 2.
+"$B" --sizes 8x12 --backends cpu --csv /dev/full --no-peak --ticks 1 --warmup 0 >/dev/null 2>"$tmp/err"
+rc=$?
+[ "$rc" -eq 2 ] && tail -1 "$tmp/err" | grep -q "^tender-bench: error: cannot write '/dev/full'" &&
+  echo "ok: --csv /dev/full -> $(tail -1 "$tmp/err")" || { echo "FAIL: --csv /dev/full -> exit $rc"; failures=$((failures + 1)); }
+if [ "$backends" != cpu ]; then
+  expect_bad --sizes 8x12 --backends gpu --device 99
+  VK_DRIVER_FILES=/nonexistent.json expect_bad --sizes 8x12 --backends gpu
+fi
 "$B" --help >/dev/null && "$B" --version | grep -q '^tender-bench ' || { echo "FAIL: --help/--version"; failures=$((failures + 1)); }
 echo "$failures failed"
 [ "$failures" -eq 0 ]

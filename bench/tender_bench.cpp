@@ -21,6 +21,8 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "backend/backend.h"
+#include "core/output.h"
 #include "core/simulation.h"
 #include "core/stats.h"
 #include "cpu/cpu_solver.h"
@@ -79,25 +81,16 @@ std::vector<std::string> split(const std::string& s, char sep) {
 std::optional<std::string> parseSizes(const std::string& text, std::vector<Size>& out) {
   if (text.empty()) return std::string("--sizes is empty");
   for (const std::string& item : split(text, ',')) {
-    Size s;
-    char x = 0;
-    char rest = 0;
-    if (std::sscanf(item.c_str(), "%u%c%u%c", &s.cols, &x, &s.rows, &rest) != 3 || (x != 'x' && x != 'X') ||
-        item.find('-') != std::string::npos)
+    const size_t x = item.find_first_of("xX");
+    uint64_t cols = 0, rows = 0;
+    if (x == std::string::npos || parseWhole(item.substr(0, x), 0, ~uint64_t(0), cols) ||
+        parseWhole(item.substr(x + 1), 0, ~uint64_t(0), rows))
       return "bad size '" + item + "' (expected WxH, e.g. 128x192)";
-    if (s.cols < 2 || s.rows < 2 || s.cols > 16384 || s.rows > 16384)
+    if (cols < 2 || rows < 2 || cols > 16384 || rows > 16384)
       return "size '" + item + "' is out of range (2 to 16384 per side)";
-    out.push_back(s);
+    out.push_back({uint32_t(cols), uint32_t(rows)});
   }
   return std::nullopt;
-}
-
-bool gpuBuilt() {
-#ifdef TENDER_HAS_GPU
-  return true;
-#else
-  return false;
-#endif
 }
 
 std::string cpuModel() {
@@ -138,7 +131,7 @@ std::optional<std::string> benchParams(const BenchOptions& o, const Size& size, 
   for (const std::string& s : o.sets)
     if (auto err = applyOverride(*p, s)) return err;
   out = *p;
-  return validate(*p);
+  return std::nullopt;
 }
 
 /// Progress on stderr: one line rewritten in place on a terminal, a line per case otherwise.
@@ -159,32 +152,6 @@ private:
   bool tty_;
 };
 
-/// A solver for a backend name, or nullptr and a reason.
-std::unique_ptr<Solver> makeSolver(const std::string& backend, const BenchOptions& o, const SimParams& p,
-                                   std::string& reason) {
-  if (backend == "cpu") return std::make_unique<CpuSolver>(CpuOptions{p.threads});
-#ifdef TENDER_HAS_GPU
-  gpu::GpuOptions g;
-  g.device = o.device;
-  auto solver = gpu::createGpuSolver(g, reason);
-  if (solver && backend == "gpu-percolor") static_cast<gpu::GpuSolver&>(*solver).setFusedPath(false);
-  return solver;
-#else
-  (void)o;
-  reason = "this build has no GPU backend";
-  return nullptr;
-#endif
-}
-
-/// Waits until the solver's last tick has finished (the GPU runs asynchronously).
-void finishTick(Solver& solver) {
-#ifdef TENDER_HAS_GPU
-  if (solver.name() == "gpu") static_cast<gpu::GpuSolver&>(solver).finish();
-#else
-  (void)solver;
-#endif
-}
-
 /// Runs one size on one backend and returns its JSON record.
 nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& size, const std::string& backend,
                        const std::string& label, Progress& progress) {
@@ -202,6 +169,7 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   };
   SimParams p;
   if (auto err = benchParams(o, size, p)) return skip(*err);
+  if (auto err = validate(p, backend)) return skip(*err);
   if (backend == "cpu" && uint64_t(p.particleCount()) > o.max_cpu_particles)
     return skip("over --max-cpu-particles " + std::to_string(o.max_cpu_particles));
   r["spacing"] = p.spacing;
@@ -209,18 +177,21 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   r["substeps"] = p.substeps;
   r["iterations"] = p.iterations;
 
-  std::string reason;
-  std::unique_ptr<Solver> solver;
+  BackendOptions bo;
+  bo.backend = backend;
+  bo.device = o.device;
+  bo.threads = p.threads;
+  Backend made;
   std::optional<Simulation> sim;
   try {
-    solver = makeSolver(backend, o, p, reason);
-    if (!solver) return skip(reason);
-    sim.emplace(p, *solver);
+    if (auto err = createBackend(bo, made)) return skip(*err);
+    sim.emplace(p, *made.solver);
   } catch (const std::exception& e) { // e.g. the device cannot hold the sheet
     return skip(e.what());
   }
+  Solver* solver = made.solver.get();
   bool collision_lists = false;
-  if (auto* cpu = dynamic_cast<CpuSolver*>(solver.get())) {
+  if (CpuSolver* cpu = made.cpu) {
     r["threads"] = cpu->threadCount();
     collision_lists = cpu->usesCollisionLists();
     r["collision_lists"] = collision_lists;
@@ -229,7 +200,7 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   }
 #ifdef TENDER_HAS_GPU
   bench::Layout layout = bench::Layout::Cpu;
-  if (auto* gpu_solver = dynamic_cast<gpu::GpuSolver*>(solver.get())) {
+  if (gpu::GpuSolver* gpu_solver = made.gpu) {
     r["device"] = std::string(gpu_solver->context().properties().deviceName);
     const bool fused = gpu_solver->usesFusedPath(sim->makeUniforms());
     r["fused"] = fused;
@@ -252,7 +223,7 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   };
   for (uint32_t t = 0; t < o.warmup; ++t) {
     sim->tick();
-    finishTick(*solver);
+    solver->finish();
     show("warm-up", t + 1, o.warmup);
     if (elapsed() > o.max_seconds / 2) break; // a slow size gets a short warm-up
   }
@@ -262,7 +233,7 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   for (uint32_t t = 0; t < o.ticks; ++t) {
     const auto t0 = Clock::now();
     sim->tick();
-    finishTick(*solver);
+    solver->finish();
     ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
     for (auto& [name, v] : solver->passTimes().ms) pass_ms[name].push_back(v);
     show("tick", t + 1, o.ticks);
@@ -365,8 +336,8 @@ void printTable(const nlohmann::json& results) {
   }
 }
 
-bool writeCsv(const std::string& path, const nlohmann::json& results) {
-  std::ofstream f(path);
+std::string csvText(const nlohmann::json& results) {
+  std::ostringstream f;
   f << "size,cols,rows,particles,backend,status,threads,ticks_measured,ms_median,ms_p95,ms_mean,ms_min,"
        "particle_substeps_per_s,dispatches_per_tick,memory_bytes,bytes_per_tick,achieved_gbps,peak_gbps,peak_pct,torn,"
        "state_hash,passes,pass_bytes,pass_gbps\n";
@@ -390,7 +361,7 @@ bool writeCsv(const std::string& path, const nlohmann::json& results) {
       << (r.contains("state_hash") ? r["state_hash"].get<std::string>() : "") << ',' << list("pass_ms") << ','
       << list("pass_bytes") << ',' << list("pass_gbps") << '\n';
   }
-  return bool(f);
+  return f.str();
 }
 
 } // namespace
@@ -399,7 +370,7 @@ bool writeCsv(const std::string& path, const nlohmann::json& results) {
 int main(int argc, char** argv) {
   using namespace tender;
   BenchOptions o;
-  o.backends = gpuBuilt() ? "cpu,gpu" : "cpu";
+  o.backends = vulkanBuilt() ? "cpu,gpu" : "cpu";
   CLI::App app{"tender-bench: how the solvers scale with the size of the sheet."};
   app.set_version_flag("--version", std::string("tender-bench ") + TENDER_VERSION);
   app.add_option("--sizes", o.sizes, "grid sizes, WxH comma-separated")->capture_default_str();
@@ -412,8 +383,8 @@ int main(int argc, char** argv) {
   app.add_option("--device", o.device, "Vulkan device index (see `tender devices`)");
   app.add_option("--json", o.json, "write the results as JSON here");
   app.add_option("--csv", o.csv, "write the results as CSV here");
-  app.add_option("--max-cpu-particles", o.max_cpu_particles, "skip CPU cases with more particles")
-      ->capture_default_str();
+  std::string max_cpu_particles = std::to_string(o.max_cpu_particles);
+  app.add_option("--max-cpu-particles", max_cpu_particles, "skip CPU cases with more particles")->capture_default_str();
   app.add_option("--max-seconds", o.max_seconds, "time budget of one case's timed ticks (at least 3 run)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
@@ -426,7 +397,13 @@ int main(int argc, char** argv) {
     return fail(e.what());
   }
 
-  // Validate everything before running anything.
+  // Validate everything before running anything: options, outputs, the device.
+  if (!std::isfinite(o.max_seconds)) return fail("--max-seconds: not a number");
+  if (auto err = parseWhole(max_cpu_particles, 0, uint64_t(1) << 40, o.max_cpu_particles))
+    return fail("--max-cpu-particles: " + *err);
+  OutputSet outputs;
+  for (const std::string& path : {o.json, o.csv})
+    if (auto err = outputs.add(path)) return fail(*err);
   uint32_t cpu_threads = 0;
   std::vector<Size> sizes;
   if (auto err = parseSizes(o.sizes, sizes)) return fail(*err);
@@ -435,7 +412,7 @@ int main(int argc, char** argv) {
   for (const std::string& b : backends) {
     if (b != "cpu" && b != "gpu" && b != "gpu-percolor")
       return fail("unknown backend '" + b + "' (cpu, gpu or gpu-percolor)");
-    if (b != "cpu" && !gpuBuilt()) return fail("this build has no GPU backend (try --backends cpu)");
+    if (b != "cpu" && !vulkanBuilt()) return fail("this build has no GPU backend (try --backends cpu)");
   }
   {
     auto p = presetParams(o.preset);
@@ -446,9 +423,17 @@ int main(int argc, char** argv) {
     }
     for (const std::string& s : o.sets)
       if (auto err = applyOverride(*p, s)) return fail(*err);
-    if (auto err = validate(*p)) return fail(*err);
+    if (auto err = validate(*p, "cpu")) return fail(*err);
     cpu_threads = p->threads;
   }
+#ifdef TENDER_HAS_GPU
+  if (std::any_of(backends.begin(), backends.end(), [](const std::string& b) { return b != "cpu"; })) {
+    gpu::ContextOptions co;
+    co.device = o.device;
+    auto ctx = gpu::VulkanContext::create(co);
+    if (!ctx) return fail(ctx.error() + " (try --backends cpu)");
+  }
+#endif
 
   nlohmann::json out;
   out["tool"] = "tender-bench";
@@ -505,10 +490,10 @@ int main(int argc, char** argv) {
     }
 
   printTable(out["results"]);
-  if (!o.json.empty()) {
-    std::ofstream f(o.json);
-    if (!(f << out.dump(2) << '\n')) return fail("cannot write '" + o.json + "'");
-  }
-  if (!o.csv.empty() && !writeCsv(o.csv, out["results"])) return fail("cannot write '" + o.csv + "'");
+  if (!o.json.empty())
+    if (auto err = outputs.stage(o.json, out.dump(2) + "\n")) return fail(*err);
+  if (!o.csv.empty())
+    if (auto err = outputs.stage(o.csv, csvText(out["results"]))) return fail(*err);
+  if (auto err = outputs.commit()) return fail(*err);
   return 0;
 }

@@ -38,12 +38,12 @@ constexpr uint64_t kSortedPos = 3 * sizeof(float);
 std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::SimUniforms& u, Layout layout,
                                      bool collision_lists) {
   const bool cpu = layout == Layout::Cpu, fused = layout == Layout::GpuFused;
-  const bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u, tear = u.tear_factor > 0.0f;
+  const bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u, tear = shaderio::tearingOn(u.tear_factor);
   const uint64_t n = topo.particleCount();         // particles
   const uint64_t slots = topo.constraintCount();   // constraint slots (the GPU's tear pass covers all)
   const uint64_t buckets = topo.hash_size;         // T: cell_count[T], cell_start[T + 1]
   const uint64_t adjacency = topo.adj_list.size(); // CSR neighbour entries
-  const uint64_t substeps = cpu ? u.substeps : std::min<uint32_t>(u.substeps, SIM_MAX_SUBSTEPS);
+  const uint64_t substeps = shaderio::substepCount(u.substeps);
   uint64_t live = 0; // live constraints, summed over the colours
   for (const ColorRange& c : topo.colors) live += c.count;
   const uint64_t constraint = cpu ? kSplitConstraint : kConstraint;

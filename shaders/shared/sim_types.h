@@ -92,10 +92,13 @@ struct Counters {
   uvec4 near_flags;
 };
 
-/// Result of a pick: nearest particle to a ray (8 bytes read back).
+/// Result of a pick: the nearest particle to a ray and where it is (SIM_BIND_PICK, read back).
 struct PickResult {
   uint index; // particle or SIM_NONE
   float t;    // ray parameter of the point nearest to the particle
+  uint d2;    // float bits of its squared distance to the ray (the passes' running minimum)
+  uint pad;
+  vec4 pos; // its position (w: inverse mass)
 };
 
 /// Push constants of the scan passes (block scan and block-sum add).

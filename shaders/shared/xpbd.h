@@ -16,6 +16,15 @@ struct PairDelta {
   vec3 db;
 };
 
+/// Substeps a tick runs: as many as asked, at most SIM_MAX_SUBSTEPS (the per-substep inputs).
+SIM_INLINE uint substepCount(uint substeps) { return min(substeps, uint(SIM_MAX_SUBSTEPS)); }
+
+/// True when constraints may tear: a tear factor of 0 (or less) disables tearing.
+SIM_INLINE bool tearingOn(float tear_factor) { return tear_factor > 0.0f; }
+
+/// A particle at its start: the rest position, inverse mass 0 at a pin point, else 1.
+SIM_INLINE vec4 startPosition(vec4 rest) { return vec4(vec3(rest), rest.w > 0.5f ? 0.0f : 1.0f); }
+
 /// Inverse mass of a particle this substep: 0 when pinned (and pins are on) or held by a grab.
 SIM_INLINE float inverseMass(vec4 rest, bool held, uint flags) {
   bool pinned = (flags & SIM_FLAG_PINS) != 0u && rest.w > 0.5f;
@@ -76,8 +85,11 @@ SIM_INLINE PairDelta solveDistance(vec4 pa, vec4 pb, float rest, float stiffness
   return r;
 }
 
-/// Integer cell of a position in the spatial hash.
-SIM_INLINE ivec3 cellOf(vec3 p, float inv_cell) { return ivec3(floor(p * inv_cell)); }
+/// Integer cell of a position in the spatial hash, clamped to +-2^29 so that the conversion and the
+/// differences of two cells stay within int range however far a particle has flown.
+SIM_INLINE ivec3 cellOf(vec3 p, float inv_cell) {
+  return ivec3(clamp(floor(p * inv_cell), vec3(-536870912.0f), vec3(536870912.0f)));
+}
 
 /// Hash bucket of a cell.
 SIM_INLINE uint hashCell(ivec3 c, uint mask) {
@@ -123,7 +135,7 @@ SIM_INLINE VerletState floorParticle(vec4 pos, vec4 prev, vec3 collision_delta, 
 
 /// True when a constraint of this kind is stretched beyond tear_factor x rest.
 SIM_INLINE bool shouldTear(vec4 pa, vec4 pb, float rest, uint kind, float tear_factor, uint tear_kinds) {
-  bool tearable = tear_factor > 0.0f && (tear_kinds & (1u << kind)) != 0u;
+  bool tearable = tearingOn(tear_factor) && (tear_kinds & (1u << kind)) != 0u;
   vec3 d = vec3(pb) - vec3(pa);
   return tearable && sqrt(dot(d, d)) > rest * tear_factor;
 }

@@ -1,6 +1,7 @@
 #version 460
 // Nearest particle to a ray within a radius, in three steps (specialization constant `step`):
-// 0: smallest squared distance; 1: smallest index at that distance; 2: that particle's ray t.
+// 0: smallest squared distance; 1: smallest index at that distance; 2: that particle's ray t and
+// position (so a grab costs one round trip).
 // Squared distances are >= 0, so their float bits order like the floats (atomicMin on uint).
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
@@ -20,5 +21,6 @@ void main() {
     if (floatBitsToUint(r.x) == pick_d2) atomicMin(pick_index, i);
   } else if (i == pick_index) {
     pick_t = r.y;
+    pick_pos = pos[i];
   }
 }

@@ -52,6 +52,7 @@ layout(std430, set = 0, binding = SIM_BIND_PICK) SIM_COHERENT buffer PickBuffer 
   float pick_t;
   uint pick_d2;
   uint pick_pad;
+  vec4 pick_pos;
 };
 layout(std430, set = 0, binding = SIM_BIND_RESET_FROM) SIM_COHERENT buffer ResetFromBuffer { vec4 reset_from[]; };
 layout(std430, set = 0, binding = SIM_BIND_CELL_SCATTER) SIM_COHERENT buffer CellScatterBuffer { uint cell_scatter[]; };

@@ -9,7 +9,7 @@ layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uint k = threadIndex();
-  if (k >= p.count || u.tear_factor <= 0.0f) return;
+  if (k >= p.count || !tearingOn(u.tear_factor)) return;
   // Slots past a colour's live count hold stale copies of constraints of that colour, each either
   // torn already (skipped here) or a copy of a live one (same ends, same verdict): the torn set
   // is the same as marking the live ranges only, without looking the ranges up.

@@ -58,10 +58,10 @@ void main() {
   uint lid = gl_LocalInvocationID.x;
   uint n = p.count, m = u.constraint_count;
   bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
-  bool tearing = u.tear_factor > 0.0f && m > 0u;
+  bool tearing = tearingOn(u.tear_factor) && m > 0u;
   float dt2 = u.dt * u.dt;
   for (uint i = lid; i < n; i += kInvocations) s_pos[i] = pos[i];
-  uint end = min(p.first_substep + p.substeps, min(u.substeps, SIM_MAX_SUBSTEPS));
+  uint end = min(p.first_substep + p.substeps, substepCount(u.substeps));
   for (uint s = p.first_substep; s < end; ++s) {
     // 1. Verlet integration (as integrate.comp)
     for (uint i = lid; i < n; i += kInvocations) {

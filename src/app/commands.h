@@ -4,7 +4,9 @@
 #include <string>
 #include <vector>
 
+#include "backend/backend.h"
 #include "core/params.h"
+#include "core/script.h"
 #include "core/solver.h"
 
 namespace tender {
@@ -21,12 +23,18 @@ struct CommonOptions {
   bool validation = false;       ///< VK_LAYER_KHRONOS_validation
   std::string script;            ///< input script to replay
   SimParams params;              ///< resolved preset + overrides
+
+  /// The backend these options ask for (threads from the parameters).
+  BackendOptions backendOptions() const;
 };
 
 struct SimOptions {
   uint64_t ticks = 120;
   std::string stats, out;
 };
+
+/// Largest --ticks of `tender sim` and `tender render`.
+constexpr uint64_t kMaxTicks = 100000000;
 
 struct RenderOptions {
   uint64_t ticks = 0;
@@ -44,8 +52,9 @@ struct DemoOptions {
 /// Prints "tender: error: <message>" and returns kExitBadInput.
 int fail(const std::string& message);
 
-/// Creates the chosen backend; on failure prints one line and sets `status` to kExitBadInput.
-std::unique_ptr<Solver> createSolver(const CommonOptions& o, int& status);
+/// The input script of `path` checked against the sheet of `params` (an empty path: no events);
+/// nullopt and `error` on failure.
+std::optional<InputScript> scriptFor(const std::string& path, const SimParams& params, std::string& error);
 
 int runSim(const CommonOptions& common, const SimOptions& o);
 int runDevices(const CommonOptions& common);

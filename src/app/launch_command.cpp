@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "core/output.h"
 
 namespace tender {
 namespace {
@@ -56,16 +57,32 @@ int runDemo(const CommonOptions& common, const DemoOptions& o) {
       std::fprintf(stderr, "tender: this build has no tender-demo; rendering headless instead\n");
     }
   }
-  // No display: one picture of the preset after two seconds of simulation.
+  // No display: one picture of the preset after two seconds of simulation (of the replayed
+  // session, with --replay); --record writes the input of that session.
   RenderOptions r;
   r.width = o.width;
   r.height = o.height;
   r.ticks = uint64_t(2.0f * common.params.tick_hz);
   r.out = "tender.png";
+  std::string error;
+  std::optional<InputScript> replay = scriptFor(o.replay, common.params, error);
+  if (!replay) return fail(error);
+  OutputSet record;
+  if (auto err = record.add(o.record)) return fail(*err);
+  CommonOptions session = common;
+  session.script = o.replay;
   std::printf("tender: no display; rendering a picture instead\n");
-  int status = runRender(common, r);
-  if (status == 0) std::printf("tender: wrote %s\n", std::filesystem::absolute(r.out, ec).string().c_str());
-  return status;
+  int status = runRender(session, r);
+  if (status != 0) return status;
+  if (!o.record.empty()) {
+    std::string text = "# tender input script, preset " + common.params.preset + " (headless session)\n";
+    for (const ScriptEvent& e : replay->events)
+      if (e.tick < r.ticks) text += formatEvent(e) + "\n";
+    if (auto err = record.stage(o.record, text)) return fail(*err);
+    if (auto err = record.commit()) return fail(*err);
+  }
+  std::printf("tender: wrote %s\n", std::filesystem::absolute(r.out, ec).string().c_str());
+  return 0;
 }
 
 } // namespace tender

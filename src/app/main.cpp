@@ -4,12 +4,27 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
+#include "core/output.h"
 
 namespace tender {
 
 int fail(const std::string& message) {
   std::fprintf(stderr, "tender: error: %s\n", message.c_str());
   return kExitBadInput;
+}
+
+BackendOptions CommonOptions::backendOptions() const {
+  BackendOptions b;
+  b.backend = backend;
+  b.device = device;
+  b.validation = validation;
+  b.threads = params.threads;
+  return b;
+}
+
+std::optional<InputScript> scriptFor(const std::string& path, const SimParams& params, std::string& error) {
+  if (path.empty()) return InputScript{};
+  return loadScriptFor(path, params.particleCount(), error);
 }
 
 namespace {
@@ -42,8 +57,8 @@ std::optional<std::string> resolve(CommonOptions& o) {
   }
   for (auto& s : o.sets)
     if (auto err = applyOverride(*p, s)) return *err;
-  if (auto err = validate(*p)) return *err;
   if (o.backend != "cpu" && o.backend != "gpu") return "unknown backend '" + o.backend + "' (cpu or gpu)";
+  if (auto err = validate(*p, o.backend)) return *err;
   o.params = *p;
   return std::nullopt;
 }
@@ -70,9 +85,10 @@ int main(int argc, char** argv) {
   app.add_option("--height", demo.height, "window height")->check(CLI::Range(64u, 16384u));
 
   SimOptions sim;
+  std::string sim_ticks = "120", render_ticks = "0";
   CLI::App* sim_cmd = app.add_subcommand("sim", "run a preset headless and write stats and state");
   addCommon(*sim_cmd, common, true);
-  sim_cmd->add_option("--ticks", sim.ticks, "ticks to run")->check(CLI::Range(uint64_t(0), uint64_t(100000000)));
+  sim_cmd->add_option("--ticks", sim_ticks, "ticks to run (decimal, at most 100000000)")->capture_default_str();
   sim_cmd->add_option("--script", common.script, "input script to replay");
   sim_cmd->add_option("--stats", sim.stats, "write stats JSON here");
   sim_cmd->add_option("--out", sim.out, "write the final state as PLY here");
@@ -80,8 +96,7 @@ int main(int argc, char** argv) {
   RenderOptions render;
   CLI::App* render_cmd = app.add_subcommand("render", "render a preset offscreen to a PNG");
   addCommon(*render_cmd, common, true);
-  render_cmd->add_option("--ticks", render.ticks, "ticks to run before rendering")
-      ->check(CLI::Range(uint64_t(0), uint64_t(100000000)));
+  render_cmd->add_option("--ticks", render_ticks, "ticks to run before rendering (decimal)")->capture_default_str();
   render_cmd->add_option("--script", common.script, "input script to replay");
   render_cmd->add_option("--out", render.out, "PNG to write")->capture_default_str();
   render_cmd->add_option("--width", render.width, "image width")->check(CLI::Range(16u, 16384u));
@@ -99,12 +114,15 @@ int main(int argc, char** argv) {
   }
   if (*devices_cmd) return runDevices(common);
   if (auto err = resolve(common)) return fail(*err);
+  if (auto err = parseWhole(sim_ticks, 0, kMaxTicks, sim.ticks)) return fail("--ticks: " + *err);
+  if (auto err = parseWhole(render_ticks, 0, kMaxTicks, render.ticks)) return fail("--ticks: " + *err);
+  // A write beyond the file-size limit fails like any other write error (exit 2, no fragment).
+  ignoreFileSizeSignal();
   try {
     if (*sim_cmd) return runSim(common, sim);
     if (*render_cmd) return runRender(common, render);
     return runDemo(common, demo);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "tender: error: %s\n", e.what());
-    return 1;
+  } catch (const std::exception& e) { // a Vulkan error at run time, out of memory
+    return fail(e.what());
   }
 }

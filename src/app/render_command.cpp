@@ -1,12 +1,15 @@
 // `tender render`: a preset after N ticks, rendered offscreen to a PNG (no window, no display).
 #include <cstdio>
 
+#include "backend/headless.h"
 #include "commands.h"
-#include "render/headless.h"
+#include "core/output.h"
 
 namespace tender {
 
 int runRender(const CommonOptions& common, const RenderOptions& o) {
+  OutputSet outputs;
+  if (auto err = outputs.add(o.out)) return fail(*err);
   render::HeadlessOptions h;
   h.params = common.params;
   h.backend = common.backend;
@@ -15,21 +18,18 @@ int runRender(const CommonOptions& common, const RenderOptions& o) {
   h.ticks = o.ticks;
   h.width = o.width;
   h.height = o.height;
-  if (!common.script.empty()) {
-    std::string error;
-    auto s = loadScript(common.script, error);
-    if (!s) return fail(error);
-    h.script = *s;
-  }
+  std::string error;
+  auto script = scriptFor(common.script, common.params, error);
+  if (!script) return fail(error);
+  h.script = *script;
   render::HeadlessResult r = render::renderHeadless(h);
   if (!r.error.empty()) return fail(r.error);
-  if (!render::writePng(o.out, r.picture)) return fail("cannot write '" + o.out + "'");
+  if (auto err = outputs.stage(o.out, render::encodePng(r.picture))) return fail(*err);
+  if (auto err = outputs.commit()) return fail(*err);
   std::printf("tender render: %s (%ux%u, preset %s, %llu ticks, backend %s)\n", o.out.c_str(), o.width, o.height,
               common.params.preset.c_str(), static_cast<unsigned long long>(o.ticks), common.backend.c_str());
-  if (common.validation && r.validation_messages > 0) {
-    std::fprintf(stderr, "tender render: %u validation messages\n", r.validation_messages);
-    return 1;
-  }
+  if (common.validation && r.validation_messages > 0)
+    return fail(std::to_string(r.validation_messages) + " validation messages");
   return 0;
 }
 

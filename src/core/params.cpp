@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <unistd.h>
 
@@ -13,7 +14,6 @@ namespace {
 struct Param {
   ParamInfo info;
   std::function<std::optional<std::string>(SimParams&, const std::string&)> set;
-  std::function<std::string(const SimParams&)> get;
 };
 
 std::optional<std::string> parseFloat(const std::string& s, float lo, float hi, float& out) {
@@ -32,12 +32,7 @@ std::optional<std::string> parseFloat(const std::string& s, float lo, float hi, 
 
 std::optional<std::string> parseUint(const std::string& s, uint32_t lo, uint32_t hi, uint32_t& out) {
   uint64_t v = 0;
-  const char* end = s.data() + s.size();
-  auto [ptr, ec] = std::from_chars(s.data(), end, v);
-  if (s.empty() || ptr != end || (ec != std::errc() && ec != std::errc::result_out_of_range))
-    return "'" + s + "' is not a whole number";
-  if (ec == std::errc::result_out_of_range || v < lo || v > hi)
-    return s + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (auto err = parseWhole(s, lo, hi, v)) return err;
   out = uint32_t(v);
   return std::nullopt;
 }
@@ -58,35 +53,24 @@ std::string fmt(float v) {
 constexpr uint32_t kMaxSide = 16384;
 
 Param floatParam(const char* key, float SimParams::*m, float lo, float hi, const char* help) {
-  return {{key, help},
-          [m, lo, hi](SimParams& p, const std::string& v) { return parseFloat(v, lo, hi, p.*m); },
-          [m](const SimParams& p) { return fmt(p.*m); }};
+  return {{key, help, lo, hi}, [m, lo, hi](SimParams& p, const std::string& v) { return parseFloat(v, lo, hi, p.*m); }};
 }
 Param uintParam(const char* key, uint32_t SimParams::*m, uint32_t lo, uint32_t hi, const char* help) {
-  return {{key, help},
-          [m, lo, hi](SimParams& p, const std::string& v) { return parseUint(v, lo, hi, p.*m); },
-          [m](const SimParams& p) { return std::to_string(p.*m); }};
+  return {{key, help, double(lo), double(hi)},
+          [m, lo, hi](SimParams& p, const std::string& v) { return parseUint(v, lo, hi, p.*m); }};
 }
 Param boolParam(const char* key, bool SimParams::*m, const char* help) {
-  return {{key, help},
-          [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); },
-          [m](const SimParams& p) { return std::string(p.*m ? "on" : "off"); }};
+  return {{key, help}, [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); }};
 }
 template <typename E>
 Param enumParam(const char* key, E SimParams::*m, std::vector<std::pair<std::string, E>> names, const char* help) {
-  return {{key, help},
-          [m, names](SimParams& p, const std::string& v) -> std::optional<std::string> {
+  return {{key, help}, [m, names](SimParams& p, const std::string& v) -> std::optional<std::string> {
             std::string all;
             for (auto& [n, e] : names) {
               if (n == v) return p.*m = e, std::nullopt;
               all += (all.empty() ? "" : ", ") + n;
             }
             return "'" + v + "' is not one of " + all;
-          },
-          [m, names](const SimParams& p) {
-            for (auto& [n, e] : names)
-              if (e == p.*m) return n;
-            return std::string("?");
           }};
 }
 
@@ -137,6 +121,18 @@ const std::vector<Param>& params() {
 }
 
 } // namespace
+
+std::optional<std::string> parseWhole(const std::string& s, uint64_t lo, uint64_t hi, uint64_t& out) {
+  uint64_t v = 0;
+  const char* end = s.data() + s.size();
+  auto [ptr, ec] = std::from_chars(s.data(), end, v, 10);
+  if (s.empty() || ptr != end || (ec != std::errc() && ec != std::errc::result_out_of_range))
+    return "'" + s + "' is not a whole number";
+  if (ec == std::errc::result_out_of_range || v < lo || v > hi)
+    return s + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  out = v;
+  return std::nullopt;
+}
 
 std::vector<std::string> presetNames() { return {"tender", "crumple", "tender-low", "crumple-low"}; }
 
@@ -195,29 +191,81 @@ std::optional<std::string> applyOverride(SimParams& p, const std::string& assign
   return "unknown parameter '" + key + "' (see --help for the keys)";
 }
 
-std::string paramValue(const SimParams& p, const std::string& key) {
+std::optional<ParamInfo> paramInfo(const std::string& key) {
   for (auto& param : params())
-    if (param.info.key == key) return param.get(p);
-  return "";
+    if (param.info.key == key) return param.info;
+  return std::nullopt;
 }
 
-uint64_t estimateSheetBytes(const SimParams& p) {
-  uint64_t n = uint64_t(p.cols) * p.rows;
-  // Particle arrays (pos, prev, rest, normal, delta, reset source, uv, hash, adjacency) and
-  // up to 8 constraints per particle in three copies (live, pristine, scratch), both solvers' worth.
-  uint64_t per_particle = 6 * 16 + 8 + 4 * 16 + 16 * 4 + 8 * 16 * 3 + 2 * 16 * 2;
-  return n * per_particle;
+SheetCounts sheetCounts(const SimParams& p) {
+  const uint64_t w = p.cols, h = p.rows;
+  auto pairs = [](uint64_t a, uint64_t b) { return a > b ? a - b : 0; }; // a - b, at least 0
+  SheetCounts c;
+  c.particles = w * h;
+  c.constraints = pairs(w, 1) * h + w * pairs(h, 1);
+  if (p.shear) c.constraints += 2 * pairs(w, 1) * pairs(h, 1);
+  if (p.bend) c.constraints += pairs(w, 2) * h + w * pairs(h, 2);
+  if (p.tri_bend) c.constraints += pairs(w, 1) * pairs(h, 2) + pairs(w, 2) * pairs(h, 1);
+  c.triangles = 2 * pairs(w, 1) * pairs(h, 1);
+  c.hash_buckets = 2;
+  while (c.hash_buckets < 2 * c.particles) c.hash_buckets <<= 1;
+  return c;
 }
 
-std::optional<std::string> validate(const SimParams& p) {
+uint64_t estimateSheetBytes(const SimParams& p, const std::string& backend) {
+  const SheetCounts c = sheetCounts(p);
+  const uint64_t n = c.particles, m = c.constraints, t = c.triangles, hb = c.hash_buckets;
+  // SheetTopology: rest, uv, constraints, adjacency (offsets and 2 entries per constraint),
+  // triangles and their edges.
+  const uint64_t topology = 24 * n + 16 * m + 4 * n + 8 * m + 24 * t;
+  // Building it: colour masks, colours, the sorted copy, the edge ids of the triangles.
+  const uint64_t building = 8 * n + 20 * m + 8 * n;
+  // The read-back state: pos, prev, normal, constraints, torn flags, triangles.
+  const uint64_t state = 48 * n + 20 * m + 16 * t;
+  uint64_t solver = 0;
+  if (backend == "cpu") {
+    // Particle arrays (pos, prev, rest, normal, delta, reset source, uv), constraints with their
+    // split copy and torn flags, triangles, adjacency, the hash and its sorted copies, the
+    // collision candidate lists.
+    solver = 104 * n + 40 * m + 16 * t + 4 * n + 8 * m + 8 * hb + 28 * n + 28 * n + 76 * n;
+  } else {
+    // The solver's copy of the topology, its storage buffers (particle arrays, constraints and
+    // their compaction scratch, hash, candidate lists) and the largest staging of an upload.
+    // (and what a driver keeping device memory on the host adds: ~80 bytes per particle).
+    solver =
+        80 * n + topology + 16 * 9 * n + 4 * 6 * n + 36 * m + 48 * t + 12 * hb + 80 * n + 4 * (m + t) + 72 * n + 16 * m;
+  }
+  return topology + std::max(building, state) + solver;
+}
+
+namespace {
+
+// Host memory this process may still use: MemAvailable, or half the physical memory.
+uint64_t availableBytes() {
+  if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
+    char line[256];
+    unsigned long long kb = 0;
+    bool found = false;
+    while (!found && std::fgets(line, sizeof(line), f)) found = std::sscanf(line, "MemAvailable: %llu kB", &kb) == 1;
+    std::fclose(f);
+    if (found) return uint64_t(kb) * 1024;
+  }
+  long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? uint64_t(pages) * uint64_t(page) / 2 : ~uint64_t(0);
+}
+
+} // namespace
+
+std::optional<std::string> validate(const SimParams& p, const std::string& backend) {
   uint64_t n = uint64_t(p.cols) * p.rows;
   if (n == 0) return "the grid has no particles";
   if (n > (1u << 24)) return "a grid of " + std::to_string(n) + " particles is too large (at most 16777216)";
-  uint64_t need = estimateSheetBytes(p);
-  long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  if (pages > 0 && page > 0 && need > uint64_t(pages) * uint64_t(page) / 2)
-    return "a grid of " + std::to_string(n) + " particles needs about " + std::to_string(need >> 20) +
-           " MiB, more than this machine can hold";
+  // Refused up front, with room to spare (a tenth of the memory for everything else).
+  const uint64_t need = estimateSheetBytes(p, backend), have = availableBytes();
+  if (need > have / 10 * 9)
+    return "a " + std::to_string(p.cols) + "x" + std::to_string(p.rows) + " sheet needs about " +
+           std::to_string(need >> 20) + " MiB on the " + (backend == "cpu" ? "cpu" : "gpu") + " backend; " +
+           std::to_string(have >> 20) + " MiB are available";
   if (p.substeps > SIM_MAX_SUBSTEPS) return "substeps is at most " + std::to_string(SIM_MAX_SUBSTEPS);
   if (p.collision && p.collisionRadius() > p.cell_size)
     return "collision radius (" + fmt(p.collisionRadius()) + ") must not exceed cell_size (" + fmt(p.cell_size) + ")";

@@ -75,18 +75,32 @@ std::optional<SimParams> presetParams(const std::string& name);
 struct ParamInfo {
   std::string key;
   std::string help;
+  double lo = 0.0, hi = 0.0; ///< accepted range of a number (lo == hi: not a number)
 };
 /// All keys accepted by `--set`.
 const std::vector<ParamInfo>& paramKeys();
+/// The parameter of a key (its help and range); nullopt when unknown.
+std::optional<ParamInfo> paramInfo(const std::string& key);
+
+/// Parses a decimal whole number in [lo, hi] (digits only: no sign, no hex); returns an error.
+std::optional<std::string> parseWhole(const std::string& s, uint64_t lo, uint64_t hi, uint64_t& out);
 
 /// Applies one `key=value` override; returns an error message on failure.
 std::optional<std::string> applyOverride(SimParams& p, const std::string& assignment);
-/// Checks ranges and cross-parameter rules (radius vs cell, memory); returns an error message.
-std::optional<std::string> validate(const SimParams& p);
-/// Value of a key as text (for stats and the HUD).
-std::string paramValue(const SimParams& p, const std::string& key);
+/// Checks ranges and cross-parameter rules (radius vs cell) and that the sheet fits this
+/// machine's memory on the given backend ("cpu", or a GPU backend: its buffers counted as host
+/// memory, as on a CPU device or a GPU with shared memory); returns an error message.
+std::optional<std::string> validate(const SimParams& p, const std::string& backend = "gpu");
 
-/// Bytes the simulation needs for a sheet of these parameters (estimate, both solvers' arrays).
-uint64_t estimateSheetBytes(const SimParams& p);
+/// Sizes of the sheet a SimParams describes, counted without building it.
+struct SheetCounts {
+  uint64_t particles = 0, constraints = 0, triangles = 0;
+  uint64_t hash_buckets = 0; ///< power of two >= 2 x particles
+};
+/// The counts of buildSheet(p), from the grid alone.
+SheetCounts sheetCounts(const SimParams& p);
+/// Peak host bytes of a run on a backend ("cpu" or a GPU backend, whose buffers count as host
+/// memory): the topology, the solver's arrays, staging and the read-back state.
+uint64_t estimateSheetBytes(const SimParams& p, const std::string& backend);
 
 } // namespace tender

@@ -1,7 +1,12 @@
 #include "script.h"
 
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <charconv>
 #include <cmath>
-#include <fstream>
+#include <cstdio>
+#include <cstring>
 #include <sstream>
 
 namespace tender {
@@ -21,16 +26,20 @@ bool readToggle(std::istringstream& in, Toggle& t) {
   return true;
 }
 
-bool readVec(std::istringstream& in, glm::vec3& v) {
+// Reads three coordinates; returns an error message (empty when fine).
+std::string readVec(std::istringstream& in, glm::vec3& v) {
   for (int k = 0; k < 3; ++k) {
     std::string w;
-    if (!(in >> w)) return false;
+    if (!(in >> w)) return "missing";
     char* end = nullptr;
     double d = std::strtod(w.c_str(), &end);
-    if (end == w.c_str() || *end != 0 || !std::isfinite(d)) return false;
+    if (end == w.c_str() || *end != 0 || std::isnan(d)) return "'" + w + "' is not a number";
+    if (!(std::fabs(d) <= double(kMaxCoordinate)))
+      return w + " is out of range [-" + std::to_string(int64_t(kMaxCoordinate)) + ", " +
+             std::to_string(int64_t(kMaxCoordinate)) + "]";
     v[k] = float(d);
   }
-  return true;
+  return "";
 }
 
 const char* toggleName(Toggle t) { return t == Toggle::On ? "on" : t == Toggle::Off ? "off" : "toggle"; }
@@ -54,9 +63,13 @@ std::optional<InputScript> parseScript(const std::string& text, std::string& err
       error = "line " + std::to_string(number) + ": " + what;
       return std::nullopt;
     };
-    char* end = nullptr;
-    unsigned long long tick = std::strtoull(tick_word.c_str(), &end, 10);
-    if (tick_word[0] == '-' || *end != 0) return fail("expected a tick number, got '" + tick_word + "'");
+    uint64_t tick = 0;
+    const char* last = tick_word.data() + tick_word.size();
+    auto [ptr, ec] = std::from_chars(tick_word.data(), last, tick, 10);
+    if (ptr != last || (ec != std::errc() && ec != std::errc::result_out_of_range))
+      return fail("expected a tick number, got '" + tick_word + "'");
+    if (ec == std::errc::result_out_of_range || tick > kMaxTick)
+      return fail("tick " + tick_word + " is out of range [0, " + std::to_string(kMaxTick) + "]");
     if (tick < last_tick) return fail("tick " + tick_word + " comes before an earlier line's tick");
     last_tick = tick;
     if (!(in >> verb)) return fail("missing event after the tick");
@@ -72,14 +85,19 @@ std::optional<InputScript> parseScript(const std::string& text, std::string& err
         e.particle = uint32_t(i);
       } else if (how == "ray") {
         e.kind = EventKind::GrabRay;
-        if (!readVec(in, e.a) || !readVec(in, e.b)) return fail("grab ray needs 6 numbers: origin and direction");
+        std::string bad = readVec(in, e.a);
+        if (bad.empty()) bad = readVec(in, e.b);
+        if (bad == "missing") return fail("grab ray needs 6 numbers: origin and direction");
+        if (!bad.empty()) return fail("grab ray: " + bad);
         if (glm::dot(e.b, e.b) < 1e-12f) return fail("grab ray direction is zero");
       } else {
         return fail("grab needs 'particle <index>' or 'ray <ox oy oz dx dy dz>'");
       }
     } else if (verb == "move") {
       e.kind = EventKind::Move;
-      if (!readVec(in, e.a)) return fail("move needs 3 numbers");
+      const std::string bad = readVec(in, e.a);
+      if (bad == "missing") return fail("move needs 3 numbers");
+      if (!bad.empty()) return fail("move: " + bad);
     } else if (verb == "release") {
       e.kind = EventKind::Release;
     } else if (verb == "wind" || verb == "pins" || verb == "pause") {
@@ -98,14 +116,38 @@ std::optional<InputScript> parseScript(const std::string& text, std::string& err
 }
 
 std::optional<InputScript> loadScript(const std::string& path, std::string& error) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream ss;
-  if (!f || !(ss << f.rdbuf())) {
-    error = "cannot read script '" + path + "'";
+  std::string text;
+  struct stat st {};
+  if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+    error = "cannot read script '" + path + "': it is a folder";
     return std::nullopt;
   }
-  auto s = parseScript(ss.str(), error);
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) {
+    error = "cannot read script '" + path + "': " + std::strerror(errno);
+    return std::nullopt;
+  }
+  char buf[65536];
+  for (size_t got; (got = std::fread(buf, 1, sizeof(buf), f)) > 0;) text.append(buf, got);
+  const bool failed = std::ferror(f) != 0;
+  const int saved = errno;
+  std::fclose(f);
+  if (failed) {
+    error = "cannot read script '" + path + "': " + std::strerror(saved);
+    return std::nullopt;
+  }
+  auto s = parseScript(text, error);
   if (!s) error = path + ": " + error;
+  return s;
+}
+
+std::optional<InputScript> loadScriptFor(const std::string& path, uint32_t particle_count, std::string& error) {
+  auto s = loadScript(path, error);
+  if (!s) return s;
+  if (auto err = checkScript(*s, particle_count)) {
+    error = path + ": " + *err;
+    return std::nullopt;
+  }
   return s;
 }
 

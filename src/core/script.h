@@ -22,6 +22,12 @@
 
 namespace tender {
 
+/// Largest magnitude of a world coordinate an input may name (script, drag, replay): scripts
+/// naming more are refused, and a grab target beyond it is clamped, so the state stays finite.
+constexpr float kMaxCoordinate = 1.0e6f;
+/// Largest tick a script line may name (decimal digits only).
+constexpr uint64_t kMaxTick = 1000000000000ull;
+
 enum class EventKind { GrabParticle, GrabRay, Move, Release, Wind, Pins, Pause, Reset };
 /// Value of on/off/toggle events.
 enum class Toggle { Off, On, Flip };
@@ -46,6 +52,9 @@ std::optional<InputScript> parseScript(const std::string& text, std::string& err
 std::optional<InputScript> loadScript(const std::string& path, std::string& error);
 /// Checks a script against a sheet: particle indices must exist. Returns an error message.
 std::optional<std::string> checkScript(const InputScript& script, uint32_t particle_count);
+/// Reads, parses and checks a script file against a sheet of `particle_count` particles (what
+/// every program does with a script it is given); errors name the file.
+std::optional<InputScript> loadScriptFor(const std::string& path, uint32_t particle_count, std::string& error);
 /// Formats one event as a script line.
 std::string formatEvent(const ScriptEvent& e);
 

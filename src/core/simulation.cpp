@@ -20,6 +20,13 @@ double valueNoise(double x, uint32_t seed) {
   return knot(int64_t(f)) * (1.0 - s) + knot(int64_t(f) + 1) * s;
 }
 
+// A grab target within the coordinates an input may name (kMaxCoordinate): a far drag or a huge
+// script value moves the sheet far, never to infinity.
+glm::vec3 boundedTarget(glm::vec3 p) {
+  for (int k = 0; k < 3; ++k) p[k] = std::isnan(p[k]) ? 0.0f : glm::clamp(p[k], -kMaxCoordinate, kMaxCoordinate);
+  return p;
+}
+
 double fractalNoise(double t, uint32_t seed) {
   return 0.65 * valueNoise(t * 0.6, seed) + 0.35 * valueNoise(t * 1.7, seed + 101u);
 }
@@ -102,8 +109,9 @@ void Simulation::apply(const ScriptEvent& e) {
   }
 }
 
-void Simulation::grabParticle(uint32_t i) {
-  glm::vec3 p = solver_.particlePosition(i);
+void Simulation::grabParticle(uint32_t i) { grabAt(i, solver_.particlePosition(i)); }
+
+void Simulation::grabAt(uint32_t i, glm::vec3 p) {
   grab_index_ = i;
   grab_from_ = grab_to_ = p;
   grab_history_.fill(p);
@@ -112,17 +120,18 @@ void Simulation::grabParticle(uint32_t i) {
 }
 
 bool Simulation::grabRay(glm::vec3 origin, glm::vec3 dir) {
+  if (!(glm::dot(dir, dir) > 0.0f)) return false;
   dir = glm::normalize(dir);
   shaderio::PickResult r = solver_.pick(origin, dir, params_.grab_radius);
   if (r.index == SIM_NONE) return false;
-  grabParticle(r.index);
+  grabAt(r.index, glm::vec3(r.pos));
   // The particle follows the cursor: it moves onto the ray at its nearest point.
-  grab_to_ = origin + dir * r.t;
+  grab_to_ = boundedTarget(origin + dir * r.t);
   return true;
 }
 
 void Simulation::moveGrab(glm::vec3 target) {
-  if (grab_index_ != SIM_NONE) grab_to_ = target;
+  if (grab_index_ != SIM_NONE) grab_to_ = boundedTarget(target);
 }
 
 void Simulation::release() {

@@ -74,6 +74,7 @@ public:
   shaderio::SimUniforms makeUniforms() const;
 
 private:
+  void grabAt(uint32_t i, glm::vec3 position);
   void runPhysicsTick();
   void runResetFrame();
   void applyDueEvents();

@@ -41,12 +41,16 @@ public:
   virtual void beginReset() = 0;
   /// Recomputes the normals (once per frame, before drawing or reading back).
   virtual void computeNormals() = 0;
-  /// Nearest particle to the ray o + t d (|d| = 1) within radius, or SIM_NONE.
+  /// Nearest particle to the ray o + t d (|d| = 1) within radius (index SIM_NONE: none), with its
+  /// ray parameter and position: a grab costs this one round trip.
   virtual shaderio::PickResult pick(glm::vec3 o, glm::vec3 d, float radius) = 0;
   /// Position of one particle (a small read-back, used when a grab starts).
   virtual glm::vec3 particlePosition(uint32_t index) = 0;
   /// Copies the whole state to the host.
   virtual void readback(SimState& out) = 0;
+  /// Waits until every tick submitted so far has finished (the GPU runs asynchronously; the CPU
+  /// has finished when tick() returns).
+  virtual void finish() {}
   /// GPU time per pass of the last tick (empty on the CPU).
   virtual PassTimes passTimes() const { return {}; }
   /// Dispatches (or pass invocations) recorded per tick.

@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 
 namespace tender {
 
@@ -72,19 +71,17 @@ nlohmann::json statsJson(const SheetStats& s) {
   return j;
 }
 
-bool writePly(const std::string& path, const SimState& s) {
-  std::ofstream f(path, std::ios::binary);
-  if (!f) return false;
-  f << "ply\nformat binary_little_endian 1.0\ncomment Tender receipt sheet\n"
-    << "element vertex " << s.pos.size() << "\nproperty float x\nproperty float y\nproperty float z\n"
-    << "element face " << s.triangle_count << "\nproperty list uchar uint vertex_indices\nend_header\n";
-  for (const glm::vec4& p : s.pos) f.write(reinterpret_cast<const char*>(&p), 12);
-  for (uint32_t k = 0; k < s.triangle_count; ++k) {
-    const unsigned char three = 3;
-    f.write(reinterpret_cast<const char*>(&three), 1);
-    f.write(reinterpret_cast<const char*>(&s.triangles[k]), 12);
-  }
-  return bool(f);
+bool writePly(std::FILE* f, const SimState& s) {
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\ncomment Tender receipt sheet\nelement vertex " +
+      std::to_string(s.pos.size()) + "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+      std::to_string(s.triangle_count) + "\nproperty list uchar uint vertex_indices\nend_header\n";
+  bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size();
+  for (size_t i = 0; ok && i < s.pos.size(); ++i) ok = std::fwrite(&s.pos[i], 4, 3, f) == 3;
+  const unsigned char three = 3;
+  for (uint32_t k = 0; ok && k < s.triangle_count; ++k)
+    ok = std::fwrite(&three, 1, 1, f) == 1 && std::fwrite(&s.triangles[k], 4, 3, f) == 3;
+  return ok;
 }
 
 } // namespace tender

@@ -1,6 +1,7 @@
 #pragma once
 /// Summary statistics of a state, the `--stats` JSON, and the PLY writer.
 #include <array>
+#include <cstdio>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -30,7 +31,8 @@ uint64_t hashPositions(const std::vector<glm::vec4>& pos);
 SheetStats computeStats(const SimState& s, float substep_dt);
 /// The stats as JSON (the caller adds timing fields).
 nlohmann::json statsJson(const SheetStats& s);
-/// Writes a binary PLY with the positions and the live triangles; returns false on I/O failure.
-bool writePly(const std::string& path, const SimState& s);
+/// Writes a binary PLY with the positions and the live triangles to an open file; false on an
+/// I/O error (write it through OutputSet or writeFileAtomically).
+bool writePly(std::FILE* f, const SimState& s);
 
 } // namespace tender

@@ -663,14 +663,20 @@ void CpuSolver::computeNormals() {
 }
 
 PickResult CpuSolver::pick(glm::vec3 o, glm::vec3 d, float radius) {
-  PickResult best{SIM_NONE, 0.0f};
+  PickResult best{};
+  best.index = SIM_NONE;
   float best_d2 = radius * radius;
   for (uint32_t i = 0; i < pos_.size(); ++i) {
     vec2 r = rayPointDistance2(o, d, vec3(pos_[i]));
     if (r.x <= best_d2 && (best.index == SIM_NONE || r.x < best_d2)) {
-      best = {i, r.y};
+      best.index = i;
+      best.t = r.y;
       best_d2 = r.x;
     }
+  }
+  if (best.index != SIM_NONE) {
+    best.d2 = floatBitsToUint(best_d2);
+    best.pos = pos_[best.index];
   }
   return best;
 }

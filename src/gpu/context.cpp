@@ -11,10 +11,10 @@ namespace tender::gpu {
 std::string vkResultName(VkResult result) { return vk::to_string(vk::Result(result)); }
 
 void vkCheckFailed(VkResult result, const char* expr, const char* file, int line) {
-  std::fprintf(stderr, "tender: Vulkan error %s (%d) in %s at %s:%d\n", vkResultName(result).c_str(), int(result), expr,
-               file, line);
-  std::fflush(stderr);
-  std::abort();
+  std::string call(expr);
+  call = call.substr(0, call.find('('));
+  if (std::getenv("TENDER_DEBUG")) std::fprintf(stderr, "tender: debug: %s failed at %s:%d\n", expr, file, line);
+  throw VulkanError(result, "Vulkan error " + vkResultName(result) + " in " + call);
 }
 
 void preferLavapipeForTests() {
@@ -173,6 +173,9 @@ VKAPI_ATTR VkBool32 VKAPI_CALL VulkanContext::debugCallback(VkDebugUtilsMessageS
                                                             void* user) {
   auto* self = static_cast<VulkanContext*>(user);
   if (severity < VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) return VK_FALSE;
+  // Only the layers' messages count: the loader reports through the same messenger (for example
+  // that VK_INSTANCE_LAYERS enabled a layer), and its notices are no validation findings.
+  if (data && data->pMessageIdName && std::strcmp(data->pMessageIdName, "Loader Message") == 0) return VK_FALSE;
   self->validation_messages_.fetch_add(1);
   if (!self->quiet_)
     std::fprintf(stderr, "tender: validation %s: %s\n",
@@ -462,17 +465,6 @@ void VulkanContext::submit(VkCommandBuffer cmd, VkFence fence) const {
 }
 
 void VulkanContext::waitIdle() { VK_CHECK(vkQueueWaitIdle(queue_)); }
-
-void VulkanContext::upload(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset) {
-  if (size == 0) return;
-  Buffer staging = createHostBuffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-  std::memcpy(staging.mapped, data, size_t(size));
-  submitOnce([&](VkCommandBuffer cmd) {
-    VkBufferCopy region{0, offset, size};
-    vkCmdCopyBuffer(cmd, staging.buffer, dst.buffer, 1, &region);
-  });
-  destroyBuffer(staging);
-}
 
 void VulkanContext::download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset) {
   if (size == 0) return;

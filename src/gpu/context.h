@@ -17,6 +17,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <variant>
@@ -26,12 +27,25 @@
 
 namespace tender::gpu {
 
-/// Prints the VkResult name, the call, file and line, then aborts (never reached on success).
+/// A Vulkan call failed at run time: what() is one line for the user ("Vulkan error
+/// VK_ERROR_DEVICE_LOST in vkQueueSubmit2"); the programs end with it as `tender: error: ...` and
+/// exit status 2.
+class VulkanError : public std::runtime_error {
+public:
+  VulkanError(VkResult result, const std::string& message) : std::runtime_error(message), result_(result) {}
+  /// The failed call's result.
+  VkResult result() const { return result_; }
+
+private:
+  VkResult result_;
+};
+
+/// Throws VulkanError for a failed call; the file and line go to stderr only with TENDER_DEBUG set.
 [[noreturn]] void vkCheckFailed(VkResult result, const char* expr, const char* file, int line);
 /// Name of a VkResult ("VK_ERROR_DEVICE_LOST").
 std::string vkResultName(VkResult result);
 
-/// Checks a Vulkan call in every build type (Release too).
+/// Checks a Vulkan call in every build type (Release too); a failure throws VulkanError.
 #define VK_CHECK(expr)                                                                                                 \
   do {                                                                                                                 \
     VkResult vk_check_result_ = (expr);                                                                                \
@@ -133,8 +147,6 @@ public:
   Buffer createHostBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
   /// Destroys a buffer and frees its memory (no-op on an empty one).
   void destroyBuffer(Buffer& b);
-  /// Copies bytes into a device buffer through a staging buffer (waits for completion).
-  void upload(const Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize offset = 0);
   /// Copies bytes out of a device buffer through a staging buffer (waits for completion).
   void download(const Buffer& src, void* data, VkDeviceSize size, VkDeviceSize offset = 0);
   /// Records commands into a fresh command buffer, submits, and waits for the queue to finish them.

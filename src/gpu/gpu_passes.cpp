@@ -81,10 +81,8 @@ void GpuSolver::recordScan(VkCommandBuffer cmd, uint32_t mode, uint32_t offset, 
   auto dispatch = [&](const ComputePipeline& p) {
     if (grid == Grid::Compaction)
       dispatchIndirect(cmd, p, &push, sizeof(push));
-    else if (grid == Grid::Hash)
-      dispatchHash(cmd, p, count, push);
     else
-      dispatchThreads(cmd, p, count, push);
+      dispatchHash(cmd, p, count, push);
   };
   dispatch(pipes_.scan);
   computeToCompute(cmd);

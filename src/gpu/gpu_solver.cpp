@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "gpu/barriers.h"
 #include "gpu/shaders.h"
@@ -48,18 +50,6 @@ std::vector<uint32_t> adjacencyMasks(const SheetTopology& topo) {
 }
 
 } // namespace
-
-std::unique_ptr<Solver> createGpuSolver(const GpuOptions& options, std::string& error) {
-  ContextOptions co;
-  co.device = options.device;
-  co.validation = options.validation;
-  auto ctx = VulkanContext::create(co);
-  if (!ctx) {
-    error = ctx.error();
-    return nullptr;
-  }
-  return std::make_unique<GpuSolver>(std::move(ctx.value()));
-}
 
 GpuSolver::GpuSolver(std::unique_ptr<VulkanContext> ctx) : owned_ctx_(std::move(ctx)), ctx_(*owned_ctx_) {
   createPipelines({});
@@ -247,7 +237,14 @@ void GpuSolver::upload(const SheetTopology& topo) {
   VkDeviceSize align = ctx_.properties().limits.minUniformBufferOffsetAlignment;
   uniform_stride_ = (sizeof(SimUniforms) + align - 1) / align * align;
   buf_[SIM_BIND_UNIFORMS] = ctx_.createHostBuffer(uniform_stride_ * (kSlots + 1), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  // A sheet whose arrays exceed what the device binds is refused with one line, not left to fail
+  const VkDeviceSize max_range = ctx_.properties().limits.maxStorageBufferRange;
   auto storage = [&](uint32_t binding, VkDeviceSize bytes) {
+    if (bytes > max_range)
+      throw std::runtime_error("a " + std::to_string(topo.cols) + "x" + std::to_string(topo.rows) + " sheet needs a " +
+                               std::to_string(bytes >> 20) + " MiB buffer (binding " + std::to_string(binding) +
+                               "); this Vulkan device binds at most " + std::to_string(max_range >> 20) +
+                               " MiB (try a smaller sheet or --backend cpu)");
     buf_[binding] = ctx_.createDeviceBuffer(bytes, kStorageUsage);
   };
   storage(SIM_BIND_POS, 16ull * n);
@@ -269,7 +266,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
   storage(SIM_BIND_TRI_EDGES, 8ull * topo.tri_edges.size());
   storage(SIM_BIND_COUNTERS, sizeof(Counters));
   storage(SIM_BIND_SCRATCH, 4ull * scratch_size);
-  storage(SIM_BIND_PICK, 16);
+  storage(SIM_BIND_PICK, sizeof(PickResult));
   storage(SIM_BIND_RESET_FROM, 16ull * n);
   storage(SIM_BIND_CELL_SCATTER, 4ull * n);
   storage(SIM_BIND_COMPACT_TMP, 16ull * (m + t));
@@ -311,8 +308,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
     std::vector<glm::vec4> normals(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
     stage(SIM_BIND_NORMAL, normals.data(), 16ull * n, cmd);
     std::vector<glm::vec4> pos(n);
-    for (uint32_t i = 0; i < n; ++i)
-      pos[i] = glm::vec4(glm::vec3(topo.rest_pos[i]), topo.rest_pos[i].w > 0.5f ? 0.0f : 1.0f);
+    for (uint32_t i = 0; i < n; ++i) pos[i] = startPosition(topo.rest_pos[i]);
     stage(SIM_BIND_POS, pos.data(), 16ull * n, cmd);
     stage(SIM_BIND_PREV, pos.data(), 16ull * n, cmd);
     stage(SIM_BIND_RESET_FROM, pos.data(), 16ull * n, cmd);
@@ -436,8 +432,7 @@ void GpuSolver::tick(const SimUniforms& u) {
     dispatches_per_tick_ = 1;
     return;
   }
-  RecordKey key{std::min<uint32_t>(u.substeps, SIM_MAX_SUBSTEPS), u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u,
-                usesFusedPath(u)};
+  RecordKey key{substepCount(u.substeps), u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u, usesFusedPath(u)};
   if (slot.recorded != key) recordTick(slot, index, key);
   ctx_.submit(slot.tick, slot.fence);
   slot.pending = true;
@@ -484,8 +479,10 @@ PickResult GpuSolver::pick(glm::vec3 o, glm::vec3 d, float radius) {
   push.dir = vec4(d, 0.0f);
   push.count = topo_.particleCount();
   ctx_.submitOnce([&](VkCommandBuffer cmd) {
-    const uint32_t init[4] = {SIM_NONE, 0u, 0x7F800000u, 0u}; // no particle, t = 0, d2 = +inf
-    vkCmdUpdateBuffer(cmd, buf_[SIM_BIND_PICK].buffer, 0, sizeof(init), init);
+    PickResult init{};
+    init.index = SIM_NONE;
+    init.d2 = 0x7F800000u; // +inf
+    vkCmdUpdateBuffer(cmd, buf_[SIM_BIND_PICK].buffer, 0, sizeof(init), &init);
     transferToCompute(cmd);
     bindSet(cmd, kStaticSlot);
     for (int s = 0; s < 3; ++s) {
@@ -546,7 +543,7 @@ void GpuSolver::readback(SimState& out) {
   });
   VkDeviceSize off = 0;
   for (const Item& it : items) {
-    std::memcpy(it.dst, static_cast<const char*>(staging.mapped) + off, size_t(it.bytes));
+    if (it.bytes) std::memcpy(it.dst, static_cast<const char*>(staging.mapped) + off, size_t(it.bytes));
     off += it.bytes;
   }
   ctx_.destroyBuffer(staging);

@@ -14,16 +14,6 @@
 
 namespace tender::gpu {
 
-/// Options of the factory.
-struct GpuOptions {
-  int device = -1;         ///< Vulkan device index, -1 = prefer a discrete GPU
-  bool validation = false; ///< VK_LAYER_KHRONOS_validation with synchronization validation
-};
-
-/// Creates a GpuSolver with its own VulkanContext; nullptr and a one-line `error` when no usable
-/// Vulkan device exists.
-std::unique_ptr<Solver> createGpuSolver(const GpuOptions& options, std::string& error);
-
 /// Shape of the fused small-sheet tick; 0 picks the device's value. On a CPU device (lavapipe):
 /// SIM_WG_FUSED_CPU invocations, SIM_FUSED_SUBSTEPS_CPU substeps per dispatch, and only with hash
 /// cells of at most SIM_FUSED_CPU_MAX_CELL_SPACINGS grid spacings; on a GPU: SIM_WG_FUSED
@@ -111,7 +101,7 @@ public:
   /// collision on, the hash cell is within the shape's limit.
   bool usesFusedPath(const shaderio::SimUniforms& u) const;
   /// Waits until every submitted tick has finished.
-  void finish();
+  void finish() override;
 
 private:
   /// Tick command buffers in flight; each has its own uniform slot, fence and timestamp pool.
@@ -119,9 +109,9 @@ private:
   /// Uniform slot of the normals and pick passes (static: written at upload).
   static constexpr uint32_t kStaticSlot = kSlots;
   static constexpr uint32_t kBindingCount = SIM_BIND_HASH_ARGS + 1;
-  /// How a dispatch gets its grid: from the host, from the tear compaction's arguments (zero
-  /// workgroups unless something tore), or from the next live hash-pass argument.
-  enum class Grid : uint8_t { Direct, Compaction, Hash };
+  /// Where an indirect dispatch gets its grid: the tear compaction's arguments (zero workgroups
+  /// unless something tore), or the next live hash-pass argument.
+  enum class Grid : uint8_t { Compaction, Hash };
   /// Timestamp categories, in passTimes() order.
   /// kFused: the fused small-sheet tick, every pass in one dispatch.
   enum Category : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kFused, kCategoryCount };

@@ -1,5 +1,7 @@
 #include "offscreen.h"
 
+#include "core/output.h"
+
 #include <cstring>
 
 #include <stb/stb_image.h>
@@ -19,7 +21,7 @@ OffscreenTarget::OffscreenTarget(gpu::VulkanContext& ctx, Renderer& renderer, ui
 }
 
 OffscreenTarget::~OffscreenTarget() {
-  ctx_.waitIdle();
+  vkQueueWaitIdle(ctx_.queue()); // unchecked: may run while a Vulkan error unwinds
   destroyImage(ctx_.device(), image_);
   ctx_.destroyBuffer(readback_);
 }
@@ -53,9 +55,18 @@ Picture OffscreenTarget::render(const SceneView& view) {
   return p;
 }
 
-bool writePng(const std::string& path, const Picture& picture) {
-  return stbi_write_png(path.c_str(), int(picture.width), int(picture.height), 4, picture.rgba.data(),
-                        int(picture.width * 4)) != 0;
+std::string encodePng(const Picture& picture) {
+  std::string bytes;
+  stbi_write_png_to_func(
+      [](void* context, void* data, int size) {
+        static_cast<std::string*>(context)->append(static_cast<char*>(data), size_t(size));
+      },
+      &bytes, int(picture.width), int(picture.height), 4, picture.rgba.data(), int(picture.width * 4));
+  return bytes;
+}
+
+std::optional<std::string> writePng(const std::string& path, const Picture& picture) {
+  return writeFileAtomically(path, encodePng(picture));
 }
 
 Picture readPng(const std::string& path) {

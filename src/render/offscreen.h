@@ -1,6 +1,7 @@
 #pragma once
 /// Rendering without a window: the scene resolved into an offscreen image and read back.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,8 +36,10 @@ private:
   gpu::Buffer readback_;
 };
 
-/// Writes a picture as PNG; returns false when the file cannot be written.
-bool writePng(const std::string& path, const Picture& picture);
+/// The picture encoded as PNG bytes.
+std::string encodePng(const Picture& picture);
+/// Writes a picture as PNG atomically (see core/output.h); returns the error on failure.
+std::optional<std::string> writePng(const std::string& path, const Picture& picture);
 /// Reads a PNG as RGBA8; returns an empty picture when it cannot be read.
 Picture readPng(const std::string& path);
 

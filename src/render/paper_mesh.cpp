@@ -1,9 +1,16 @@
 #include "paper_mesh.h"
 
+#include "gpu/gpu_solver.h"
+
 #include <algorithm>
 #include <cstring>
 
 namespace tender::render {
+
+PaperBuffers gpuPaperBuffers(gpu::GpuSolver& solver) {
+  return {solver.positionBuffer(), solver.normalBuffer(),  solver.uvBuffer(),
+          solver.triangleBuffer(), solver.counterBuffer(), gpu::GpuSolver::kDrawArgsOffset};
+}
 
 HostPaperMesh::HostPaperMesh(gpu::VulkanContext& ctx, const SheetTopology& topo) : ctx_(ctx) {
   particles_ = std::max(topo.particleCount(), 1u);

@@ -4,7 +4,14 @@
 #include "core/solver.h"
 #include "renderer.h"
 
+namespace tender::gpu {
+class GpuSolver;
+}
+
 namespace tender::render {
+
+/// The GPU solver's own buffers as the renderer binds them (no copy).
+PaperBuffers gpuPaperBuffers(gpu::GpuSolver& solver);
 
 /// One set of host-visible buffers (pos, normal, uv, triangles, draw arguments).
 class HostPaperMesh {

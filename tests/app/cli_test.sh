@@ -42,6 +42,62 @@ expect_bad "${sim[@]}" --script "$tmp/range.txt"
 expect_bad "${sim[@]}" --script /
 expect_bad sim --ticks -5
 expect_bad sim --bogus-flag
+expect_bad "${sim[@]}" --ticks 0x10
+expect_bad "${sim[@]}" --ticks 100000001
+# Coordinates beyond +-1e6 (or beyond float) are refused; a tick number must fit.
+printf '0 grab particle 1535\n1 move 1e30 1e30 1e30\n' >"$tmp/far.txt"
+expect_bad "${sim[@]}" --script "$tmp/far.txt"
+printf '0 grab particle 1535\n1 move 1e39 0 0\n' >"$tmp/inf.txt"
+expect_bad "${sim[@]}" --script "$tmp/inf.txt"
+printf '0 grab ray 3e38 0 10 0 0 -1\n' >"$tmp/ray.txt"
+expect_bad "${sim[@]}" --script "$tmp/ray.txt"
+printf '99999999999999999999999 reset\n' >"$tmp/tick.txt"
+expect_bad "${sim[@]}" --script "$tmp/tick.txt"
+# Outputs: checked before the run, never two outputs in one file, write errors are errors.
+expect_bad "${sim[@]}" --stats /dev/full
+expect_bad "${sim[@]}" --out /dev/full
+expect_bad "${sim[@]}" --stats "$tmp/same" --out "$tmp/same"
+expect_bad "${sim[@]}" --stats "$tmp/nostats.json" --out /nonexistent/dir/x.ply
+[ -e "$tmp/nostats.json" ] && { echo "FAIL: a failed run left its stats file"; failures=$((failures + 1)); }
+expect_bad "${sim[@]}" --stats "$tmp"
+
+# An empty script is a script with no events.
+: >"$tmp/empty.txt"
+"$T" "${sim[@]}" --script "$tmp/empty.txt" >/dev/null 2>"$tmp/err" || { echo "FAIL: empty script: $(cat "$tmp/err")"; failures=$((failures + 1)); }
+
+# A yank to the edge of the allowed coordinates keeps every position finite, torn or not.
+printf '0 grab particle 1535\n1 move 999999 999999 -999999\n' >"$tmp/edge.txt"
+for tear in 2.5 0; do
+  "$T" sim --backend cpu --ticks 200 --set tear_factor=$tear --script "$tmp/edge.txt" --stats "$tmp/edge.json" >/dev/null &&
+    python3 -c "import json,sys; s=json.load(open(sys.argv[1])); assert s['nan_count']==0, s" "$tmp/edge.json" &&
+    echo "ok: yank to 999999 with tear_factor=$tear stays finite" ||
+    { echo "FAIL: yank to 999999 with tear_factor=$tear"; failures=$((failures + 1)); }
+done
+
+# A write that fails (the file-size limit) exits 2, keeps the earlier good file and leaves no
+# temporary file; so does a run killed while it writes.
+"$T" sim --backend cpu --ticks 2 --out "$tmp/keep.ply" --stats "$tmp/keep.json" >/dev/null
+cp "$tmp/keep.ply" "$tmp/keep.orig"
+(ulimit -f 8; exec "$T" sim --backend cpu --ticks 2 --set cols=64 --set rows=64 --out "$tmp/keep.ply") >/dev/null 2>"$tmp/err"
+rc=$?
+if [ "$rc" -ne 2 ] || [ "$(wc -l <"$tmp/err")" -ne 1 ] || ! cmp -s "$tmp/keep.ply" "$tmp/keep.orig"; then
+  echo "FAIL: over the file-size limit -> exit $rc: $(cat "$tmp/err")"; failures=$((failures + 1))
+else
+  echo "ok: over the file-size limit -> $(cat "$tmp/err"), earlier file intact"
+fi
+ls -A "$tmp" | grep -q '\.tmp\.' && { echo "FAIL: a temporary file was left"; failures=$((failures + 1)); }
+"$T" sim --backend cpu --ticks 1 --set cols=700 --set rows=700 --set threads=1 --out "$tmp/keep.ply" >/dev/null 2>&1 &
+victim=$!
+sleep 1.5
+kill -9 "$victim" 2>/dev/null
+wait "$victim" 2>/dev/null
+size=$(stat -c %s "$tmp/keep.ply")
+if cmp -s "$tmp/keep.ply" "$tmp/keep.orig" ||
+   python3 -c "import sys; d=open(sys.argv[1],'rb').read(); h=d.split(b'end_header\n')[0].decode(); v=int(h.split('element vertex ')[1].split()[0]); f=int(h.split('element face ')[1].split()[0]); assert len(d)==len(h)+11+12*v+13*f" "$tmp/keep.ply"; then
+  echo "ok: a run killed while writing leaves the earlier file or the whole new one"
+else
+  echo "FAIL: a killed run left a fragment ($size bytes)"; failures=$((failures + 1))
+fi
 
 # A good run writes stats and a PLY that matches them.
 printf '# yank a corner\n0 grab particle 1535\n1 move 4 -4 6\n20 release\n' >"$tmp/yank.txt"

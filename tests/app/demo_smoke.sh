@@ -28,6 +28,17 @@ export DISPLAY=$display
 for _ in $(seq 50); do xdpyinfo >/dev/null 2>&1 && break; sleep 0.1; done
 
 fail() { echo "FAIL: $*"; echo "--- demo output"; cat "$tmp/demo.log"; exit 1; }
+
+# No usable display: one line `tender: error: ...` naming the cause, exit 2.
+DISPLAY=:9999 "$DEMO" --backend cpu >"$tmp/nodisplay.out" 2>"$tmp/nodisplay.err"
+rc=$?
+[ "$rc" -eq 2 ] && [ "$(wc -l <"$tmp/nodisplay.err")" -eq 1 ] && grep -q '^tender: error: ' "$tmp/nodisplay.err" ||
+  { cat "$tmp/nodisplay.err"; fail "no usable display -> exit $rc, not one error line"; }
+echo "ok: no usable display -> $(cat "$tmp/nodisplay.err")"
+# An unwritable --record is refused before the window opens.
+"$DEMO" --backend cpu --record /nonexistent/dir/input.txt >/dev/null 2>"$tmp/record.err"
+rc=$?
+[ "$rc" -eq 2 ] && [ "$(wc -l <"$tmp/record.err")" -eq 1 ] || { cat "$tmp/record.err"; fail "unwritable --record -> exit $rc"; }
 alive() { kill -0 "$demo" 2>/dev/null || fail "tender-demo exited during: $1"; }
 shot() { xwd -root -silent | convert xwd:- "$tmp/$1.png"; }
 

@@ -34,6 +34,45 @@ expect_bad() {
   if [ "$rc" -ne 2 ] || [ "$(wc -l <"$tmp/e")" -ne 1 ]; then fail "tender $* -> exit $rc: $(cat "$tmp/e")"; else echo "ok: tender $* -> $(cat "$tmp/e")"; fi
 }
 expect_bad render --width 4 --out "$tmp/x.png"
+expect_bad render --backend cpu --ticks 1 --width 64 --height 64 --out /dev/full
+printf '0 grab particle 99999\n' >"$tmp/range.txt"
+expect_bad render --backend cpu --script "$tmp/range.txt" --out "$tmp/x.png"
+# Without a display: --replay and --record are honoured (a missing replay, an unwritable record: exit 2).
+expect_bad_nodisplay() {
+  (cd "$tmp" && env -u DISPLAY -u WAYLAND_DISPLAY "$T" "$@" >"$tmp/o" 2>"$tmp/e")
+  local rc=$?
+  if [ "$rc" -ne 2 ] || [ "$(wc -l <"$tmp/e")" -ne 1 ]; then fail "tender $* (no display) -> exit $rc: $(cat "$tmp/e")"; else echo "ok: tender $* (no display) -> $(cat "$tmp/e")"; fi
+}
+expect_bad_nodisplay --backend cpu --width 64 --height 64 --replay "$tmp/missing.txt"
+printf 'garbage\n' >"$tmp/garbage.txt"
+expect_bad_nodisplay --backend cpu --width 64 --height 64 --replay "$tmp/garbage.txt"
+expect_bad_nodisplay --backend cpu --width 64 --height 64 --record /nonexistent/dir/r.txt
+printf '0 wind off\n0 grab particle 1520\n1 move 0 -9 0\n' >"$tmp/replay.txt"
+(cd "$tmp" && env -u DISPLAY -u WAYLAND_DISPLAY "$T" --backend cpu --width 64 --height 64 --replay replay.txt --record rec.txt >/dev/null 2>&1) &&
+  grep -q "move 0 -9 0" "$tmp/rec.txt" && echo "ok: no display: the replay is rendered and recorded" ||
+  fail "no display: --replay/--record not honoured"
+
+# A Vulkan error at run time (the driver cannot allocate under a memory limit) is one line, exit 2.
+(ulimit -v 800000; exec "$T" sim --backend gpu --set cols=512 --set rows=512 --ticks 1) >"$tmp/o" 2>"$tmp/e"
+rc=$?
+if [ "$rc" -ne 2 ] || [ "$(wc -l <"$tmp/e")" -ne 1 ] || ! grep -q '^tender: error: ' "$tmp/e"; then
+  fail "a Vulkan error at run time -> exit $rc: $(cat "$tmp/e")"
+else
+  echo "ok: a Vulkan error at run time -> $(cat "$tmp/e")"
+fi
+# A sheet larger than the device binds is refused with one line.
+expect_bad sim --backend gpu --set cols=4096 --set rows=2048 --ticks 1
+# Loader notices are not validation messages: the layer enabled through the environment too.
+VK_INSTANCE_LAYERS=VK_LAYER_KHRONOS_validation "$T" render --validation --backend gpu --ticks 3 --width 64 --height 64 \
+  --out "$tmp/v.png" >"$tmp/o" 2>"$tmp/e" && echo "ok: VK_INSTANCE_LAYERS with --validation" ||
+  fail "VK_INSTANCE_LAYERS with --validation: $(cat "$tmp/e")"
+# A sheet of one particle, and a yank to the edge of the allowed coordinates, on the GPU.
+"$T" sim --backend gpu --validation --set cols=1 --set rows=1 --ticks 3 >"$tmp/o" 2>"$tmp/e" && echo "ok: a 1x1 sheet on the GPU" ||
+  fail "1x1 sheet on the GPU: $(cat "$tmp/e")"
+printf '0 grab particle 1535\n1 move 999999 999999 -999999\n' >"$tmp/edge.txt"
+"$T" sim --backend gpu --ticks 200 --set tear_factor=0 --script "$tmp/edge.txt" --stats "$tmp/edge.json" >/dev/null &&
+  python3 -c "import json,sys; s=json.load(open(sys.argv[1])); assert s['nan_count']==0, s" "$tmp/edge.json" &&
+  echo "ok: a yank to 999999 stays finite on the GPU" || fail "a yank to 999999 on the GPU"
 expect_bad render --backend cpu --script "$tmp/missing.txt" --out "$tmp/x.png"
 expect_bad render --backend cpu --ticks 1 --out /nonexistent/dir/x.png
 

@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "core/params.h"
 #include "core/script.h"
+#include "core/sheet.h"
 
 using namespace tender;
 
@@ -93,4 +96,59 @@ TEST(Script, RejectsMalformedLines) {
   std::string err;
   EXPECT_FALSE(loadScript("/nonexistent/script.txt", err));
   EXPECT_NE(err.find("cannot read"), std::string::npos);
+  EXPECT_FALSE(loadScript("/", err));
+  EXPECT_NE(err.find("folder"), std::string::npos) << err;
+}
+
+TEST(Script, CoordinatesAndTicksStayInRange) {
+  std::string err;
+  // Beyond +-kMaxCoordinate, or beyond float, or not decimal: refused with the reason.
+  for (const char* bad :
+       {"1 move 1e30 0 0", "1 move 0 0 -1e39", "1 move 0 1000001 0", "0 grab ray 3e38 0 0 0 0 -1",
+        "0 grab ray 0 0 0 1 inf 0", "99999999999999999999999 reset", "1000000000001 reset", "0x10 reset", "+5 reset"}) {
+    EXPECT_FALSE(parseScript(bad, err)) << bad;
+    EXPECT_NE(err.find("line 1"), std::string::npos) << err;
+  }
+  auto edge = parseScript("1000000000000 move 1000000 -1000000 999999.5", err);
+  ASSERT_TRUE(edge) << err;
+  EXPECT_EQ(edge->events[0].a, glm::vec3(1e6f, -1e6f, 999999.5f));
+}
+
+TEST(Script, AnEmptyFileHasNoEvents) {
+  const std::string path = ::testing::TempDir() + "/tender_empty_script.txt";
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  ASSERT_TRUE(f);
+  std::fclose(f);
+  std::string err;
+  auto s = loadScriptFor(path, 10, err);
+  ASSERT_TRUE(s) << err;
+  EXPECT_TRUE(s->events.empty());
+  std::remove(path.c_str());
+}
+
+TEST(Params, SheetCountsMatchTheBuiltSheet) {
+  for (const char* name : {"tender", "crumple", "tender-low"})
+    for (auto [cols, rows] : {std::pair{1u, 1u}, {2u, 1u}, {3u, 7u}, {32u, 48u}, {17u, 2u}}) {
+      SimParams p = *presetParams(name);
+      p.cols = cols;
+      p.rows = rows;
+      const SheetCounts c = sheetCounts(p);
+      const SheetTopology t = buildSheet(p);
+      EXPECT_EQ(c.particles, t.particleCount()) << name << " " << cols << "x" << rows;
+      EXPECT_EQ(c.constraints, t.constraintCount()) << name << " " << cols << "x" << rows;
+      EXPECT_EQ(c.triangles, t.triangleCount()) << name << " " << cols << "x" << rows;
+      EXPECT_EQ(c.hash_buckets, t.hash_size) << name << " " << cols << "x" << rows;
+    }
+}
+
+TEST(Params, MemoryEstimateRefusesWhatDoesNotFit) {
+  SimParams p = *presetParams("tender");
+  p.cols = p.rows = 1024;
+  // About 1 KB per particle on the CPU, more on a GPU whose buffers live in host memory.
+  const uint64_t cpu = estimateSheetBytes(p, "cpu"), gpu = estimateSheetBytes(p, "gpu");
+  EXPECT_GT(cpu, 900ull << 20);
+  EXPECT_GT(gpu, cpu);
+  // 4096 x 4096 is within the particle limit and needs over 15 GiB.
+  p.cols = p.rows = 4096;
+  EXPECT_GT(estimateSheetBytes(p, "cpu"), 15ull << 30);
 }

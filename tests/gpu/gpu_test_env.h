@@ -3,15 +3,14 @@
 // synchronization validation always on; any validation message fails the test.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <initializer_list>
 #include <memory>
 #include <string>
 
-#include "core/params.h"
-#include "core/script.h"
-#include "core/simulation.h"
+#include "common/sim_helpers.h"
 #include "gpu/context.h"
 
 namespace tender::test {
@@ -43,41 +42,29 @@ inline bool inCi() {
   return ci && std::strcmp(ci, "true") == 0;
 }
 
-/// Parameters of a preset with overrides (which must be valid).
-inline SimParams preset(const char* name, std::initializer_list<const char*> sets = {}) {
-  SimParams p = *presetParams(name);
-  for (const char* s : sets) {
-    auto err = applyOverride(p, s);
-    EXPECT_FALSE(err) << *err;
-  }
-  auto err = validate(p);
-  EXPECT_FALSE(err) << *err;
-  return p;
-}
-
-/// Parses an input script.
-inline InputScript script(const char* text) {
-  std::string err;
-  auto s = parseScript(text, err);
-  EXPECT_TRUE(s) << err;
-  return s ? *s : InputScript{};
-}
-
-/// Ticks the simulation and reads the state back.
-inline SimState run(Simulation& sim, int ticks) {
-  for (int t = 0; t < ticks; ++t) sim.tick();
-  SimState s;
-  sim.solver().computeNormals();
-  sim.solver().readback(s);
-  return s;
-}
-
-/// Largest |a - b| over the xyz of two position arrays.
+/// Largest |a - b| over the xyz of two position arrays (infinite when their sizes differ).
 inline float maxAbsDiff(const std::vector<glm::vec4>& a, const std::vector<glm::vec4>& b) {
+  if (a.size() != b.size()) return INFINITY;
   float m = 0.0f;
-  for (size_t i = 0; i < std::min(a.size(), b.size()); ++i)
+  for (size_t i = 0; i < a.size(); ++i)
     for (int k = 0; k < 3; ++k) m = std::max(m, std::abs(a[i][k] - b[i][k]));
   return m;
+}
+
+/// Parity: two states hold the same bits in their positions and previous positions, and the same
+/// number of particles (an empty or short read-back fails). On failure: the first particle that
+/// differs and the largest difference.
+inline ::testing::AssertionResult sameState(const SimState& a, const SimState& b) {
+  if (a.pos.empty() || a.pos.size() != b.pos.size() || a.prev.size() != b.prev.size())
+    return ::testing::AssertionFailure() << "the states differ in size: " << a.pos.size() << " and " << b.pos.size()
+                                         << " particles";
+  if (sameBytes(a.pos, b.pos) && sameBytes(a.prev, b.prev)) return ::testing::AssertionSuccess();
+  size_t first = 0;
+  while (first < a.pos.size() && std::memcmp(&a.pos[first], &b.pos[first], sizeof(glm::vec4)) == 0 &&
+         std::memcmp(&a.prev[first], &b.prev[first], sizeof(glm::vec4)) == 0)
+    ++first;
+  return ::testing::AssertionFailure() << "the states part at particle " << first
+                                       << "; max |dx| = " << maxAbsDiff(a.pos, b.pos);
 }
 
 /// Base of every GPU test: gets the context (skip or, under CI, fail without one) and fails the
@@ -88,6 +75,9 @@ protected:
     std::string why;
     ctx_ = testContext(why);
     if (!ctx_) {
+      // Every GPU test runs under validation: a missing layer fails everywhere (tools/setup
+      // installs it), while a machine without any Vulkan device skips outside CI.
+      if (why.find("VK_LAYER_KHRONOS_validation") != std::string::npos) FAIL() << why;
       if (inCi()) FAIL() << "no Vulkan device under CI=true: " << why;
       GTEST_SKIP() << "no Vulkan device (" << why << "); GPU tests skipped";
     }
@@ -98,8 +88,12 @@ protected:
       EXPECT_EQ(ctx_->validationMessages(), messages_) << "validation messages during the test";
     }
   }
+
+public:
+  /// The shared context (set up unless the test was skipped).
   gpu::VulkanContext& ctx() { return *ctx_; }
 
+protected:
   gpu::VulkanContext* ctx_ = nullptr;
   uint32_t messages_ = 0;
 };

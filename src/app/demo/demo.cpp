@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <optional>
 
@@ -14,11 +13,10 @@
 #include <imgui_impl_vulkan.h>
 
 #include "../commands.h"
+#include "core/output.h"
 #include "core/simulation.h"
-#include "cpu/cpu_solver.h"
 #include "gpu/gpu_solver.h"
 #include "hud.h"
-#include "render/headless.h"
 #include "render/paper_mesh.h"
 #include "render/renderer.h"
 #include "swapchain.h"
@@ -77,7 +75,7 @@ private:
   VkSurfaceKHR surface_ = VK_NULL_HANDLE;
   std::unique_ptr<demo::Swapchain> swapchain_;
   std::unique_ptr<render::Renderer> renderer_;
-  std::unique_ptr<Solver> solver_;
+  Backend backend_;
   std::unique_ptr<Simulation> sim_;
   std::vector<std::unique_ptr<render::HostPaperMesh>> host_meshes_;
   std::unique_ptr<demo::Hud> hud_;
@@ -90,20 +88,29 @@ private:
   render::OrbitCamera camera_;
   Input input_;
   bool show_fps_ = false;
-  uint32_t grabs_ = 0; // grabs that caught a particle
-  std::ofstream record_;
+  uint32_t grabs_ = 0;      // grabs that caught a particle
+  OutputSet record_;        // --record: written when the session ends
+  std::string record_text_; // the events of the session so far, as an input script
   SimState state_;
 };
 
 DemoApp* appOf(GLFWwindow* w) { return static_cast<DemoApp*>(glfwGetWindowUserPointer(w)); }
 
+// The newest GLFW error, for the one line that reports a failed start.
+std::string g_glfw_error;
+bool g_glfw_started = false;
+
 bool DemoApp::init() {
-  glfwSetErrorCallback(
-      [](int code, const char* text) { std::fprintf(stderr, "tender-demo: GLFW %d: %s\n", code, text); });
+  glfwSetErrorCallback([](int code, const char* text) {
+    g_glfw_error = text ? text : std::to_string(code);
+    if (g_glfw_started) std::fprintf(stderr, "tender-demo: GLFW %d: %s\n", code, g_glfw_error.c_str());
+  });
   if (!glfwInit()) {
-    fail("cannot open a window (no display?); try `tender render`");
+    fail("cannot open a window (" + (g_glfw_error.empty() ? std::string("no display?") : g_glfw_error) +
+         "); try `tender render`");
     return false;
   }
+  g_glfw_started = true;
   if (!glfwVulkanSupported()) {
     fail("the Vulkan loader has no window-system support");
     return false;
@@ -177,23 +184,19 @@ bool DemoApp::init() {
   initImGui(options_.ui_scale > 0.0f ? options_.ui_scale : std::max(xs, 1.0f));
 
   createSolver();
-  if (!options_.replay.empty()) {
-    std::string error;
-    auto script = loadScript(options_.replay, error);
-    if (!script) {
-      fail(error);
-      return false;
-    }
-    sim_->setScript(*script);
+  if (!backend_.solver) return false;
+  std::string error;
+  auto replay = scriptFor(options_.replay, common_.params, error);
+  if (!replay) {
+    fail(error);
+    return false;
   }
-  if (!options_.record.empty()) {
-    record_.open(options_.record);
-    if (!record_) {
-      fail("cannot write '" + options_.record + "'");
-      return false;
-    }
-    record_ << "# tender input script recorded by tender-demo, preset " << common_.params.preset << "\n";
+  sim_->setScript(*replay);
+  if (auto err = record_.add(options_.record)) {
+    fail(*err);
+    return false;
   }
+  record_text_ = "# tender input script recorded by tender-demo, preset " + common_.params.preset + "\n";
   return true;
 }
 
@@ -231,11 +234,13 @@ void DemoApp::initImGui(float scale) {
 }
 
 void DemoApp::createSolver() {
-  if (common_.backend == "cpu")
-    solver_ = std::make_unique<CpuSolver>();
-  else
-    solver_ = std::make_unique<gpu::GpuSolver>(*ctx_);
-  sim_ = std::make_unique<Simulation>(common_.params, *solver_);
+  BackendOptions bo = common_.backendOptions();
+  bo.context = ctx_.get();
+  if (auto err = createBackend(bo, backend_)) {
+    fail(*err);
+    return;
+  }
+  sim_ = std::make_unique<Simulation>(common_.params, *backend_.solver);
   panel_params_ = common_.params;
   attachPaper();
 }
@@ -244,8 +249,8 @@ void DemoApp::attachPaper() {
   ctx_->waitIdle();
   host_meshes_.clear();
   for (uint32_t s = 0; s < kFramesInFlight; ++s) {
-    if (auto* g = dynamic_cast<gpu::GpuSolver*>(solver_.get())) {
-      renderer_->setPaper(s, render::gpuPaperBuffers(*g));
+    if (backend_.gpu) {
+      renderer_->setPaper(s, render::gpuPaperBuffers(*backend_.gpu));
     } else {
       host_meshes_.push_back(std::make_unique<render::HostPaperMesh>(*ctx_, sim_->topology()));
       renderer_->setPaper(s, host_meshes_.back()->buffers());
@@ -272,7 +277,8 @@ void DemoApp::recreateSwapchain() {
 }
 
 DemoApp::~DemoApp() {
-  if (ctx_) ctx_->waitIdle();
+  // No checked calls here: the destructor also runs while a Vulkan error unwinds.
+  if (ctx_) vkDeviceWaitIdle(ctx_->device());
   if (imgui_ready_) {
     ImGui_ImplVulkan_Shutdown();
     ImGui_ImplGlfw_Shutdown();
@@ -290,7 +296,7 @@ DemoApp::~DemoApp() {
   }
   host_meshes_.clear();
   sim_.reset();
-  solver_.reset();
+  backend_ = Backend{};
   renderer_.reset();
   swapchain_.reset();
   if (surface_) vkDestroySurfaceKHR(ctx_->instance(), surface_, nullptr);
@@ -308,7 +314,7 @@ render::Ray DemoApp::cursorRay() const {
 void DemoApp::apply(ScriptEvent e) {
   e.tick = sim_->frameCount();
   sim_->apply(e);
-  if (record_.is_open()) record_ << formatEvent(e) << '\n' << std::flush;
+  if (!options_.record.empty()) record_text_ += formatEvent(e) + "\n";
 }
 
 void DemoApp::onMouseButton(GLFWwindow* w, int button, int action, int) {
@@ -431,12 +437,12 @@ void DemoApp::handleActions(const demo::HudActions& a) {
   if (a.preset) {
     if (auto p = presetParams(*a.preset)) switchParams(*p, true);
   } else if (a.rebuild) {
-    if (auto err = validate(panel_params_))
+    if (auto err = validate(panel_params_, common_.backend))
       std::fprintf(stderr, "tender-demo: %s\n", err->c_str());
     else
       switchParams(panel_params_, false);
   } else if (a.live_changed) {
-    if (!validate(panel_params_)) {
+    if (!validate(panel_params_, common_.backend)) {
       // Grid size edits wait for "Rebuild sheet"; everything else applies now.
       SimParams live = panel_params_;
       live.cols = sim_->params().cols;
@@ -462,7 +468,7 @@ void DemoApp::drawFrame(const render::SceneView& view) {
 
   // The CPU backend's state goes to this slot's host-visible buffers.
   if (!host_meshes_.empty()) {
-    solver_->readback(state_);
+    backend_.solver->readback(state_);
     host_meshes_[slot_]->update(state_);
   }
   ImGui::Render();
@@ -547,7 +553,7 @@ int DemoApp::run() {
         input_.pending_move.reset();
       }
       sim_->advance(dt);
-      solver_->computeNormals();
+      backend_.solver->computeNormals();
     }
     hs.seconds = sim_start ? std::chrono::duration<double>(now - *sim_start).count() : 0.0;
     // "Initialising…" stays for a moment, then fades out over half a second.
@@ -558,7 +564,7 @@ int DemoApp::run() {
     hs.wind = sim_->wind();
     hs.pins = sim_->pins();
     hs.device = device;
-    PassTimes times = solver_->passTimes();
+    PassTimes times = backend_.solver->passTimes();
     hs.times = &times;
 
     ImGui_ImplVulkan_NewFrame();
@@ -576,10 +582,12 @@ int DemoApp::run() {
   std::printf("tender-demo: %llu frames in %.1f s (%.1f FPS), %llu physics ticks, %u grabs\n",
               static_cast<unsigned long long>(frames), seconds, seconds > 0 ? double(frames) / seconds : 0.0,
               static_cast<unsigned long long>(sim_->physicsTicks()), grabs_);
-  if (common_.validation && ctx_->validationMessages() > 0) {
-    std::fprintf(stderr, "tender-demo: %u validation messages\n", ctx_->validationMessages());
-    return 1;
+  if (!options_.record.empty()) {
+    if (auto err = record_.stage(options_.record, record_text_)) return fail(*err);
+    if (auto err = record_.commit()) return fail(*err);
   }
+  if (common_.validation && ctx_->validationMessages() > 0)
+    return fail(std::to_string(ctx_->validationMessages()) + " validation messages");
   return 0;
 }
 

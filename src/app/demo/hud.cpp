@@ -122,19 +122,28 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
         if (ImGui::Selectable(name.c_str(), name == params.preset)) a.preset = name;
       ImGui::EndCombo();
     }
-    int substeps = int(params.substeps), iterations = int(params.iterations);
-    if (ImGui::SliderInt("substeps", &substeps, 1, SIM_MAX_SUBSTEPS))
-      params.substeps = uint32_t(substeps), a.live_changed = true;
-    if (ImGui::SliderInt("iterations", &iterations, 1, 32))
-      params.iterations = uint32_t(iterations), a.live_changed = true;
-    a.live_changed |= ImGui::SliderFloat("damping", &params.damping, 0.9f, 1.0f, "%.4f");
-    a.live_changed |= ImGui::SliderFloat("wind strength", &params.wind_strength, 0.0f, 5.0f, "%.2f");
-    a.live_changed |= ImGui::SliderFloat("tear factor", &params.tear_factor, 0.0f, 6.0f, "%.2f");
+    // Sliders over the ranges `--set` accepts (the parameter table); wide ones are logarithmic.
+    auto slideUint = [&](const char* label, const char* key, uint32_t& v) {
+      const ParamInfo info = *paramInfo(key);
+      int i = int(v);
+      if (ImGui::SliderInt(label, &i, int(info.lo), int(info.hi), "%d", ImGuiSliderFlags_Logarithmic))
+        v = uint32_t(i), a.live_changed = true;
+    };
+    auto slideFloat = [&](const char* label, const char* key, float& v, const char* format, bool logarithmic) {
+      const ParamInfo info = *paramInfo(key);
+      a.live_changed |= ImGui::SliderFloat(label, &v, float(info.lo), float(info.hi), format,
+                                           logarithmic ? ImGuiSliderFlags_Logarithmic : 0);
+    };
+    slideUint("substeps", "substeps", params.substeps);
+    slideUint("iterations", "iterations", params.iterations);
+    slideFloat("damping", "damping", params.damping, "%.4f", false);
+    slideFloat("wind strength", "wind_strength", params.wind_strength, "%.2f", true);
+    slideFloat("tear factor", "tear_factor", params.tear_factor, "%.2f", true);
     a.live_changed |= ImGui::Checkbox("collision", &params.collision);
     int grid[2] = {int(params.cols), int(params.rows)};
     if (ImGui::InputInt2("grid (cols, rows)", grid)) {
-      params.cols = uint32_t(std::clamp(grid[0], 2, 4096));
-      params.rows = uint32_t(std::clamp(grid[1], 2, 4096));
+      params.cols = uint32_t(std::clamp(grid[0], int(paramInfo("cols")->lo), int(paramInfo("cols")->hi)));
+      params.rows = uint32_t(std::clamp(grid[1], int(paramInfo("rows")->lo), int(paramInfo("rows")->hi)));
     }
     if (ImGui::Button("Rebuild sheet")) a.rebuild = true;
     if (!s.device.empty()) ImGui::TextDisabled("%s", s.device.c_str());

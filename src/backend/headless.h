@@ -1,23 +1,20 @@
 #pragma once
-/// A picture of a preset without a window: build the sheet, run N ticks (optionally replaying an
-/// input script), render it offscreen.
+/// A picture of a preset without a window: build the sheet on the chosen backend (sharing the
+/// renderer's Vulkan context), run N ticks (optionally replaying an input script), render it
+/// offscreen.
 #include <cstdint>
 #include <string>
 
 #include "core/params.h"
 #include "core/script.h"
-#include "offscreen.h"
-
-namespace tender::gpu {
-class GpuSolver;
-}
+#include "render/offscreen.h"
 
 namespace tender::render {
 
 /// What to render.
 struct HeadlessOptions {
   SimParams params;
-  std::string backend = "gpu"; ///< cpu or gpu
+  std::string backend = "gpu"; ///< a createBackend name
   int device = -1;             ///< Vulkan device index, -1 = best
   bool validation = false;     ///< VK_LAYER_KHRONOS_validation
   bool quiet = false;          ///< count validation messages without printing them
@@ -33,10 +30,8 @@ struct HeadlessResult {
   std::string error;                ///< empty on success
 };
 
-/// The solver's own buffers as the renderer binds them (no copy).
-PaperBuffers gpuPaperBuffers(gpu::GpuSolver& solver);
-
-/// Runs the simulation and renders it; a missing device sets `error` (a missing font throws).
+/// Runs the simulation and renders it; a missing device, a Vulkan error or a missing font set
+/// `error`.
 HeadlessResult renderHeadless(const HeadlessOptions& options);
 
 } // namespace tender::render

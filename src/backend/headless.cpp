@@ -1,18 +1,14 @@
 #include "headless.h"
 
+#include <exception>
 #include <memory>
 
+#include "backend.h"
 #include "core/simulation.h"
-#include "cpu/cpu_solver.h"
 #include "gpu/gpu_solver.h"
-#include "paper_mesh.h"
+#include "render/paper_mesh.h"
 
 namespace tender::render {
-
-PaperBuffers gpuPaperBuffers(gpu::GpuSolver& solver) {
-  return {solver.positionBuffer(), solver.normalBuffer(),  solver.uvBuffer(),
-          solver.triangleBuffer(), solver.counterBuffer(), gpu::GpuSolver::kDrawArgsOffset};
-}
 
 HeadlessResult renderHeadless(const HeadlessOptions& o) {
   HeadlessResult result;
@@ -27,18 +23,24 @@ HeadlessResult renderHeadless(const HeadlessOptions& o) {
     return result;
   }
   std::unique_ptr<gpu::VulkanContext> ctx = std::move(created.value());
-  {
+  try {
     // The receipt first: a missing font is reported before any work.
     ReceiptImage receipt = rasterizeReceipt(receiptText(o.params.preset));
-    std::unique_ptr<Solver> solver;
-    if (o.backend == "cpu")
-      solver = std::make_unique<CpuSolver>();
-    else
-      solver = std::make_unique<gpu::GpuSolver>(*ctx);
-    Simulation sim(o.params, *solver);
+    BackendOptions bo;
+    bo.backend = o.backend;
+    bo.threads = o.params.threads;
+    bo.context = ctx.get();
+    Backend backend;
+    if (auto err = createBackend(bo, backend)) {
+      result.error = *err;
+      return result;
+    }
+    Solver& solver = *backend.solver;
+    Simulation sim(o.params, solver);
     sim.setScript(o.script);
     for (uint64_t t = 0; t < o.ticks; ++t) sim.tick();
-    solver->computeNormals();
+    solver.computeNormals();
+    solver.finish();
 
     RendererOptions ro;
     ro.color_format = OffscreenTarget::kFormat;
@@ -47,12 +49,11 @@ HeadlessResult renderHeadless(const HeadlessOptions& o) {
     Renderer renderer(*ctx, ro, receipt);
     renderer.buildAll();
     std::unique_ptr<HostPaperMesh> host;
-    if (auto* g = dynamic_cast<gpu::GpuSolver*>(solver.get())) {
-      g->finish();
-      renderer.setPaper(0, gpuPaperBuffers(*g));
+    if (backend.gpu) {
+      renderer.setPaper(0, gpuPaperBuffers(*backend.gpu));
     } else {
       SimState state;
-      solver->readback(state);
+      solver.readback(state);
       host = std::make_unique<HostPaperMesh>(*ctx, sim.topology());
       host->update(state);
       renderer.setPaper(0, host->buffers());
@@ -60,6 +61,9 @@ HeadlessResult renderHeadless(const HeadlessOptions& o) {
     OffscreenTarget target(*ctx, renderer, o.width, o.height);
     result.picture = target.render(defaultSceneView(sim.params()));
     ctx->waitIdle();
+  } catch (const std::exception& e) {
+    result.error = e.what();
+    return result;
   }
   result.validation_messages = ctx->validationMessages();
   return result;

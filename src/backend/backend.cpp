@@ -1,0 +1,60 @@
+#include "backend.h"
+
+#include <exception>
+
+#include "cpu/cpu_solver.h"
+#ifdef TENDER_HAS_GPU
+#include "gpu/gpu_solver.h"
+#endif
+
+namespace tender {
+
+std::vector<std::string> backendNames() { return {"cpu", "gpu", "gpu-percolor"}; }
+
+bool vulkanBuilt() {
+#ifdef TENDER_HAS_GPU
+  return true;
+#else
+  return false;
+#endif
+}
+
+std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) {
+  out = Backend{};
+  if (o.backend == "cpu") {
+    CpuOptions co;
+    co.threads = o.threads;
+    co.min_chunk = o.min_chunk;
+    auto cpu = std::make_unique<CpuSolver>(co);
+    out.cpu = cpu.get();
+    out.solver = std::move(cpu);
+    return std::nullopt;
+  }
+  if (o.backend != "gpu" && o.backend != "gpu-percolor") return "unknown backend '" + o.backend + "' (cpu or gpu)";
+#ifdef TENDER_HAS_GPU
+  try {
+    std::unique_ptr<gpu::GpuSolver> solver;
+    if (o.context) {
+      solver = std::make_unique<gpu::GpuSolver>(*o.context);
+    } else {
+      gpu::ContextOptions co;
+      co.device = o.device;
+      co.validation = o.validation;
+      auto ctx = gpu::VulkanContext::create(co);
+      if (!ctx) return ctx.error() + " (try --backend cpu)";
+      solver = std::make_unique<gpu::GpuSolver>(std::move(ctx.value()));
+    }
+    if (o.backend == "gpu-percolor") solver->setFusedPath(false);
+    out.gpu = solver.get();
+    out.solver = std::move(solver);
+  } catch (const std::exception& e) {
+    out = Backend{};
+    return e.what();
+  }
+  return std::nullopt;
+#else
+  return std::string("this build has no Vulkan backend (try --backend cpu)");
+#endif
+}
+
+} // namespace tender

@@ -1,0 +1,50 @@
+#pragma once
+/// The one way every program (tender sim, render, the demo, tender-bench, the tests) builds a
+/// solver: the CPU reference on the threads the parameters ask for, or the Vulkan compute solver
+/// on its own or on a shared context.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/solver.h"
+
+namespace tender {
+
+class CpuSolver;
+namespace gpu {
+class GpuSolver;
+class VulkanContext;
+} // namespace gpu
+
+/// What to build.
+struct BackendOptions {
+  /// "cpu"; "gpu"; or "gpu-percolor", the GPU solver without its fused small-sheet tick.
+  std::string backend = "gpu";
+  int device = -1;         ///< Vulkan device index (`tender devices`), -1 = prefer a discrete GPU
+  bool validation = false; ///< VK_LAYER_KHRONOS_validation with synchronization validation
+  uint32_t threads = 0;    ///< CPU solver workers (SimParams::threads): 0 = one per hardware thread
+  uint32_t min_chunk = 0;  ///< CPU solver: smallest loop share worth a thread; 0 = tuned (CpuOptions)
+  /// Run the GPU solver on this context (the renderer's) instead of creating one; it must outlive
+  /// the backend.
+  gpu::VulkanContext* context = nullptr;
+};
+
+/// A solver, and the concrete solver behind it for what only that backend offers (the renderer
+/// draws the GPU solver's buffers; tools read the CPU solver's thread count).
+struct Backend {
+  std::unique_ptr<Solver> solver;
+  CpuSolver* cpu = nullptr;      ///< the solver, when it is the CPU reference
+  gpu::GpuSolver* gpu = nullptr; ///< the solver, when it runs on Vulkan
+};
+
+/// The backend names createBackend takes.
+std::vector<std::string> backendNames();
+/// True when this build has the Vulkan backend.
+bool vulkanBuilt();
+
+/// Builds a backend; on failure returns one line (an unknown name, no Vulkan device, a Vulkan
+/// error) and leaves `out` empty.
+std::optional<std::string> createBackend(const BackendOptions& options, Backend& out);
+
+} // namespace tender

@@ -1,0 +1,143 @@
+#include "output.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+namespace tender {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string cannotWrite(const std::string& path, const std::string& why) {
+  return "cannot write '" + path + "': " + why;
+}
+
+std::string folderOf(const std::string& path) {
+  const fs::path parent = fs::path(path).parent_path();
+  return parent.empty() ? std::string(".") : parent.string();
+}
+
+// True when the path names something that exists and is not a regular file (a device, a pipe):
+// such outputs are written in place.
+bool isSpecial(const std::string& path) {
+  struct stat st {};
+  return stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode);
+}
+
+// Writes through `write` to `f`, then flushes and closes it; false (errno set) on any failure.
+bool writeAndClose(std::FILE* f, const FileWriter& write, bool sync) {
+  bool ok = write(f);
+  int saved = ok ? 0 : errno;
+  if (std::fflush(f) != 0 || std::ferror(f)) ok = false, saved = saved ? saved : errno;
+  if (ok && sync && fsync(fileno(f)) != 0 && errno != EINVAL) ok = false, saved = errno;
+  if (std::fclose(f) != 0 && ok) ok = false, saved = errno;
+  if (!ok) errno = saved ? saved : EIO;
+  return ok;
+}
+
+mode_t fileMode() {
+  const mode_t mask = umask(0);
+  umask(mask);
+  return 0666 & ~mask;
+}
+
+} // namespace
+
+std::optional<std::string> checkOutputPath(const std::string& path) {
+  if (path.empty()) return std::string("an output path is empty");
+  struct stat st {};
+  if (stat(path.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode)) return cannotWrite(path, "it is a folder");
+    if (!S_ISREG(st.st_mode)) {
+      if (access(path.c_str(), W_OK) != 0) return cannotWrite(path, std::strerror(errno));
+      return std::nullopt;
+    }
+  }
+  const std::string folder = folderOf(path);
+  if (stat(folder.c_str(), &st) != 0) return cannotWrite(path, "folder '" + folder + "' does not exist");
+  if (!S_ISDIR(st.st_mode)) return cannotWrite(path, "'" + folder + "' is not a folder");
+  if (access(folder.c_str(), W_OK | X_OK) != 0) return cannotWrite(path, std::strerror(errno));
+  return std::nullopt;
+}
+
+OutputSet::~OutputSet() {
+  for (const Pending& p : staged_)
+    if (!p.temp.empty()) std::remove(p.temp.c_str());
+}
+
+std::optional<std::string> OutputSet::add(const std::string& path) {
+  if (path.empty()) return std::nullopt;
+  if (auto err = checkOutputPath(path)) return err;
+  std::error_code ec;
+  const fs::path canonical = fs::weakly_canonical(path, ec);
+  for (const std::string& other : paths_) {
+    const fs::path o = fs::weakly_canonical(other, ec);
+    if (o == canonical && !isSpecial(path))
+      return "two outputs name the same file '" + path + "'" + (other != path ? " ('" + other + "')" : "");
+  }
+  paths_.push_back(path);
+  return std::nullopt;
+}
+
+std::optional<std::string> OutputSet::stage(const std::string& path, const FileWriter& write) {
+  if (isSpecial(path)) {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f || !writeAndClose(f, write, false)) return cannotWrite(path, std::strerror(errno));
+    staged_.push_back({path, ""});
+    return std::nullopt;
+  }
+  const fs::path target(path);
+  std::string temp = (fs::path(folderOf(path)) / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
+  const int fd = mkstemp(temp.data());
+  if (fd < 0) return cannotWrite(path, std::strerror(errno));
+  staged_.push_back({path, temp});
+  if (fchmod(fd, fileMode()) != 0) {
+    const int saved = errno;
+    close(fd);
+    return cannotWrite(path, std::strerror(saved));
+  }
+  std::FILE* f = fdopen(fd, "wb");
+  if (!f) {
+    const int saved = errno;
+    close(fd);
+    return cannotWrite(path, std::strerror(saved));
+  }
+  if (!writeAndClose(f, write, true)) return cannotWrite(path, std::strerror(errno));
+  return std::nullopt;
+}
+
+std::optional<std::string> OutputSet::stage(const std::string& path, const std::string& bytes) {
+  return stage(path, [&](std::FILE* f) { return std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size(); });
+}
+
+std::optional<std::string> OutputSet::commit() {
+  for (Pending& p : staged_) {
+    if (p.temp.empty()) continue;
+    if (std::rename(p.temp.c_str(), p.path.c_str()) != 0) return cannotWrite(p.path, std::strerror(errno));
+    p.temp.clear();
+  }
+  staged_.clear();
+  return std::nullopt;
+}
+
+std::optional<std::string> writeFileAtomically(const std::string& path, const FileWriter& write) {
+  OutputSet out;
+  if (auto err = out.add(path)) return err;
+  if (auto err = out.stage(path, write)) return err;
+  return out.commit();
+}
+
+std::optional<std::string> writeFileAtomically(const std::string& path, const std::string& bytes) {
+  return writeFileAtomically(
+      path, [&](std::FILE* f) { return std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size(); });
+}
+
+void ignoreFileSizeSignal() { std::signal(SIGXFSZ, SIG_IGN); }
+
+} // namespace tender

@@ -1,0 +1,58 @@
+#pragma once
+/// Output files written safely: every path is checked before a run starts, every file is written
+/// to a temporary file beside it, flushed and closed with every error checked, then renamed over
+/// the target, so a reader sees the old file or the whole new one, never a fragment. A failed
+/// write leaves any earlier file untouched. Paths that are not regular files (/dev/stdout, a pipe)
+/// are written in place, with the same checks.
+#include <cstdio>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace tender {
+
+/// Writes a file's bytes to an open stream; returns false on failure (errno set).
+using FileWriter = std::function<bool(std::FILE*)>;
+
+/// Checks that `path` can be written: its folder exists and is writable, and it is not a folder.
+/// Returns "cannot write '<path>': <why>" on failure.
+std::optional<std::string> checkOutputPath(const std::string& path);
+
+/// A set of output files committed together: stage() writes each to a temporary file, commit()
+/// renames them all into place; files staged but not committed are removed.
+class OutputSet {
+public:
+  OutputSet() = default;
+  ~OutputSet();
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+
+  /// Registers an output before the run: checks the path (checkOutputPath) and that no other
+  /// output of the set names the same file. An empty path is ignored.
+  std::optional<std::string> add(const std::string& path);
+  /// Writes one registered output to its temporary file; returns the error on failure.
+  std::optional<std::string> stage(const std::string& path, const FileWriter& write);
+  /// As stage(), with the bytes given.
+  std::optional<std::string> stage(const std::string& path, const std::string& bytes);
+  /// Renames every staged file into place; returns the first error.
+  std::optional<std::string> commit();
+
+private:
+  struct Pending {
+    std::string path, temp;
+  };
+  std::vector<std::string> paths_;
+  std::vector<Pending> staged_;
+};
+
+/// Writes one file atomically (an OutputSet of one); returns the error on failure.
+std::optional<std::string> writeFileAtomically(const std::string& path, const FileWriter& write);
+/// As writeFileAtomically(), with the bytes given.
+std::optional<std::string> writeFileAtomically(const std::string& path, const std::string& bytes);
+
+/// Makes write errors on a file beyond the size limit (ulimit -f) ordinary I/O errors (EFBIG)
+/// instead of a signal that kills the process.
+void ignoreFileSizeSignal();
+
+} // namespace tender

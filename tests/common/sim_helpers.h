@@ -1,0 +1,51 @@
+#pragma once
+/// Helpers of every test that drives a Simulation, whatever the backend: parameters of a preset
+/// with overrides, input scripts, running and reading back.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <initializer_list>
+#include <vector>
+
+#include "core/params.h"
+#include "core/script.h"
+#include "core/simulation.h"
+
+namespace tender::test {
+
+/// Parameters of a preset with overrides (which must be valid).
+inline SimParams preset(const char* name, std::initializer_list<const char*> sets = {}) {
+  SimParams p = *presetParams(name);
+  for (const char* s : sets) {
+    auto err = applyOverride(p, s);
+    EXPECT_FALSE(err) << *err;
+  }
+  auto err = validate(p);
+  EXPECT_FALSE(err) << *err;
+  return p;
+}
+
+/// Parses an input script (which must be valid).
+inline InputScript script(const char* text) {
+  std::string err;
+  auto s = parseScript(text, err);
+  EXPECT_TRUE(s) << err;
+  return s ? *s : InputScript{};
+}
+
+/// Ticks the simulation, recomputes the normals and reads the state back.
+inline SimState run(Simulation& sim, int ticks) {
+  for (int t = 0; t < ticks; ++t) sim.tick();
+  SimState s;
+  sim.solver().computeNormals();
+  sim.solver().readback(s);
+  return s;
+}
+
+/// True when two arrays hold the same bytes (and are the same size).
+template <typename T>
+bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+} // namespace tender::test
