@@ -14,62 +14,42 @@ void GpuSolver::bindSet(VkCommandBuffer cmd, uint32_t uniform_slot) {
   bound_ = VK_NULL_HANDLE;
 }
 
-template <class Push>
-void GpuSolver::dispatchThreads(VkCommandBuffer cmd, const ComputePipeline& p, uint32_t count, const Push& push) {
-  assert(sizeof(Push) == p.push_size);
-  if (sizeof(Push) != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
-  if (count == 0) return;
-  if (bound_ != p.pipeline) {
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-    bound_ = p.pipeline;
-  }
-  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Push), &push);
-  // Grids wider than SIM_MAX_GROUPS_X spill into Y (the shaders linearise the group index).
+void GpuSolver::dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
+                         uint32_t push_size) {
+  if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
+  if (grid == Grid::Threads && count == 0) return;
+  // The full grid of `count` elements; wider than SIM_MAX_GROUPS_X spills into Y (the shaders
+  // linearise the group index).
   const uint32_t groups = (count + p.workgroup - 1) / p.workgroup;
   const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X);
-  vkCmdDispatch(cmd, gx, (groups + gx - 1) / gx, 1);
-  ++recorded_dispatches_;
-}
-
-void GpuSolver::dispatchWorkgroup(VkCommandBuffer cmd, const ComputePipeline& p, const FusedPush& push) {
-  if (sizeof(push) != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
-  if (bound_ != p.pipeline) {
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-    bound_ = p.pipeline;
+  const glm::uvec4 full(gx, gx ? (groups + gx - 1) / gx : 0u, 1u, 0u);
+  uint32_t hash_slot = 0;
+  if (grid == Grid::Hash) {
+    // Every substep records the same hash passes into the same live slots
+    hash_slot = hash_slot_++;
+    if (hash_slot >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
+    if (hash_slot == hash_grids_.size()) hash_grids_.push_back(full);
+    if (hash_grids_[hash_slot] != full) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
   }
-  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
-  vkCmdDispatch(cmd, 1, 1, 1);
-  ++recorded_dispatches_;
-}
-
-void GpuSolver::dispatchIndirect(VkCommandBuffer cmd, const ComputePipeline& p, const void* push, uint32_t push_size) {
-  if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
   if (bound_ != p.pipeline) {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
     bound_ = p.pipeline;
   }
   if (push_size) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_size, push);
-  vkCmdDispatchIndirect(cmd, buf_[SIM_BIND_COUNTERS].buffer, offsetof(Counters, compact_dispatch));
-  ++recorded_dispatches_;
-}
-
-template <class Push>
-void GpuSolver::dispatchHash(VkCommandBuffer cmd, const ComputePipeline& p, uint32_t count, const Push& push) {
-  if (sizeof(Push) != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
-  const uint32_t groups = (count + p.workgroup - 1) / p.workgroup;
-  const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X);
-  const glm::uvec4 grid(gx, (groups + gx - 1) / gx, 1u, 0u);
-  // Every substep records the same hash passes into the same live slots
-  const uint32_t slot = hash_slot_++;
-  if (slot >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
-  if (slot == hash_grids_.size()) hash_grids_.push_back(grid);
-  if (hash_grids_[slot] != grid) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
-  if (bound_ != p.pipeline) {
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-    bound_ = p.pipeline;
+  switch (grid) {
+  case Grid::Threads:
+    vkCmdDispatch(cmd, full.x, full.y, 1);
+    break;
+  case Grid::Workgroup:
+    vkCmdDispatch(cmd, 1, 1, 1);
+    break;
+  case Grid::Compaction:
+    vkCmdDispatchIndirect(cmd, buf_[SIM_BIND_COUNTERS].buffer, offsetof(Counters, compact_dispatch));
+    break;
+  case Grid::Hash:
+    vkCmdDispatchIndirect(cmd, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * hash_slot);
+    break;
   }
-  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Push), &push);
-  vkCmdDispatchIndirect(cmd, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * slot);
   ++recorded_dispatches_;
 }
 
@@ -78,17 +58,11 @@ void GpuSolver::recordScan(VkCommandBuffer cmd, uint32_t mode, uint32_t offset, 
   // Exclusive scan: block scans, then (several blocks) scan the block sums and add them back.
   const uint32_t blocks = (count + SIM_SCAN_BLOCK - 1) / SIM_SCAN_BLOCK;
   ScanPush push{mode, offset, count, sums};
-  auto dispatch = [&](const ComputePipeline& p) {
-    if (grid == Grid::Compaction)
-      dispatchIndirect(cmd, p, &push, sizeof(push));
-    else
-      dispatchHash(cmd, p, count, push);
-  };
-  dispatch(pipes_.scan);
+  dispatch(cmd, pipes_.scan, grid, count, push);
   computeToCompute(cmd);
   if (blocks <= 1) return;
   recordScan(cmd, SIM_SCAN_SCRATCH, sums, blocks, sums + blocks, grid);
-  dispatch(pipes_.scan_add);
+  dispatch(cmd, pipes_.scan_add, grid, count, push);
   computeToCompute(cmd);
 }
 
@@ -121,14 +95,15 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
     // Small sheet: every pass of fused_substeps_ substeps (on a GPU: all) in one workgroup
     for (uint32_t s = 0; s < key.substeps; s += fused_substeps_) {
       if (s > 0) computeToCompute(cmd);
-      dispatchWorkgroup(cmd, pipes_.tick_fused, FusedPush{n, s, std::min(fused_substeps_, key.substeps - s), 0});
+      dispatch(cmd, pipes_.tick_fused, Grid::Workgroup, 1,
+               FusedPush{n, s, std::min(fused_substeps_, key.substeps - s), 0});
     }
     timestamp(cmd, slot, kFused);
   } else {
     for (uint32_t s = 0; s < key.substeps; ++s) {
       all.substep = s;
       // 1. Verlet integration
-      dispatchThreads(cmd, pipes_.integrate, n, all);
+      dispatch(cmd, pipes_.integrate, Grid::Threads, n, all);
       computeToCompute(cmd);
       timestamp(cmd, slot, kIntegrate);
       // 2. Gauss-Seidel over colours; constraints beyond a colour's live count exit
@@ -136,7 +111,7 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
         for (uint32_t c = 0; c < topo_.colorCount(); ++c) {
           const ColorRange& range = topo_.colors[c];
           if (range.count == 0) continue;
-          dispatchThreads(cmd, pipes_.project, range.count, SimPush{range.first, range.count, s, c});
+          dispatch(cmd, pipes_.project, Grid::Threads, range.count, SimPush{range.first, range.count, s, c});
           computeToCompute(cmd);
         }
       timestamp(cmd, slot, kProject);
@@ -144,37 +119,37 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
         // 3. Candidate lists still good? Spatial hash: count, scan, scatter, order within bucket
         // (each pass does nothing when the lists stand in for it); then gather repulsion and
         // update the lists' state
-        dispatchThreads(cmd, pipes_.near_check, n, all);
+        dispatch(cmd, pipes_.near_check, Grid::Threads, n, all);
         computeToCompute(cmd);
-        dispatchThreads(cmd, pipes_.near_decide, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0});
+        dispatch(cmd, pipes_.near_decide, Grid::Threads, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0});
         computeToCompute(cmd);
         hash_slot_ = 0;
-        dispatchHash(cmd, pipes_.hash_count, n, all);
+        dispatch(cmd, pipes_.hash_count, Grid::Hash, n, all);
         computeToCompute(cmd);
         recordScan(cmd, SIM_SCAN_HASH, 0, topo_.hash_size, hash_sums_, Grid::Hash);
-        dispatchHash(cmd, pipes_.hash_scatter, n, all);
+        dispatch(cmd, pipes_.hash_scatter, Grid::Hash, n, all);
         computeToCompute(cmd);
-        dispatchHash(cmd, pipes_.hash_sort, n, all);
+        dispatch(cmd, pipes_.hash_sort, Grid::Hash, n, all);
         computeToCompute(cmd);
         timestamp(cmd, slot, kHash);
-        dispatchThreads(cmd, pipes_.collide, n, all);
+        dispatch(cmd, pipes_.collide, Grid::Threads, n, all);
         computeToCompute(cmd);
-        dispatchThreads(cmd, pipes_.near_finish, 1, all);
+        dispatch(cmd, pipes_.near_finish, Grid::Threads, 1, all);
         computeToCompute(cmd);
         timestamp(cmd, slot, kCollide);
       }
       // 4. Collision deltas and ground contact
-      dispatchThreads(cmd, pipes_.floor, n, all);
+      dispatch(cmd, pipes_.floor, Grid::Threads, n, all);
       computeToCompute(cmd);
       timestamp(cmd, slot, kFloor);
       // 5. Tear marking; the compaction runs zero workgroups unless something tore this substep
       if (m > 0) {
-        dispatchThreads(cmd, pipes_.tear_mark, m, SimPush{0, m, s, 0});
+        dispatch(cmd, pipes_.tear_mark, Grid::Threads, m, SimPush{0, m, s, 0});
         computeToCompute(cmd);
-        dispatchIndirect(cmd, pipes_.tear_flags, nullptr, 0);
+        dispatch(cmd, pipes_.tear_flags, Grid::Compaction, 0, nullptr, 0);
         computeToCompute(cmd);
         recordScan(cmd, SIM_SCAN_SCRATCH, 0, tear_slots_, tear_sums_, Grid::Compaction);
-        dispatchIndirect(cmd, pipes_.tear_compact, nullptr, 0);
+        dispatch(cmd, pipes_.tear_compact, Grid::Compaction, 0, nullptr, 0);
         computeToCompute(cmd);
       }
       timestamp(cmd, slot, kTear);
@@ -202,7 +177,7 @@ void GpuSolver::recordReset(Slot& slot, uint32_t index) {
   anyToCompute(cmd);
   bindSet(cmd, index);
   const uint32_t n = topo_.particleCount();
-  dispatchThreads(cmd, pipes_.reset, n, SimPush{0, n, 0, 0});
+  dispatch(cmd, pipes_.reset, Grid::Threads, n, SimPush{0, n, 0, 0});
   computeToAll(cmd);
   VK_CHECK(vkEndCommandBuffer(cmd));
 }
@@ -217,14 +192,10 @@ void GpuSolver::recordNormals() {
   bindSet(cmd, kStaticSlot);
   if (normals_queries_) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, normals_queries_, 0);
   const uint32_t n = topo_.particleCount();
-  dispatchThreads(cmd, pipes_.normals, n, SimPush{0, n, 0, 0});
+  dispatch(cmd, pipes_.normals, Grid::Threads, n, SimPush{0, n, 0, 0});
   computeToAll(cmd);
   if (normals_queries_) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, normals_queries_, 1);
   VK_CHECK(vkEndCommandBuffer(cmd));
 }
-
-template void GpuSolver::dispatchThreads<SimPush>(VkCommandBuffer, const ComputePipeline&, uint32_t, const SimPush&);
-template void GpuSolver::dispatchThreads<ScanPush>(VkCommandBuffer, const ComputePipeline&, uint32_t, const ScanPush&);
-template void GpuSolver::dispatchThreads<PickPush>(VkCommandBuffer, const ComputePipeline&, uint32_t, const PickPush&);
 
 } // namespace tender::gpu

@@ -28,7 +28,7 @@ struct FusedShape {
 struct ComputePipeline {
   VkPipeline pipeline = VK_NULL_HANDLE;
   uint32_t push_size = 0; ///< bytes of the shader's push-constant block (0: none)
-  uint32_t workgroup = 0; ///< local_size_x
+  uint32_t workgroup = 0; ///< elements one workgroup covers: local_size_x (from the SPIR-V) x elements per invocation
 };
 
 /// Every pipeline of the simulation (one file per shader in shaders/sim/).
@@ -109,9 +109,9 @@ private:
   /// Uniform slot of the normals and pick passes (static: written at upload).
   static constexpr uint32_t kStaticSlot = kSlots;
   static constexpr uint32_t kBindingCount = SIM_BIND_HASH_ARGS + 1;
-  /// Where an indirect dispatch gets its grid: the tear compaction's arguments (zero workgroups
-  /// unless something tore), or the next live hash-pass argument.
-  enum class Grid : uint8_t { Compaction, Hash };
+  /// How a dispatch gets its grid: from the element count, one workgroup, the tear compaction's
+  /// arguments (zero workgroups unless something tore), or the next live hash-pass argument.
+  enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash };
   /// Timestamp categories, in passTimes() order.
   /// kFused: the fused small-sheet tick, every pass in one dispatch.
   enum Category : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kFused, kCategoryCount };
@@ -133,22 +133,45 @@ private:
     uint32_t dispatches = 0;
   };
 
+  /// One storage buffer of the sheet, as the table of bindings describes it (gpu_buffers.cpp).
+  struct BindingSpec {
+    uint32_t binding = 0;
+    VkDeviceSize bytes = 0;       ///< size, from the topology
+    const void* data = nullptr;   ///< start contents (nullptr: zeros)
+    VkDeviceSize data_bytes = 0;  ///< bytes of `data`
+    VkDeviceSize data_offset = 0; ///< where in the buffer `data` goes
+    bool restored = false;        ///< a reset restores it (what tearing changes)
+    bool read_back = false;       ///< readback() copies it
+  };
+  /// Start contents derived from the topology, which the table points into.
+  struct StartData {
+    std::vector<glm::vec4> pos, normal;
+    std::vector<uint32_t> adj_mask;
+    std::vector<glm::uvec2> colors;
+    uint32_t last_start = 0;
+    shaderio::Counters counters{};
+  };
+  /// The table of bindings of the uploaded topology (every storage binding, once).
+  std::vector<BindingSpec> bindingTable(StartData& start) const;
+  /// Records the start contents of the table's bindings (only those a reset restores).
+  void stageBindings(VkCommandBuffer cmd, const std::vector<BindingSpec>& table, bool restored_only,
+                     std::vector<Buffer>& staging);
   void createPipelines(FusedShape fused);
   void destroySheet();
   void writeStaticUniforms();
-  void uploadMutable(VkCommandBuffer cmd, std::vector<Buffer>& staging);
   void recordTick(Slot& slot, uint32_t index, const RecordKey& key);
   void recordReset(Slot& slot, uint32_t index);
   void recordNormals();
   void bindSet(VkCommandBuffer cmd, uint32_t uniform_slot);
+  /// The one dispatch helper: binds the pipeline, checks and pushes the constants, and dispatches
+  /// `count` elements (Threads), one workgroup (Workgroup), or the grid of an indirect argument
+  /// (Compaction, Hash: the next live hash-pass slot, whose full grid near_decide copies in).
+  void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
+                uint32_t push_size);
   template <class Push>
-  void dispatchThreads(VkCommandBuffer cmd, const ComputePipeline& p, uint32_t count, const Push& push);
-  void dispatchWorkgroup(VkCommandBuffer cmd, const ComputePipeline& p, const shaderio::FusedPush& push);
-  void dispatchIndirect(VkCommandBuffer cmd, const ComputePipeline& p, const void* push, uint32_t push_size);
-  /// A hash pass over `count` elements, its grid read from the next live SIM_BIND_HASH_ARGS slot
-  /// (near_decide fills it from the full grid recorded here, or zeroes it).
-  template <class Push>
-  void dispatchHash(VkCommandBuffer cmd, const ComputePipeline& p, uint32_t count, const Push& push);
+  void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const Push& push) {
+    dispatch(cmd, p, grid, count, &push, uint32_t(sizeof(Push)));
+  }
   void recordScan(VkCommandBuffer cmd, uint32_t mode, uint32_t offset, uint32_t count, uint32_t sums, Grid grid);
   void timestamp(VkCommandBuffer cmd, Slot& slot, Category c);
   void waitSlot(Slot& slot) const;
@@ -166,6 +189,7 @@ private:
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   SimPipelines pipes_;
   std::vector<VkShaderModule> modules_;
+  std::vector<VkPipeline> pipelines_; ///< every pipeline created, for the destructor
 
   std::array<Buffer, kBindingCount> buf_{};
   Buffer small_readback_; ///< host-visible: pick result and particle positions
