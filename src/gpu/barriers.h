@@ -20,6 +20,25 @@ inline void memoryBarrier(VkCommandBuffer cmd, VkPipelineStageFlags2 src_stage, 
   vkCmdPipelineBarrier2(cmd, &dep);
 }
 
+/// Everything submitted earlier finishes writing before any later command reads or writes.
+inline void allToAll(VkCommandBuffer cmd) {
+  memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+}
+
+/// What every command so far wrote is seen by later commands and, after the fence, by the host.
+inline void allToAllAndHost(VkCommandBuffer cmd) {
+  memoryBarrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT | VK_PIPELINE_STAGE_2_HOST_BIT,
+                VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT | VK_ACCESS_2_HOST_READ_BIT);
+}
+
+/// A copy's writes are seen by the host after the fence (a read-back).
+inline void transferToHost(VkCommandBuffer cmd) {
+  memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                VK_ACCESS_2_HOST_READ_BIT);
+}
+
 /// A compute pass reads (or overwrites, or dispatches indirectly from) what the previous one wrote.
 inline void computeToCompute(VkCommandBuffer cmd) {
   memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,

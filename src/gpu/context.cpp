@@ -1,5 +1,7 @@
 #include "context.h"
 
+#include "barriers.h"
+
 #include <algorithm>
 #include <cstring>
 
@@ -290,7 +292,7 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   }
   ctx->timestamp_period_ = ctx->props_.limits.timestampPeriod;
 
-  // Device: Vulkan 1.3 synchronization2 and dynamic rendering, plus the requested extensions.
+  // Device: Vulkan 1.3 synchronization2, plus the requested extensions.
   std::vector<const char*> dev_exts;
   for (auto& e : o.device_extensions) {
     if (!hasDeviceExtension(ctx->physical_, e))
@@ -310,7 +312,6 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   VkPhysicalDeviceVulkan13Features en13{};
   en13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
   en13.synchronization2 = VK_TRUE;
-  en13.dynamicRendering = f13.dynamicRendering;
   en13.maintenance4 = f13.maintenance4;
   VkPhysicalDeviceVulkan12Features en12{};
   en12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
@@ -429,23 +430,11 @@ void VulkanContext::submitOnce(const std::function<void(VkCommandBuffer)>& recor
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
-  // Everything submitted earlier on this queue finishes writing before these commands start.
-  VkMemoryBarrier2 mb{};
-  mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2;
-  mb.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-  mb.srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT;
-  mb.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-  mb.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
-  VkDependencyInfo dep{};
-  dep.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
-  dep.memoryBarrierCount = 1;
-  dep.pMemoryBarriers = &mb;
-  vkCmdPipelineBarrier2(cmd, &dep);
+  // Everything submitted earlier on this queue finishes writing before these commands start, and
+  // later submissions (and host reads after the fence) see what these commands wrote.
+  allToAll(cmd);
   record(cmd);
-  // ... and later submissions (and host reads after the fence) see what these commands wrote.
-  mb.dstAccessMask |= VK_ACCESS_2_HOST_READ_BIT;
-  mb.dstStageMask |= VK_PIPELINE_STAGE_2_HOST_BIT;
-  vkCmdPipelineBarrier2(cmd, &dep);
+  allToAllAndHost(cmd);
   VK_CHECK(vkEndCommandBuffer(cmd));
   submit(cmd, once_fence_);
   VK_CHECK(vkWaitForFences(device_, 1, &once_fence_, VK_TRUE, UINT64_MAX));

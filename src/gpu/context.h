@@ -6,10 +6,10 @@
 /// extensions (VK_KHR_surface + the platform one, e.g. from glfwGetRequiredInstanceExtensions)
 /// and the device extension VK_KHR_swapchain, call VulkanContext::create(), create its surface
 /// from `instance()`, then build a GpuSolver on the same context (`GpuSolver(ctx)`). Solver and
-/// renderer share `queue()`: the solver's submissions end with a compute → vertex-input barrier,
-/// so a frame submitted after a tick reads the solver's buffers (pos, normal, uv, triangles,
-/// counters.draw_args) directly, with no copy. Vulkan 1.3 synchronization2 and dynamic rendering
-/// are enabled on the device.
+/// renderer share `queue()`: the solver's submissions end with a barrier from compute to every
+/// later command (computeToAll in barriers.h), so a frame submitted after a tick reads the
+/// solver's buffers (pos, normal, uv, triangles, counters.draw_args) directly, with no copy. The
+/// renderer draws with render passes; Vulkan 1.3 synchronization2 is enabled on the device.
 #include <atomic>
 #include <cstdint>
 #include <cstdio>

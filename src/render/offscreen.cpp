@@ -1,6 +1,7 @@
 #include "offscreen.h"
 
 #include "core/output.h"
+#include "gpu/barriers.h"
 
 #include <cstring>
 
@@ -35,17 +36,7 @@ Picture OffscreenTarget::render(const SceneView& view) {
     copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     copy.imageExtent = {e.width, e.height, 1};
     vkCmdCopyImageToBuffer(cmd, image_.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.buffer, 1, &copy);
-    VkMemoryBarrier2 b{};
-    b.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2;
-    b.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-    b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    b.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-    b.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
-    VkDependencyInfo di{};
-    di.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
-    di.memoryBarrierCount = 1;
-    di.pMemoryBarriers = &b;
-    vkCmdPipelineBarrier2(cmd, &di);
+    gpu::transferToHost(cmd);
   });
   Picture p;
   p.width = e.width;
