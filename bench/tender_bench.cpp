@@ -177,10 +177,8 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   r["substeps"] = p.substeps;
   r["iterations"] = p.iterations;
 
-  BackendOptions bo;
-  bo.backend = backend;
+  BackendOptions bo = backendOptionsFor(backend, p);
   bo.device = o.device;
-  bo.threads = p.threads;
   Backend made;
   std::optional<Simulation> sim;
   try {

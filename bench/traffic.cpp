@@ -73,12 +73,12 @@ std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::
     // travel test; fused: the current one in shared memory), then its list's count and its
     // position (fused: shared memory), and writes delta. The entries and their positions depend
     // on how close the sheet comes to itself and are not counted.
-    const uint64_t base = cpu ? kSortedPos : kPos; // CpuSolver::near_base_ holds xyz only
+    const uint64_t base = cpu ? kSortedPos : kPos; // CpuCollision's candidate bases hold xyz only
     hash.read += n * (base + (fused ? 0 : kPos));
     collide.read += n * (kIndex + (fused ? 0 : kPos));
     collide.write += n * kPos;
   } else if (collision && cpu) {
-    // hash (CpuSolver::buildHash), step by step:
+    // hash (CpuCollision::buildHash), step by step:
     hash.read += n * kPos;                     // cell of each particle: read pos,
     hash.write += n * (kCoord + kIndex);       //   write particle_coord_, particle_cell_
     hash.read += n * 2 * kIndex;               // count: read particle_cell_ and a count per particle,

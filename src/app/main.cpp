@@ -14,11 +14,9 @@ int fail(const std::string& message) {
 }
 
 BackendOptions CommonOptions::backendOptions() const {
-  BackendOptions b;
-  b.backend = backend;
+  BackendOptions b = backendOptionsFor(backend, params);
   b.device = device;
   b.validation = validation;
-  b.threads = params.threads;
   return b;
 }
 

@@ -9,6 +9,14 @@
 
 namespace tender {
 
+BackendOptions backendOptionsFor(const std::string& backend, const SimParams& params) {
+  BackendOptions o;
+  o.backend = backend;
+  o.threads = params.threads;
+  o.simd = params.simd;
+  return o;
+}
+
 std::vector<std::string> backendNames() { return {"cpu", "gpu", "gpu-percolor"}; }
 
 bool vulkanBuilt() {
@@ -25,6 +33,7 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
     CpuOptions co;
     co.threads = o.threads;
     co.min_chunk = o.min_chunk;
+    co.simd = o.simd;
     auto cpu = std::make_unique<CpuSolver>(co);
     out.cpu = cpu.get();
     out.solver = std::move(cpu);

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/params.h"
 #include "core/solver.h"
 
 namespace tender {
@@ -25,6 +26,7 @@ struct BackendOptions {
   bool validation = false; ///< VK_LAYER_KHRONOS_validation with synchronization validation
   uint32_t threads = 0;    ///< CPU solver workers (SimParams::threads): 0 = one per hardware thread
   uint32_t min_chunk = 0;  ///< CPU solver: smallest loop share worth a thread; 0 = tuned (CpuOptions)
+  bool simd = true;        ///< CPU solver SIMD kernels (SimParams::simd)
   /// Run the GPU solver on this context (the renderer's) instead of creating one; it must outlive
   /// the backend.
   gpu::VulkanContext* context = nullptr;
@@ -37,6 +39,9 @@ struct Backend {
   CpuSolver* cpu = nullptr;      ///< the solver, when it is the CPU reference
   gpu::GpuSolver* gpu = nullptr; ///< the solver, when it runs on Vulkan
 };
+
+/// Options of a backend for a sheet of these parameters: its CPU threads and SIMD switch.
+BackendOptions backendOptionsFor(const std::string& backend, const SimParams& params);
 
 /// The backend names createBackend takes.
 std::vector<std::string> backendNames();

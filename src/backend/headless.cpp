@@ -26,9 +26,7 @@ HeadlessResult renderHeadless(const HeadlessOptions& o) {
   try {
     // The receipt first: a missing font is reported before any work.
     ReceiptImage receipt = rasterizeReceipt(receiptText(o.params.preset));
-    BackendOptions bo;
-    bo.backend = o.backend;
-    bo.threads = o.params.threads;
+    BackendOptions bo = backendOptionsFor(o.backend, o.params);
     bo.context = ctx.get();
     Backend backend;
     if (auto err = createBackend(bo, backend)) {

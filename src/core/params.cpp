@@ -116,6 +116,7 @@ const std::vector<Param>& params() {
                 "velocity on release: zero, drag"),
       floatParam("grab_radius", &SimParams::grab_radius, 0.0f, 100.0f, "pick radius around the ray"),
       uintParam("threads", &SimParams::threads, 0, 255, "CPU solver threads, 0: one per core (same results)"),
+      boolParam("simd", &SimParams::simd, "CPU solver SIMD kernels; off: the plain scalar reference (same results)"),
   };
   return table;
 }

@@ -59,6 +59,7 @@ struct SimParams {
   float grab_radius = 0.6f; ///< pick radius around the ray
   // Performance
   uint32_t threads = 0; ///< CPU solver worker threads; 0 = one per hardware thread (results do not change)
+  bool simd = true;     ///< CPU solver SIMD kernels; off runs the plain scalar reference (same results)
 
   uint32_t particleCount() const { return cols * rows; }
   float tickDt() const { return 1.0f / tick_hz; }

@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <initializer_list>
+#include <string>
 #include <vector>
 
 #include "core/params.h"
@@ -14,15 +15,18 @@
 namespace tender::test {
 
 /// Parameters of a preset with overrides (which must be valid).
-inline SimParams preset(const char* name, std::initializer_list<const char*> sets = {}) {
+inline SimParams preset(const std::string& name, const std::vector<std::string>& sets) {
   SimParams p = *presetParams(name);
-  for (const char* s : sets) {
+  for (const std::string& s : sets) {
     auto err = applyOverride(p, s);
     EXPECT_FALSE(err) << *err;
   }
   auto err = validate(p);
   EXPECT_FALSE(err) << *err;
   return p;
+}
+inline SimParams preset(const char* name, std::initializer_list<const char*> sets = {}) {
+  return preset(std::string(name), std::vector<std::string>(sets.begin(), sets.end()));
 }
 
 /// Parses an input script (which must be valid).

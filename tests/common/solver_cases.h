@@ -14,7 +14,7 @@
 #include <cmath>
 #include <memory>
 
-#include "core/free_fall.h"
+#include "common/free_fall.h"
 #include "core/stats.h"
 #include "sim_helpers.h"
 

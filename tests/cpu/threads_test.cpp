@@ -2,56 +2,21 @@
 // its collision candidate lists.
 #include <gtest/gtest.h>
 
-#include <cstring>
+#include <algorithm>
+#include <thread>
 
-#include "core/simulation.h"
-#include "cpu/cpu_solver.h"
+#include "cpu/cpu_runs.h"
 
 using namespace tender;
 
 namespace {
 
-// Runs `ticks` ticks of a preset (with overrides and a script) and returns the final state.
-SimState run(const std::string& preset, std::vector<std::string> sets, const std::string& script, uint32_t ticks,
+using test::expectIdentical;
+using test::tornCount;
+
+SimState run(const std::string& preset, const std::vector<std::string>& sets, const std::string& script, int ticks,
              CpuOptions options) {
-  SimParams p = *presetParams(preset);
-  for (auto& s : sets) EXPECT_FALSE(applyOverride(p, s).has_value()) << s;
-  EXPECT_FALSE(validate(p).has_value());
-  CpuSolver solver(options);
-  Simulation sim(p, solver);
-  if (!script.empty()) {
-    std::string error;
-    auto parsed = parseScript(script, error);
-    EXPECT_TRUE(parsed.has_value()) << error;
-    sim.setScript(*parsed);
-  }
-  for (uint32_t t = 0; t < ticks; ++t) sim.tick();
-  solver.computeNormals();
-  SimState s;
-  solver.readback(s);
-  return s;
-}
-
-template <typename T>
-bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
-
-void expectIdentical(const SimState& a, const SimState& b) {
-  EXPECT_TRUE(sameBytes(a.pos, b.pos));
-  EXPECT_TRUE(sameBytes(a.prev, b.prev));
-  EXPECT_TRUE(sameBytes(a.normal, b.normal));
-  EXPECT_TRUE(sameBytes(a.constraints, b.constraints));
-  EXPECT_TRUE(sameBytes(a.colors, b.colors));
-  EXPECT_TRUE(sameBytes(a.torn, b.torn));
-  EXPECT_TRUE(sameBytes(a.triangles, b.triangles));
-  EXPECT_EQ(a.triangle_count, b.triangle_count);
-}
-
-uint32_t tornCount(const SimState& s) {
-  uint32_t n = 0;
-  for (uint32_t t : s.torn) n += t ? 1u : 0u;
-  return n;
+  return test::runCpu(preset, sets, script, ticks, options);
 }
 
 // min_chunk = 1 splits every loop, however small, so the small sheets exercise every parallel path.
@@ -105,10 +70,10 @@ TEST(CpuThreads, ResetAndNoCollisionAreIdentical) {
                   run("tender", {"collision=off"}, script, 40, kTwo));
 }
 
-TEST(CpuThreads, ZeroMeansOnePerCore) {
-  CpuSolver solver(CpuOptions{0, 0});
-  EXPECT_GE(solver.threadCount(), 1u);
-  EXPECT_EQ(CpuSolver(CpuOptions{2, 0}).threadCount(), 2u);
+TEST(CpuThreads, ZeroMeansOnePerHardwareThread) {
+  const uint32_t cores = std::clamp(std::thread::hardware_concurrency(), 1u, 64u);
+  EXPECT_EQ(CpuSolver(CpuOptions{.threads = 0}).threadCount(), cores);
+  EXPECT_EQ(CpuSolver(CpuOptions{.threads = 3}).threadCount(), 3u);
 }
 
 TEST(CpuThreads, MemoryIsReported) {
@@ -119,7 +84,7 @@ TEST(CpuThreads, MemoryIsReported) {
   EXPECT_GE(solver.memoryBytes(), 1536u * 64u + 8818u * 16u);
 }
 
-TEST(CpuCollisionLists, ListsAreUsedAndChangeNothing) {
+TEST(CpuCandidateLists, ListsAreUsedAndChangeNothing) {
   // A sheet hanging in the wind: most substeps sum from the lists.
   SimParams p = *presetParams("tender");
   ASSERT_FALSE(applyOverride(p, "wind=on").has_value());
@@ -128,7 +93,7 @@ TEST(CpuCollisionLists, ListsAreUsedAndChangeNothing) {
   uint32_t on_lists = 0;
   for (int t = 0; t < 60; ++t) {
     sim.tick();
-    on_lists += solver.listState().x == 1u && solver.listState().y >= p.substeps ? 1u : 0u;
+    on_lists += solver.candidateState().x == 1u && solver.candidateState().y >= p.substeps ? 1u : 0u;
   }
   EXPECT_GT(on_lists, 30u);
   solver.computeNormals();
@@ -137,7 +102,7 @@ TEST(CpuCollisionLists, ListsAreUsedAndChangeNothing) {
   expectIdentical(with, run("tender", {"wind=on"}, "", 60, kOneNoLists));
 }
 
-TEST(CpuCollisionLists, DragTossAndCrowdsAreIdenticalWithoutLists) {
+TEST(CpuCandidateLists, DragTossAndCrowdsAreIdenticalWithoutLists) {
   // A drag that tears (lists outgrown, then waiting), a crumple toss, a radius of 1.6 spacings
   // (lists of several candidates each) and one of 2.5 spacings (lists overflow).
   const std::string drag = "0 grab particle 1535\n1 move 1 2 1\n10 move 2 0 2\n20 move 4 -4 6\n40 release\n";

@@ -1,0 +1,39 @@
+#pragma once
+/// Whole runs of the CPU solver and bitwise comparisons of their states, for the CPU tests.
+#include <string>
+#include <vector>
+
+#include "common/sim_helpers.h"
+#include "cpu/cpu_solver.h"
+
+namespace tender::test {
+
+/// Runs `ticks` ticks of a preset (with overrides and a script) and returns the final state.
+inline SimState runCpu(const std::string& preset_name, const std::vector<std::string>& sets,
+                       const std::string& script_text, int ticks, CpuOptions options) {
+  CpuSolver solver(options);
+  Simulation sim(preset(preset_name, sets), solver);
+  if (!script_text.empty()) sim.setScript(script(script_text.c_str()));
+  return run(sim, ticks);
+}
+
+/// Expects two states to be bitwise identical, array by array.
+inline void expectIdentical(const SimState& a, const SimState& b) {
+  EXPECT_TRUE(sameBytes(a.pos, b.pos));
+  EXPECT_TRUE(sameBytes(a.prev, b.prev));
+  EXPECT_TRUE(sameBytes(a.normal, b.normal));
+  EXPECT_TRUE(sameBytes(a.constraints, b.constraints));
+  EXPECT_TRUE(sameBytes(a.colors, b.colors));
+  EXPECT_TRUE(sameBytes(a.torn, b.torn));
+  EXPECT_TRUE(sameBytes(a.triangles, b.triangles));
+  EXPECT_EQ(a.triangle_count, b.triangle_count);
+}
+
+/// Number of torn constraints.
+inline uint32_t tornCount(const SimState& s) {
+  uint32_t n = 0;
+  for (uint32_t t : s.torn) n += t ? 1u : 0u;
+  return n;
+}
+
+} // namespace tender::test
