@@ -188,11 +188,11 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
     return skip(e.what());
   }
   Solver* solver = made.solver.get();
-  bool collision_lists = false;
+  bool candidate_lists = false;
   if (CpuSolver* cpu = made.cpu) {
     r["threads"] = cpu->threadCount();
-    collision_lists = cpu->usesCollisionLists();
-    r["collision_lists"] = collision_lists;
+    candidate_lists = cpu->usesCandidateLists();
+    r["candidate_lists"] = candidate_lists;
   } else {
     r["threads"] = 0;
   }
@@ -203,8 +203,8 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
     const bool fused = gpu_solver->usesFusedPath(sim->makeUniforms());
     r["fused"] = fused;
     layout = fused ? bench::Layout::GpuFused : bench::Layout::Gpu;
-    collision_lists = gpu_solver->usesCollisionLists();
-    r["collision_lists"] = collision_lists;
+    candidate_lists = gpu_solver->usesCandidateLists();
+    r["candidate_lists"] = candidate_lists;
   }
 #else
   const bench::Layout layout = bench::Layout::Cpu;
@@ -266,7 +266,7 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   uint64_t bytes = 0;
   nlohmann::json pass_bytes = nlohmann::json::object(), pass_gbps = nlohmann::json::object();
   for (const bench::PassTraffic& t :
-       bench::tickTraffic(sim->topology(), sim->makeUniforms(), layout, collision_lists)) {
+       bench::tickTraffic(sim->topology(), sim->makeUniforms(), layout, candidate_lists)) {
     bytes += t.bytes();
     pass_bytes[t.name] = {{"read", t.read}, {"write", t.write}};
     if (passes.contains(t.name) && passes[t.name].get<double>() > 0.0 && t.bytes() > 0)

@@ -36,7 +36,7 @@ constexpr uint64_t kSortedPos = 3 * sizeof(float);
 } // namespace
 
 std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::SimUniforms& u, Layout layout,
-                                     bool collision_lists) {
+                                     bool candidate_lists) {
   const bool cpu = layout == Layout::Cpu, fused = layout == Layout::GpuFused;
   const bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u, tear = shaderio::tearingOn(u.tear_factor);
   const uint64_t n = topo.particleCount();         // particles
@@ -67,7 +67,7 @@ std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::
       project.write += fused ? 0 : c.count * 2 * kPos;
     }
 
-  if (collision && collision_lists) {
+  if (collision && candidate_lists) {
     // The candidate lists in use (a substep that rebuilds them runs the hash and the search
     // below): each particle reads the position its list was built at and its current one (the
     // travel test; fused: the current one in shared memory), then its list's count and its
@@ -114,7 +114,7 @@ std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::
   }
 
   // floor: read pos, prev and (with collision) delta (on the CPU through particle_slot_); write pos, prev.
-  floor.read += n * (collision ? 3 : 2) * kPos + (collision && cpu && !collision_lists ? n * kIndex : 0);
+  floor.read += n * (collision ? 3 : 2) * kPos + (collision && cpu && !candidate_lists ? n * kIndex : 0);
   floor.write += n * 2 * kPos;
 
   // tear marking: read the constraint records and every position (each particle ends several

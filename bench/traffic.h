@@ -34,10 +34,10 @@ struct PassTraffic {
 /// per pass). Counts come from the topology (particles, constraints per colour, hash buckets,
 /// adjacency) and record sizes from the types the solvers store. Steady state: the tear
 /// compaction, which runs only in a substep where something tore, and the once-per-frame normals
-/// pass are not part of it; with `collision_lists`, the collision candidate lists are in use (no
+/// pass are not part of it; with `candidate_lists`, the collision candidate lists are in use (no
 /// hash is built).
 std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::SimUniforms& u, Layout layout,
-                                     bool collision_lists = false);
+                                     bool candidate_lists = false);
 
 /// A measured copy bandwidth.
 struct PeakBandwidth {

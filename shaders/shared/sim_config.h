@@ -58,8 +58,8 @@
 #define SIM_BIND_COMPACT_TMP 23
 #define SIM_BIND_CELL_POS 24
 #define SIM_BIND_ADJ_MASK 25
-#define SIM_BIND_NEAR 26
-#define SIM_BIND_NEAR_BASE 27
+#define SIM_BIND_CANDIDATES 26
+#define SIM_BIND_CANDIDATE_BASE 27
 #define SIM_BIND_HASH_ARGS 28
 
 // Adjacency masks (SIM_BIND_ADJ_MASK): bit (dy + 2) * 5 + (dx + 2) is set when particle i is
@@ -93,32 +93,32 @@
 // Largest hash table the fused tick takes (one workgroup scans it every substep)
 #define SIM_FUSED_MAX_BUCKETS 4096u
 
-// Candidate lists of the fused tick (SIM_BIND_NEAR): for each particle, the particles not
-// connected to it within collision radius + skin when the lists were built (SIM_BIND_NEAR_BASE
-// holds the positions then). While no particle has moved SIM_NEAR_TRAVEL x skin since, every pair
+// Candidate lists of the fused tick (SIM_BIND_CANDIDATES): for each particle, the particles not
+// connected to it within collision radius + skin when the lists were built (SIM_BIND_CANDIDATE_BASE
+// holds the positions then). While no particle has moved SIM_CANDIDATE_TRAVEL x skin since, every pair
 // closer than the radius is in the lists, so a substep reads the lists instead of rebuilding the
-// hash and searching 27 cells. Record of particle i: SIM_NEAR_STRIDE words at i * SIM_NEAR_STRIDE,
-// the count then up to SIM_NEAR_CAPACITY particles in ascending order.
-#define SIM_NEAR_CAPACITY 15u
-#define SIM_NEAR_STRIDE 16u
+// hash and searching 27 cells. Record of particle i: SIM_CANDIDATE_STRIDE words at i * SIM_CANDIDATE_STRIDE,
+// the count then up to SIM_CANDIDATE_CAPACITY particles in ascending order.
+#define SIM_CANDIDATE_CAPACITY 15u
+#define SIM_CANDIDATE_STRIDE 16u
 // Skin: this fraction of the collision radius, at most 0.99 x (cell - radius), so that the lists
-// come from the 27 cells around a particle; below SIM_NEAR_MIN_SKIN x radius no lists are kept
-#define SIM_NEAR_SKIN 0.5f
-#define SIM_NEAR_MIN_SKIN 0.05f
+// come from the 27 cells around a particle; below SIM_CANDIDATE_MIN_SKIN x radius no lists are kept
+#define SIM_CANDIDATE_SKIN 0.5f
+#define SIM_CANDIDATE_MIN_SKIN 0.05f
 // Lists are usable while every particle is within this fraction of the skin of where it was when
 // they were built (two particles then closed in by less than the skin, with room for rounding)
-#define SIM_NEAR_TRAVEL 0.45f
-// Lists outgrown within SIM_NEAR_MIN_AGE substeps, or overflowing, are not rebuilt for
-// SIM_NEAR_WAIT substeps: fast motion (a drag, a toss) uses the hash every substep instead
-#define SIM_NEAR_MIN_AGE 4u
+#define SIM_CANDIDATE_TRAVEL 0.45f
+// Lists outgrown within SIM_CANDIDATE_MIN_AGE substeps, or overflowing, are not rebuilt for
+// SIM_CANDIDATE_WAIT substeps: fast motion (a drag, a toss) uses the hash every substep instead
+#define SIM_CANDIDATE_MIN_AGE 4u
 // How a substep finds its collisions: build the hash and search the 27 cells within the radius;
 // sum from the candidate lists; or build the hash, search within radius + skin, build the lists
-#define SIM_NEAR_HASH 0u
-#define SIM_NEAR_LISTS 1u
-#define SIM_NEAR_BUILD 2u
-#define SIM_NEAR_WAIT 32u
+#define SIM_COLLIDE_HASH 0u
+#define SIM_COLLIDE_CANDIDATES 1u
+#define SIM_COLLIDE_BUILD 2u
+#define SIM_CANDIDATE_WAIT 32u
 // Indirect dispatches of the separate hash passes (SIM_BIND_HASH_ARGS holds this many live
-// arguments, then as many with every pass's full grid): near_decide zeroes the live ones in a
+// arguments, then as many with every pass's full grid): candidates_decide zeroes the live ones in a
 // substep that sums from the lists
 #define SIM_HASH_DISPATCHES 16u
 

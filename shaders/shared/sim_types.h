@@ -57,8 +57,8 @@ struct SimUniforms {
 // SimUniforms.flags bits
 #define SIM_FLAG_COLLISION 1u
 #define SIM_FLAG_PINS 2u
-// Set by the GPU solver when it keeps collision candidate lists (SIM_NEAR_* in sim_config.h)
-#define SIM_FLAG_NEAR 4u
+// Set by the GPU solver when it keeps collision candidate lists (SIM_CANDIDATE_* in sim_config.h)
+#define SIM_FLAG_CANDIDATES 4u
 
 /// Push constants of every simulation dispatch.
 struct SimPush {
@@ -87,9 +87,9 @@ struct Counters {
   uvec4 draw_args;        // indirect draw: vertexCount, instanceCount, firstVertex, firstInstance
   // Collision candidate lists: x 1 when usable, y substeps since they were built, z substeps to
   // wait before building them again, w the bits of the radius + skin they hold
-  uvec4 near;
+  uvec4 candidate_state;
   // This substep: x a particle travelled too far for the lists, y a list overflowed
-  uvec4 near_flags;
+  uvec4 candidate_flags;
 };
 
 /// Result of a pick: the nearest particle to a ray and where it is (SIM_BIND_PICK, read back).

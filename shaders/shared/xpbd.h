@@ -85,30 +85,6 @@ SIM_INLINE PairDelta solveDistance(vec4 pa, vec4 pb, float rest, float stiffness
   return r;
 }
 
-/// Integer cell of a position in the spatial hash, clamped to +-2^29 so that the conversion and the
-/// differences of two cells stay within int range however far a particle has flown.
-SIM_INLINE ivec3 cellOf(vec3 p, float inv_cell) {
-  return ivec3(clamp(floor(p * inv_cell), vec3(-536870912.0f), vec3(536870912.0f)));
-}
-
-/// Hash bucket of a cell.
-SIM_INLINE uint hashCell(ivec3 c, uint mask) {
-  uint h = (uint(c.x) * 73856093u) ^ (uint(c.y) * 19349663u) ^ (uint(c.z) * 83492791u);
-  return h & mask;
-}
-
-/// Repulsion of particle i away from j when closer than radius (half the overlap, scaled).
-SIM_INLINE vec3 repulsion(vec3 pi, vec3 pj, float radius, float stiffness) {
-  vec3 d = pi - pj;
-  float d2 = dot(d, d);
-  vec3 r = vec3(0.0f);
-  if (d2 < radius * radius && d2 > 1e-12f) {
-    float len = sqrt(d2);
-    r = d * (stiffness * 0.5f * (radius - len) / len);
-  }
-  return r;
-}
-
 /// Ground contact: clamp to the floor, reflect normal velocity with restitution, apply friction.
 SIM_INLINE VerletState floorContact(vec4 pos, vec4 prev, float floor_y, float restitution, float friction) {
   VerletState s;
@@ -140,50 +116,6 @@ SIM_INLINE bool shouldTear(vec4 pa, vec4 pb, float rest, uint kind, float tear_f
   return tearable && sqrt(dot(d, d)) > rest * tear_factor;
 }
 
-/// Skin of the collision candidate lists (SIM_NEAR_* in sim_config.h) for radius r and cells of
-/// 1 / inv_cell: SIM_NEAR_SKIN x r, at most 0.99 x (cell - r) so that the lists come from the 27
-/// cells around a particle; 0 (no lists) below SIM_NEAR_MIN_SKIN x r.
-SIM_INLINE float listSkin(float r, float inv_cell) {
-  float skin = min(SIM_NEAR_SKIN * r, 0.99f * (1.0f / inv_cell - r));
-  return skin >= SIM_NEAR_MIN_SKIN * r ? skin : 0.0f;
-}
-
-/// True when the lists of `state` (x usable, y substeps since built, z substeps to wait, w the
-/// bits of the search radius they were built with) hold the pairs within `search` (skin > 0).
-SIM_INLINE bool listsCurrent(uvec4 state, float skin, float search) {
-  return skin > 0.0f && state.x != 0u && state.w == floatBitsToUint(search);
-}
-
-/// True when a particle at p has travelled SIM_NEAR_TRAVEL x skin or more from `base`, where it
-/// was when the lists were built (the lists may then miss a pair).
-SIM_INLINE bool travelledTooFar(vec3 p, vec3 base, float skin) {
-  vec3 d = p - base;
-  float travel = SIM_NEAR_TRAVEL * skin;
-  return !(dot(d, d) < travel * travel);
-}
-
-/// True when the lists of `state` were outgrown within SIM_NEAR_MIN_AGE substeps.
-SIM_INLINE bool listsShortLived(uvec4 state) { return state.x != 0u && state.y < SIM_NEAR_MIN_AGE; }
-
-/// How a substep finds its collisions (SIM_NEAR_HASH, _LISTS or _BUILD), given the lists' state
-/// and whether a particle has travelled SIM_NEAR_TRAVEL x skin or more since they were built.
-SIM_INLINE uint listMode(uvec4 state, bool travelled, float skin, float search) {
-  if (listsCurrent(state, skin, search) && !travelled) return SIM_NEAR_LISTS;
-  return skin > 0.0f && state.z == 0u && !listsShortLived(state) ? SIM_NEAR_BUILD : SIM_NEAR_HASH;
-}
-
-/// The lists' state after a substep in `mode` (overflow: a list outgrew SIM_NEAR_CAPACITY).
-SIM_INLINE uvec4 listNextState(uvec4 state, uint mode, bool overflow, float search) {
-  if (mode == SIM_NEAR_LISTS) return uvec4(1u, state.y + 1u, 0u, state.w);
-  if (mode == SIM_NEAR_BUILD)
-    return uvec4(overflow ? 0u : 1u, 0u, overflow ? SIM_NEAR_WAIT : 0u, floatBitsToUint(search));
-  return uvec4(0u, 0u, listsShortLived(state) ? SIM_NEAR_WAIT : max(state.z, 1u) - 1u, 0u);
-}
-
-/// Neighbour cell code of a cell offset o in {-1, 0, 1}^3: the order (dz, dy, dx) in which the
-/// collision gather visits cells.
-SIM_INLINE uint cellCode(ivec3 o) { return uint((o.z + 1) * 9 + (o.y + 1) * 3 + o.x + 1); }
-
 /// Smooth normal of grid particle (i, j) from central differences of its neighbours.
 SIM_INLINE vec3 gridNormal(vec3 left, vec3 right, vec3 up, vec3 down) {
   vec3 n = cross(right - left, up - down);
@@ -197,5 +129,7 @@ SIM_INLINE vec2 rayPointDistance2(vec3 o, vec3 d, vec3 p) {
   vec3 q = o + d * t - p;
   return vec2(t < 0.0f ? 3.0e38f : dot(q, q), t);
 }
+
+#include "collision.h"
 
 #endif

@@ -60,9 +60,11 @@ layout(std430, set = 0, binding = SIM_BIND_COMPACT_TMP) SIM_COHERENT buffer Comp
 // Bucket order: xyz the bits of pos[cell_particles[k]].xyz, w the particle cell_particles[k], so
 // collide reads buckets contiguously in one load per candidate
 layout(std430, set = 0, binding = SIM_BIND_CELL_POS) SIM_COHERENT buffer CellPosBuffer { uvec4 cell_pos[]; };
-// Candidate lists of the fused tick and the positions they were built at (SIM_NEAR_* in sim_config.h)
-layout(std430, set = 0, binding = SIM_BIND_NEAR) SIM_COHERENT buffer NearBuffer { uint near_list[]; };
-layout(std430, set = 0, binding = SIM_BIND_NEAR_BASE) SIM_COHERENT buffer NearBaseBuffer { vec4 near_base[]; };
+// Candidate lists of the fused tick and the positions they were built at (SIM_CANDIDATE_* in sim_config.h)
+layout(std430, set = 0, binding = SIM_BIND_CANDIDATES) SIM_COHERENT buffer CandidateBuffer { uint candidates[]; };
+layout(std430, set = 0, binding = SIM_BIND_CANDIDATE_BASE) SIM_COHERENT buffer CandidateBaseBuffer {
+  vec4 candidate_base[];
+};
 // Indirect arguments of the separate hash passes: SIM_HASH_DISPATCHES live, then as many full
 layout(std430, set = 0, binding = SIM_BIND_HASH_ARGS) SIM_COHERENT buffer HashArgsBuffer { uvec4 hash_args[]; };
 
@@ -87,18 +89,22 @@ uint colorOf(uint k) {
   return lo;
 }
 
-// Collision candidate lists (SIM_NEAR_* in sim_config.h, listMode and the rest in xpbd.h) with
+// Collision candidate lists (SIM_CANDIDATE_* in sim_config.h, collideMode and the rest in xpbd.h) with
 // the current parameters: their skin (0: none kept), search radius, mode and next state.
-float nearSkin() { return (u.flags & SIM_FLAG_NEAR) != 0u ? listSkin(u.collision_radius, u.inv_cell) : 0.0f; }
-float nearSearch() { return u.collision_radius + nearSkin(); }
-bool nearListsCurrent(uvec4 state) { return listsCurrent(state, nearSkin(), nearSearch()); }
-uint nearMode(uvec4 state, bool travelled) { return listMode(state, travelled, nearSkin(), nearSearch()); }
-uvec4 nearNextState(uvec4 state, uint mode, bool overflow) {
-  return listNextState(state, mode, overflow, nearSearch());
+float candidateSkinNow() {
+  return (u.flags & SIM_FLAG_CANDIDATES) != 0u ? candidateSkin(u.collision_radius, u.inv_cell) : 0.0f;
+}
+float candidateSearchNow() { return u.collision_radius + candidateSkinNow(); }
+bool candidatesCurrentNow(uvec4 state) { return candidatesCurrent(state, candidateSkinNow(), candidateSearchNow()); }
+uint collideModeOf(uvec4 state, bool travelled) {
+  return collideMode(state, travelled, candidateSkinNow(), candidateSearchNow());
+}
+uvec4 candidatesNextStateOf(uvec4 state, uint mode, bool overflow) {
+  return candidatesNextState(state, mode, overflow, candidateSearchNow());
 }
 
-// The mode of this substep in the separate passes (near_check has run).
-uint nearModeNow() { return nearMode(counters.near, counters.near_flags.x != 0u); }
+// The mode of this substep in the separate passes (candidates_check has run).
+uint collideModeNow() { return collideModeOf(counters.candidate_state, counters.candidate_flags.x != 0u); }
 
 // Slots the tear compaction covers: constraints, triangles, and one end slot for the totals.
 uint compactSlots() { return u.constraint_count + u.triangle_count + 1u; }

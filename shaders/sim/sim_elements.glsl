@@ -93,7 +93,7 @@ const uint kCellsWithOffset[9] = uint[9](0x1249249u, 0x2492492u, 0x4924924u,  //
 // cell (`search`, at least the radius, never exceeds a cell); the test is in cell units with a
 // margin, so the cells skipped add no term and the sum is unchanged. Unless `list` is SIM_NONE,
 // the particles not connected to i closer than `search` also go to the candidate list record at
-// near_list[list] (ascending); `fits` is false when they are more than SIM_NEAR_CAPACITY.
+// candidates[list] (ascending); `fits` is false when they are more than SIM_CANDIDATE_CAPACITY.
 vec3 gatherRepulsion(uint i, vec3 pi, float search, uint list, out bool fits) {
   float r = u.collision_radius;
   float r2 = r * r, search2 = search * search;
@@ -125,15 +125,15 @@ vec3 gatherRepulsion(uint i, vec3 pi, float search, uint list, out bool fits) {
     uint h = hashCell(c, u.hash_mask);
     uint end = cell_start[h + 1u];
     for (uint first = cell_start[h]; first < end; first += 32u) {
-      uint near = 0u;
+      uint close = 0u;
       for (uint k = first; k < min(first + 32u, end); ++k) {
         uvec4 q = cell_pos[k];
         vec3 d = pi - uintBitsToFloat(q.xyz);
         bool may_repel = q.w != grid_i && adjacencyOf(gi, mask_i, q.w) != SIM_CONNECTED;
-        near |= dot(d, d) < search2 && may_repel ? 1u << (k - first) : 0u;
+        close |= dot(d, d) < search2 && may_repel ? 1u << (k - first) : 0u;
       }
-      for (; near != 0u; near &= near - 1u) {
-        uvec4 q = cell_pos[first + uint(findLSB(near))];
+      for (; close != 0u; close &= close - 1u) {
+        uvec4 q = cell_pos[first + uint(findLSB(close))];
         vec3 pj = uintBitsToFloat(q.xyz);
         // Count j once, from its own cell
         if (cellOf(pj, u.inv_cell) != c) continue;
@@ -142,10 +142,10 @@ vec3 gatherRepulsion(uint i, vec3 pi, float search, uint list, out bool fits) {
         if (adjacencyOf(gi, mask_i, q.w) == SIM_ASK_LIST && adjacentInList(i, j)) continue;
         if (list != SIM_NONE) {
           // Insertion into the ascending list
-          if (listed < SIM_NEAR_CAPACITY) {
+          if (listed < SIM_CANDIDATE_CAPACITY) {
             uint e = listed + 1u;
-            for (; e > 1u && near_list[list + e - 1u] > j; --e) near_list[list + e] = near_list[list + e - 1u];
-            near_list[list + e] = j;
+            for (; e > 1u && candidates[list + e - 1u] > j; --e) candidates[list + e] = candidates[list + e - 1u];
+            candidates[list + e] = j;
           }
           ++listed;
         }
@@ -154,8 +154,8 @@ vec3 gatherRepulsion(uint i, vec3 pi, float search, uint list, out bool fits) {
       }
     }
   }
-  fits = listed <= SIM_NEAR_CAPACITY;
-  if (list != SIM_NONE) near_list[list] = fits ? listed : 0u;
+  fits = listed <= SIM_CANDIDATE_CAPACITY;
+  if (list != SIM_NONE) candidates[list] = fits ? listed : 0u;
   return sum;
 }
 
@@ -163,13 +163,13 @@ vec3 gatherRepulsion(uint i, vec3 pi, float search, uint list, out bool fits) {
 // SIM_POSITION, none moved yet this substep): the candidates closer than the radius, summed as
 // gatherRepulsion sums them, by neighbour cell (cellCode) and then by index (the list is
 // ascending), so the result is the gather's to the bit.
-vec3 listRepulsion(uint i, vec3 pi) {
-  uint list = i * SIM_NEAR_STRIDE, count = near_list[list];
+vec3 candidateRepulsion(uint i, vec3 pi) {
+  uint list = i * SIM_CANDIDATE_STRIDE, count = candidates[list];
   float r = u.collision_radius, r2 = r * r;
   ivec3 ci = cellOf(pi, u.inv_cell);
   uint codes = 0u; // neighbour cells holding a candidate within the radius
   for (uint e = 1u; e <= count; ++e) {
-    vec3 pj = vec3(SIM_POSITION(near_list[list + e]));
+    vec3 pj = vec3(SIM_POSITION(candidates[list + e]));
     vec3 d = pi - pj;
     ivec3 o = cellOf(pj, u.inv_cell) - ci;
     if (dot(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1)))) codes |= 1u << cellCode(o);
@@ -178,7 +178,7 @@ vec3 listRepulsion(uint i, vec3 pi) {
   for (; codes != 0u; codes &= codes - 1u) {
     uint b = uint(findLSB(codes));
     for (uint e = 1u; e <= count; ++e) {
-      vec3 pj = vec3(SIM_POSITION(near_list[list + e]));
+      vec3 pj = vec3(SIM_POSITION(candidates[list + e]));
       vec3 d = pi - pj;
       ivec3 o = cellOf(pj, u.inv_cell) - ci;
       if (dot(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1))) && cellCode(o) == b)
@@ -188,14 +188,14 @@ vec3 listRepulsion(uint i, vec3 pi) {
   return sum;
 }
 
-// Collision of particle i at pi in a substep of `mode` (SIM_NEAR_*, not SIM_NEAR_LISTS: the
+// Collision of particle i at pi in a substep of `mode` (SIM_CANDIDATE_*, not SIM_COLLIDE_CANDIDATES: the
 // lists read other particles, which must not have moved): its repulsion gathered from the hash; in
-// SIM_NEAR_BUILD also its candidate list and the position it was built at. False in `fits` when
+// SIM_COLLIDE_BUILD also its candidate list and the position it was built at. False in `fits` when
 // the list overflowed.
 vec3 gatherParticle(uint i, vec3 pi, uint mode, out bool fits) {
-  if (mode != SIM_NEAR_BUILD) return gatherRepulsion(i, pi, u.collision_radius, SIM_NONE, fits);
-  near_base[i] = vec4(pi, 0.0f);
-  return gatherRepulsion(i, pi, nearSearch(), i * SIM_NEAR_STRIDE, fits);
+  if (mode != SIM_COLLIDE_BUILD) return gatherRepulsion(i, pi, u.collision_radius, SIM_NONE, fits);
+  candidate_base[i] = vec4(pi, 0.0f);
+  return gatherRepulsion(i, pi, candidateSearchNow(), i * SIM_CANDIDATE_STRIDE, fits);
 }
 
 // Marks constraint c (ends at pa, pb; not torn yet) when stretched beyond the tear threshold and

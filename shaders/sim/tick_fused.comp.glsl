@@ -88,26 +88,26 @@ void main() {
         }
         sync();
       }
-    // 3. Collision (as near_check, hash_*, collide and near_finish). From the candidate lists
-    // while they hold every pair that can touch (no particle has travelled SIM_NEAR_TRAVEL x skin
+    // 3. Collision (as candidates_check, hash_*, collide and candidates_finish). From the candidate lists
+    // while they hold every pair that can touch (no particle has travelled SIM_CANDIDATE_TRAVEL x skin
     // since they were built); otherwise from the spatial hash (count, scan, scatter, order within
     // bucket) and a search of the 27 cells around each particle, which rebuilds the lists as it
-    // goes unless they were outgrown too fast of late (SIM_NEAR_MIN_AGE, SIM_NEAR_WAIT).
-    uvec4 state = counters.near;
-    uint mode = SIM_NEAR_HASH;
+    // goes unless they were outgrown too fast of late (SIM_CANDIDATE_MIN_AGE, SIM_CANDIDATE_WAIT).
+    uvec4 state = counters.candidate_state;
+    uint mode = SIM_COLLIDE_HASH;
     if (collision) {
-      if (lid == 0u) counters.near_flags = uvec4(0u);
+      if (lid == 0u) counters.candidate_flags = uvec4(0u);
       sync();
-      if (nearListsCurrent(state)) {
-        float skin = nearSkin();
+      if (candidatesCurrentNow(state)) {
+        float skin = candidateSkinNow();
         bool far = false;
         for (uint i = lid; i < n; i += kInvocations)
-          far = far || travelledTooFar(vec3(s_pos[i]), vec3(near_base[i]), skin);
-        if (far) atomicOr(counters.near_flags.x, 1u);
+          far = far || travelledTooFar(vec3(s_pos[i]), vec3(candidate_base[i]), skin);
+        if (far) atomicOr(counters.candidate_flags.x, 1u);
         sync();
       }
-      mode = nearMode(state, counters.near_flags.x != 0u);
-      if (mode != SIM_NEAR_LISTS) {
+      mode = collideModeOf(state, counters.candidate_flags.x != 0u);
+      if (mode != SIM_COLLIDE_CANDIDATES) {
         for (uint i = lid; i < n; i += kInvocations) hashCount(i, vec3(s_pos[i]));
         sync();
         scanWorkgroup(SIM_SCAN_HASH, u.hash_mask + 1u, compactSlots());
@@ -117,7 +117,7 @@ void main() {
         sync();
       } else {
         // The lists read the positions of other particles: all of them before any moves
-        for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(listRepulsion(i, vec3(s_pos[i])), 0.0f);
+        for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(candidateRepulsion(i, vec3(s_pos[i])), 0.0f);
         sync();
       }
     }
@@ -127,14 +127,15 @@ void main() {
       vec4 q = s_pos[i];
       vec3 repel = vec3(0.0f);
       bool fits = true;
-      if (collision) repel = mode == SIM_NEAR_LISTS ? vec3(delta[i]) : gatherParticle(i, vec3(q), mode, fits);
-      if (!fits) atomicOr(counters.near_flags.y, 1u);
+      if (collision) repel = mode == SIM_COLLIDE_CANDIDATES ? vec3(delta[i]) : gatherParticle(i, vec3(q), mode, fits);
+      if (!fits) atomicOr(counters.candidate_flags.y, 1u);
       VerletState st = floorParticle(q, prev[i], repel, u.flags, u.floor_y, u.restitution, u.friction);
       s_pos[i] = st.pos;
       prev[i] = st.prev;
     }
     sync();
-    if (collision && lid == 0u) counters.near = nearNextState(state, mode, counters.near_flags.y != 0u);
+    if (collision && lid == 0u)
+      counters.candidate_state = candidatesNextStateOf(state, mode, counters.candidate_flags.y != 0u);
     // 5. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
     // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
     // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the

@@ -29,7 +29,7 @@ bool gatherReference(const GatherArrays& g, const SimUniforms& u, uint32_t begin
     const vec3 pi(g.x[k], g.y[k], g.z[k]);
     const ivec3 ci(g.cell[k]);
     const uint32_t *adj = g.adj_list + g.adj_offsets[i], *adj_end = g.adj_list + g.adj_offsets[i + 1];
-    uint32_t* candidates = build ? g.candidates + size_t(SIM_NEAR_STRIDE) * i : nullptr;
+    uint32_t* candidates = build ? g.candidates + size_t(SIM_CANDIDATE_STRIDE) * i : nullptr;
     uint32_t found = 0;
     vec3 sum(0.0f);
     // The 27 cells in cellCode order; each bucket's particles that lie in that very cell.
@@ -45,7 +45,7 @@ bool gatherReference(const GatherArrays& g, const SimUniforms& u, uint32_t begin
             // Candidate list: insert j in order, while it has room; count every candidate.
             const vec3 d = pi - pj;
             if (candidates && dot(d, d) < search2) {
-              if (found < SIM_NEAR_CAPACITY) {
+              if (found < SIM_CANDIDATE_CAPACITY) {
                 uint32_t e = found + 1;
                 for (; e > 1 && candidates[e - 1] > j; --e) candidates[e] = candidates[e - 1];
                 candidates[e] = j;
@@ -57,9 +57,9 @@ bool gatherReference(const GatherArrays& g, const SimUniforms& u, uint32_t begin
         }
     g.delta[k] = vec4(sum, 0.0f);
     if (candidates) {
-      candidates[0] = found <= SIM_NEAR_CAPACITY ? found : 0u;
+      candidates[0] = found <= SIM_CANDIDATE_CAPACITY ? found : 0u;
       g.candidate_base[i] = pi;
-      fits = fits && found <= SIM_NEAR_CAPACITY;
+      fits = fits && found <= SIM_CANDIDATE_CAPACITY;
     }
   }
   return fits;
@@ -87,7 +87,7 @@ void CpuCollision::upload(const std::vector<uint32_t>& adj_offsets, const std::v
   sorted_coord_.assign(n, ivec4(0));
   delta_.assign(n, vec4(0.0f));
   delta_by_particle_ = false;
-  candidates_.assign(candidates_enabled_ ? size_t(SIM_NEAR_STRIDE) * n : 0, 0u);
+  candidates_.assign(candidates_enabled_ ? size_t(SIM_CANDIDATE_STRIDE) * n : 0, 0u);
   candidate_base_.assign(candidates_enabled_ ? n : 0, vec3(0.0f));
   candidate_state_ = uvec4(0u);
 }
@@ -171,14 +171,14 @@ bool CpuCollision::gather(const SimUniforms& u, float search, bool build) {
 // Repulsion on particle i from its candidate list: the candidates closer than the radius, summed as
 // the gather sums them, by neighbour cell and then by index (the list is ascending).
 vec3 CpuCollision::candidateRepulsion(const SimUniforms& u, const vec4* pos, uint32_t i) const {
-  const uint32_t* candidates = candidates_.data() + size_t(SIM_NEAR_STRIDE) * i;
+  const uint32_t* candidates = candidates_.data() + size_t(SIM_CANDIDATE_STRIDE) * i;
   const uint32_t count = candidates[0];
   vec3 sum(0.0f);
   if (count == 0) return sum;
   const float r = u.collision_radius, r2 = r * r;
   const vec3 pi(pos[i]);
   const ivec3 ci = cellOf(pi, u.inv_cell);
-  uint32_t code[SIM_NEAR_CAPACITY]; // neighbour cell of each candidate within the radius; 27: none
+  uint32_t code[SIM_CANDIDATE_CAPACITY]; // neighbour cell of each candidate within the radius; 27: none
   for (uint32_t e = 0; e < count; ++e) {
     const vec3 pj(pos[candidates[e + 1]]);
     const vec3 d = pi - pj;
@@ -194,20 +194,20 @@ vec3 CpuCollision::candidateRepulsion(const SimUniforms& u, const vec4* pos, uin
 
 uint32_t CpuCollision::substep(const SimUniforms& u, const vec4* pos) {
   const uint32_t n = uint32_t(cell_particles_.size());
-  const float skin = candidates_enabled_ ? listSkin(u.collision_radius, u.inv_cell) : 0.0f;
+  const float skin = candidates_enabled_ ? candidateSkin(u.collision_radius, u.inv_cell) : 0.0f;
   const float search = u.collision_radius + skin;
   // Has a particle travelled too far for the lists?
   std::atomic<bool> travelled{false};
-  if (listsCurrent(candidate_state_, skin, search)) {
+  if (candidatesCurrent(candidate_state_, skin, search)) {
     pool_.parallelFor(n, grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
       bool far = false;
       for (uint32_t i = begin; i < end; ++i) far = far || travelledTooFar(vec3(pos[i]), candidate_base_[i], skin);
       if (far) travelled.store(true, std::memory_order_relaxed);
     });
   }
-  const uint32_t mode = listMode(candidate_state_, travelled.load(), skin, search);
+  const uint32_t mode = collideMode(candidate_state_, travelled.load(), skin, search);
   bool fits = true;
-  if (mode == SIM_NEAR_LISTS) {
+  if (mode == SIM_COLLIDE_CANDIDATES) {
     // Mostly empty lists: a few ns per particle, shared out like the per-particle passes
     pool_.parallelFor(
         n, grain_(kGrainParticles),
@@ -218,10 +218,10 @@ uint32_t CpuCollision::substep(const SimUniforms& u, const vec4* pos) {
     delta_by_particle_ = true;
   } else {
     buildHash(u, pos);
-    const bool build = mode == SIM_NEAR_BUILD;
+    const bool build = mode == SIM_COLLIDE_BUILD;
     fits = gather(u, build ? search : u.collision_radius, build);
   }
-  candidate_state_ = listNextState(candidate_state_, mode, !fits, search);
+  candidate_state_ = candidatesNextState(candidate_state_, mode, !fits, search);
   return mode;
 }
 

@@ -1,6 +1,6 @@
 #pragma once
 /// Self-collision of the CPU solver: the spatial hash, the gather over the 27 cells around each
-/// particle, and the candidate lists (SIM_NEAR_* in sim_config.h) that stand in for both while no
+/// particle, and the candidate lists (SIM_CANDIDATE_* in sim_config.h) that stand in for both while no
 /// particle has travelled far since they were built. The results are the same either way.
 #include <cstdint>
 #include <vector>
@@ -28,7 +28,7 @@ struct GatherArrays {
   const uint32_t* adj_offsets = nullptr; ///< CSR adjacency: particle i's neighbours at [offsets[i], offsets[i + 1])
   const uint32_t* adj_list = nullptr;    ///< ascending per particle, then kAdjacencyPad entries of ~0u
   glm::vec4* delta = nullptr;            ///< out: the repulsion summed on each slot
-  uint32_t* candidates = nullptr;        ///< out when building: SIM_NEAR_STRIDE words per particle
+  uint32_t* candidates = nullptr;        ///< out when building: SIM_CANDIDATE_STRIDE words per particle
   glm::vec3* candidate_base = nullptr;   ///< out when building: where each particle was
 };
 
@@ -36,7 +36,7 @@ struct GatherArrays {
 /// repulsion of the particles not connected to it in its 27 neighbour cells, cells in dz, dy, dx
 /// order (cellCode), the particles of a cell in ascending index, as the GPU sums them. With
 /// `build`, the unconnected particles closer than `search` (at least the radius) also go to its
-/// candidate list, ascending. Returns false when a candidate list outgrew SIM_NEAR_CAPACITY.
+/// candidate list, ascending. Returns false when a candidate list outgrew SIM_CANDIDATE_CAPACITY.
 bool gatherReference(const GatherArrays& g, const shaderio::SimUniforms& u, uint32_t begin, uint32_t end, float search,
                      bool build);
 
@@ -59,7 +59,7 @@ public:
   bool gather(const shaderio::SimUniforms& u, float search, bool build);
   /// The collision of one substep: from the candidate lists when they hold every pair that can
   /// touch, else buildHash and the gather, which rebuilds the lists unless they were outgrown too
-  /// fast of late. Returns the mode (SIM_NEAR_*).
+  /// fast of late. Returns the mode (SIM_CANDIDATE_*).
   uint32_t substep(const shaderio::SimUniforms& u, const glm::vec4* pos);
   /// Collision delta of particle i from the last gather or candidate sum.
   glm::vec3 delta(uint32_t i) const { return glm::vec3(delta_[delta_by_particle_ ? i : particle_slot_[i]]); }
@@ -72,11 +72,11 @@ public:
   const std::vector<uint32_t>& cellParticles() const { return cell_particles_; }
   /// Deltas of the last gather, per hash slot (for tests).
   const std::vector<glm::vec4>& slotDeltas() const { return delta_; }
-  /// Candidate lists, SIM_NEAR_STRIDE words per particle: the count, then ascending particles.
+  /// Candidate lists, SIM_CANDIDATE_STRIDE words per particle: the count, then ascending particles.
   const std::vector<uint32_t>& candidates() const { return candidates_; }
   /// Positions the candidate lists were built at.
   const std::vector<glm::vec3>& candidateBase() const { return candidate_base_; }
-  /// The candidate lists' state (as the GPU's Counters::near): x usable, y age, z wait, w search bits.
+  /// The candidate lists' state (as the GPU's Counters::candidate_state): x usable, y age, z wait, w search bits.
   glm::uvec4 candidateState() const { return candidate_state_; }
   /// What a gather reads and writes.
   GatherArrays arrays();
@@ -99,7 +99,7 @@ private:
   std::vector<glm::ivec4> sorted_coord_;              // cells in hash order
   std::vector<glm::vec4> delta_;                      // collision delta of each hash slot, or particle
   bool delta_by_particle_ = false;                    // delta_ indexed by particle (candidate sums)
-  std::vector<uint32_t> candidates_;                  // candidate lists, SIM_NEAR_STRIDE words per particle
+  std::vector<uint32_t> candidates_;                  // candidate lists, SIM_CANDIDATE_STRIDE words per particle
   std::vector<glm::vec3> candidate_base_;             // positions the lists were built at
   glm::uvec4 candidate_state_{0u};                    // x usable, y age, z wait, w search bits
 };

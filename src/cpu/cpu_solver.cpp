@@ -21,7 +21,7 @@ uint64_t bytesOf(const std::vector<T>& v) {
 
 CpuSolver::CpuSolver(CpuOptions options)
     : options_(options), simd_(options.simd && simd::kBuilt), pool_(std::make_unique<WorkerPool>(options.threads)),
-      collision_(*pool_, options.simd, options.collision_lists) {}
+      collision_(*pool_, options.simd, options.candidate_lists) {}
 
 // The constraints of each colour, reordered by their first particle, into one array per field
 // (the SIMD kernels load them four or eight at a time). Constraints of one colour share no

@@ -20,10 +20,10 @@ class WorkerPool;
 struct CpuOptions {
   uint32_t threads = 1;   ///< worker threads, the caller included; 0 = one per hardware thread
   uint32_t min_chunk = 0; ///< smallest loop share worth a thread; 0 = tuned defaults, 1 = split every loop (tests)
-  /// Keep collision candidate lists (SIM_NEAR_* in sim_config.h, as the GPU solver): a substep
+  /// Keep collision candidate lists (SIM_CANDIDATE_* in sim_config.h, as the GPU solver): a substep
   /// whose particles have not travelled too far since the lists were built sums its repulsion
   /// from them instead of building the hash. The results are the same either way.
-  bool collision_lists = true;
+  bool candidate_lists = true;
   /// Run the SIMD kernels (simd_kernels.h: SSE, and AVX where the CPU has it) for the projection,
   /// the tear test and the collision gather; off runs the scalar reference alone. The results are
   /// bitwise the same either way.
@@ -49,8 +49,8 @@ public:
   uint64_t memoryBytes() const override;
   /// Worker threads in use, the caller included.
   uint32_t threadCount() const;
-  /// True when the solver keeps collision candidate lists (CpuOptions::collision_lists).
-  bool usesCollisionLists() const { return options_.collision_lists; }
+  /// True when the solver keeps collision candidate lists (CpuOptions::candidate_lists).
+  bool usesCandidateLists() const { return options_.candidate_lists; }
   /// True when the SIMD kernels run (CpuOptions::simd, in a build that has them).
   bool usesSimd() const { return simd_; }
 
@@ -59,7 +59,7 @@ public:
   void integrate(const shaderio::SimUniforms& u, uint32_t substep);
   /// Gauss-Seidel over the colours, `iterations` times.
   void project(const shaderio::SimUniforms& u, uint32_t iterations);
-  /// The collision of one substep (CpuCollision::substep); returns the mode (SIM_NEAR_*).
+  /// The collision of one substep (CpuCollision::substep); returns the mode (SIM_CANDIDATE_*).
   uint32_t collide(const shaderio::SimUniforms& u) { return collision_.substep(u, pos_.data()); }
   /// Applies the collision deltas, then the ground contact.
   void floorPass(const shaderio::SimUniforms& u);

@@ -232,7 +232,7 @@ bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_
     const Adjacency adjacency(g.adj_list + g.adj_offsets[i], g.adj_offsets[i + 1] - g.adj_offsets[i]);
     vec3 sum(0.0f);
     uint32_t hit_count = 0;
-    uint32_t* candidates = build ? g.candidates + size_t(SIM_NEAR_STRIDE) * i : nullptr;
+    uint32_t* candidates = build ? g.candidates + size_t(SIM_CANDIDATE_STRIDE) * i : nullptr;
     uint32_t found = 0;
     // Sums the hits so far (and lists the candidates). Skips the particle itself (slot k), particles of
     // other cells sharing a bucket (each is counted from its own cell) and connected particles.
@@ -242,7 +242,7 @@ bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_
         if (m == k || coords[m] != bucket_cell[hit_bucket[t]] || adjacency.contains(slots[m])) continue;
         const vec3 pj(sx[m], sy[m], sz[m]);
         if (candidates) {
-          if (found < SIM_NEAR_CAPACITY) {
+          if (found < SIM_CANDIDATE_CAPACITY) {
             uint32_t e = found + 1;
             for (; e > 1 && candidates[e - 1] > slots[m]; --e) candidates[e] = candidates[e - 1];
             candidates[e] = slots[m];
@@ -280,9 +280,9 @@ bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_
     flush();
     g.delta[k] = vec4(sum, 0.0f);
     if (candidates) {
-      candidates[0] = found <= SIM_NEAR_CAPACITY ? found : 0u;
+      candidates[0] = found <= SIM_CANDIDATE_CAPACITY ? found : 0u;
       g.candidate_base[i] = pi;
-      fits = fits && found <= SIM_NEAR_CAPACITY;
+      fits = fits && found <= SIM_CANDIDATE_CAPACITY;
     }
   }
   return fits;

@@ -57,7 +57,8 @@ std::vector<GpuSolver::BindingSpec> GpuSolver::bindingTable(StartData& d) const 
   // The fused tick's scans meet their per-invocation totals in the SIM_WG_FUSED slots after the
   // compaction slots (the separate passes' block sums, unused on that path).
   const uint32_t scratch = std::max(hash_sums_ + scanSumsSize(cells), tear_slots_ + SIM_WG_FUSED);
-  const VkDeviceSize list_bytes = lists_fit_ ? 4ull * SIM_NEAR_STRIDE * n : 16, list_base = lists_fit_ ? 16ull * n : 16;
+  const VkDeviceSize list_bytes = candidates_fit_ ? 4ull * SIM_CANDIDATE_STRIDE * n : 16,
+                     list_base = candidates_fit_ ? 16ull * n : 16;
 
   // Start contents derived from the topology.
   d.pos.resize(n);
@@ -105,8 +106,8 @@ std::vector<GpuSolver::BindingSpec> GpuSolver::bindingTable(StartData& d) const 
       spec(SIM_BIND_PARTICLE_CELL, 4ull * n),
       spec(SIM_BIND_CELL_SCATTER, 4ull * n),
       spec(SIM_BIND_CELL_POS, 16ull * n),
-      spec(SIM_BIND_NEAR, list_bytes),
-      spec(SIM_BIND_NEAR_BASE, list_base),
+      spec(SIM_BIND_CANDIDATES, list_bytes),
+      spec(SIM_BIND_CANDIDATE_BASE, list_base),
       spec(SIM_BIND_HASH_ARGS, 16ull * 2 * SIM_HASH_DISPATCHES),
       // Interaction
       spec(SIM_BIND_PICK, sizeof(PickResult)),
@@ -146,7 +147,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
   hash_sums_ = tear_sums_ + scanSumsSize(tear_slots_);
   const VkDeviceSize max_range = ctx_.properties().limits.maxStorageBufferRange;
   // Collision candidate lists, when the largest binding holds them
-  lists_fit_ = 4ull * SIM_NEAR_STRIDE * topo.particleCount() <= max_range;
+  candidates_fit_ = 4ull * SIM_CANDIDATE_STRIDE * topo.particleCount() <= max_range;
   hash_grids_.clear();
   hash_grids_uploaded_.clear();
 

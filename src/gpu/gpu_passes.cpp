@@ -119,9 +119,9 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
         // 3. Candidate lists still good? Spatial hash: count, scan, scatter, order within bucket
         // (each pass does nothing when the lists stand in for it); then gather repulsion and
         // update the lists' state
-        dispatch(cmd, pipes_.near_check, Grid::Threads, n, all);
+        dispatch(cmd, pipes_.candidates_check, Grid::Threads, n, all);
         computeToCompute(cmd);
-        dispatch(cmd, pipes_.near_decide, Grid::Threads, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0});
+        dispatch(cmd, pipes_.candidates_decide, Grid::Threads, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0});
         computeToCompute(cmd);
         hash_slot_ = 0;
         dispatch(cmd, pipes_.hash_count, Grid::Hash, n, all);
@@ -134,7 +134,7 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
         timestamp(cmd, slot, kHash);
         dispatch(cmd, pipes_.collide, Grid::Threads, n, all);
         computeToCompute(cmd);
-        dispatch(cmd, pipes_.near_finish, Grid::Threads, 1, all);
+        dispatch(cmd, pipes_.candidates_finish, Grid::Threads, 1, all);
         computeToCompute(cmd);
         timestamp(cmd, slot, kCollide);
       }
@@ -158,7 +158,7 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
   computeToAll(cmd); // the renderer and copies see this tick
   VK_CHECK(vkEndCommandBuffer(cmd));
   slot.recorded = key;
-  // The full grids of the hash passes, which near_decide copies to the live slots
+  // The full grids of the hash passes, which candidates_decide copies to the live slots
   if (hash_grids_ != hash_grids_uploaded_) {
     ctx_.submitOnce([&](VkCommandBuffer up) {
       vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * SIM_HASH_DISPATCHES,

@@ -133,15 +133,15 @@ void GpuSolver::createPipelines(FusedShape fused) {
   static constexpr PipelineSpec kPasses[] = {
       {&SimPipelines::integrate, "integrate.comp", kSim, 1},
       {&SimPipelines::project, "project.comp", kSim, 1},
-      {&SimPipelines::near_check, "near_check.comp", kSim, 1},
-      {&SimPipelines::near_decide, "near_decide.comp", kSim, 1},
+      {&SimPipelines::candidates_check, "candidates_check.comp", kSim, 1},
+      {&SimPipelines::candidates_decide, "candidates_decide.comp", kSim, 1},
       {&SimPipelines::hash_count, "hash_count.comp", kSim, 1},
       {&SimPipelines::scan, "scan.comp", kScan, SIM_SCAN_PER_THREAD},
       {&SimPipelines::scan_add, "scan_add.comp", kScan, 1},
       {&SimPipelines::hash_scatter, "hash_scatter.comp", kSim, 1},
       {&SimPipelines::hash_sort, "hash_sort.comp", kSim, 1},
       {&SimPipelines::collide, "collide.comp", kSim, 1},
-      {&SimPipelines::near_finish, "near_finish.comp", kSim, 1},
+      {&SimPipelines::candidates_finish, "candidates_finish.comp", kSim, 1},
       {&SimPipelines::floor, "floor.comp", kSim, 1},
       {&SimPipelines::tear_mark, "tear_mark.comp", kSim, 1},
       {&SimPipelines::tear_flags, "tear_flags.comp", 0, 1},
@@ -226,7 +226,7 @@ void GpuSolver::tick(const SimUniforms& u) {
   // The slot's previous tick has finished: its uniforms and command buffer may be reused.
   waitSlot(slot);
   SimUniforms gpu_u = u;
-  if (usesCollisionLists()) gpu_u.flags |= SIM_FLAG_NEAR;
+  if (usesCandidateLists()) gpu_u.flags |= SIM_FLAG_CANDIDATES;
   std::memcpy(static_cast<char*>(buf_[SIM_BIND_UNIFORMS].mapped) + index * uniform_stride_, &gpu_u, sizeof(gpu_u));
   if (u.reset_active) {
     ctx_.submit(slot.reset, slot.fence);

@@ -33,8 +33,8 @@ struct ComputePipeline {
 
 /// Every pipeline of the simulation (one file per shader in shaders/sim/).
 struct SimPipelines {
-  ComputePipeline integrate, project, near_check, near_decide, hash_count, scan, scan_add, hash_scatter, hash_sort,
-      collide, near_finish, floor, tear_mark, tear_flags, tear_compact, normals, reset;
+  ComputePipeline integrate, project, candidates_check, candidates_decide, hash_count, scan, scan_add, hash_scatter,
+      hash_sort, collide, candidates_finish, floor, tear_mark, tear_flags, tear_compact, normals, reset;
   ComputePipeline tick_fused; ///< null when the device has under 32 KiB of shared memory
   std::array<ComputePipeline, 3> pick;
 };
@@ -44,7 +44,7 @@ struct SimPipelines {
 /// dispatches (zero workgroups when nothing tore). Small sheets run every pass of a substep in one
 /// workgroup (tick_fused.comp): on a GPU the whole tick in one dispatch, on a CPU device one
 /// dispatch per substep (see FusedShape). The fused tick keeps collision candidate lists with a
-/// skin (SIM_NEAR_* in sim_config.h) and rebuilds the hash only when a particle has travelled too
+/// skin (SIM_CANDIDATE_* in sim_config.h) and rebuilds the hash only when a particle has travelled too
 /// far for them; the sums, and so the results, are those of the hash search.
 class GpuSolver final : public Solver {
 public:
@@ -91,12 +91,12 @@ public:
   void setFusedPath(bool allowed) { fused_allowed_ = allowed; }
   /// True when the sheet is small enough for the fused small-sheet tick (and it is allowed).
   bool usesFusedPath() const;
-  /// Keeps (default) or drops the collision candidate lists (SIM_NEAR_* in sim_config.h); without
+  /// Keeps (default) or drops the collision candidate lists (SIM_CANDIDATE_* in sim_config.h); without
   /// them every substep with collision builds the hash and searches it. Lists are kept only when
-  /// their buffer fits the device (one SIM_NEAR_STRIDE record per particle).
-  void setCollisionLists(bool keep) { lists_allowed_ = keep; }
+  /// their buffer fits the device (one SIM_CANDIDATE_STRIDE record per particle).
+  void setCandidateLists(bool keep) { candidates_allowed_ = keep; }
   /// True when ticks keep collision candidate lists.
-  bool usesCollisionLists() const { return lists_allowed_ && lists_fit_; }
+  bool usesCandidateLists() const { return candidates_allowed_ && candidates_fit_; }
   /// True when a tick with these uniforms runs the fused tick: the sheet is small enough and, with
   /// collision on, the hash cell is within the shape's limit.
   bool usesFusedPath(const shaderio::SimUniforms& u) const;
@@ -165,7 +165,7 @@ private:
   void bindSet(VkCommandBuffer cmd, uint32_t uniform_slot);
   /// The one dispatch helper: binds the pipeline, checks and pushes the constants, and dispatches
   /// `count` elements (Threads), one workgroup (Workgroup), or the grid of an indirect argument
-  /// (Compaction, Hash: the next live hash-pass slot, whose full grid near_decide copies in).
+  /// (Compaction, Hash: the next live hash-pass slot, whose full grid candidates_decide copies in).
   void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
                 uint32_t push_size);
   template <class Push>
@@ -212,8 +212,8 @@ private:
   uint32_t fused_substeps_ = 1;                 ///< substeps per dispatch of the fused tick
   float fused_max_cell_spacings_ = -1.0f;       ///< largest hash cell of the fused tick (< 0: any)
   float spacing_ = 0.0f;                        ///< grid spacing: the shortest structural rest length
-  bool lists_allowed_ = true;                   ///< setCollisionLists
-  bool lists_fit_ = false;                      ///< the candidate-list buffer fits the device
+  bool candidates_allowed_ = true;              ///< setCandidateLists
+  bool candidates_fit_ = false;                 ///< the candidate-list buffer fits the device
   std::vector<glm::uvec4> hash_grids_;          ///< full grids of the hash passes, in recording order
   std::vector<glm::uvec4> hash_grids_uploaded_; ///< what SIM_BIND_HASH_ARGS holds of them
   uint32_t hash_slot_ = 0;                      ///< next live hash-pass argument while recording

@@ -233,7 +233,7 @@ TEST(SimdKernels, CollisionGatherMatchesReference) {
     fast.buildHash(c.u, c.pos.data());
     slow.buildHash(c.u, c.pos.data());
     ASSERT_EQ(fast.cellParticles(), slow.cellParticles());
-    const float radius = c.u.collision_radius, skin = listSkin(radius, c.u.inv_cell);
+    const float radius = c.u.collision_radius, skin = candidateSkin(radius, c.u.inv_cell);
     ASSERT_GT(skin, 0.0f);
     // Within the radius; then within radius + skin, building the candidate lists.
     bool fits = true;
@@ -249,7 +249,7 @@ TEST(SimdKernels, CollisionGatherMatchesReference) {
     uint32_t pushed = 0, listed = 0;
     for (uint32_t k = 0; k < 3000; ++k) {
       pushed += slow.slotDeltas()[k] != vec4(0.0f) ? 1u : 0u;
-      listed += slow.candidates()[size_t(SIM_NEAR_STRIDE) * k];
+      listed += slow.candidates()[size_t(SIM_CANDIDATE_STRIDE) * k];
     }
     EXPECT_GT(pushed, 1500u);
     EXPECT_GT(listed, 3000u);

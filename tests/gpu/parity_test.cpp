@@ -65,7 +65,7 @@ TEST_F(Parity, HashBucketsMatchTheCpu) {
   Simulation sim(p, gpu);
   SimState s = run(sim, 30);
   // A hash in every substep: no candidate lists
-  gpu.setCollisionLists(false);
+  gpu.setCandidateLists(false);
   shaderio::SimUniforms u = sim.makeUniforms();
   u.substeps = 1;
   u.iterations = 0;
@@ -103,9 +103,9 @@ TEST_F(Parity, HugeHashTableUsesThreeScanLevelsAndTallGrids) {
   CpuSolver scratch_solver;
   Simulation sim(p, scratch_solver); // only for the uniforms of a tick
   gpu::GpuSolver gpu(ctx());
-  gpu.setCollisionLists(false); // a hash in every substep
+  gpu.setCandidateLists(false); // a hash in every substep
   CpuOptions no_lists;
-  no_lists.collision_lists = false;
+  no_lists.candidate_lists = false;
   CpuSolver cpu(no_lists);
   gpu.upload(topo);
   cpu.upload(topo);
@@ -354,12 +354,12 @@ TEST_F(Parity, FarConnectedParticlesNeverRepel) {
 
 namespace {
 
-/// The fused tick's candidate-list state (Counters::near): x usable, y substeps since built, z
+/// The fused tick's candidate-list state (Counters::candidate_state): x usable, y substeps since built, z
 /// substeps to wait before the next build.
-glm::uvec4 listState(gpu::GpuSolver& gpu) {
+glm::uvec4 candidateState(gpu::GpuSolver& gpu) {
   shaderio::Counters c{};
   gpu.context().download(gpu.buffer(SIM_BIND_COUNTERS), &c, sizeof(c));
-  return c.near;
+  return c.candidate_state;
 }
 
 } // namespace
@@ -382,14 +382,14 @@ void Parity::checkCandidateLists(const SimParams& p, bool fused, bool expect_ent
   gpu.setFusedPath(fused);
   Simulation sim(p, gpu);
   ASSERT_EQ(gpu.usesFusedPath(sim.makeUniforms()), fused);
-  ASSERT_TRUE(gpu.usesCollisionLists());
+  ASSERT_TRUE(gpu.usesCandidateLists());
   CpuSolver cpu;
   Simulation ref(p, cpu);
   const SheetTopology& topo = sim.topology();
   const uint32_t n = topo.particleCount();
   const shaderio::SimUniforms u = sim.makeUniforms();
   const float r = u.collision_radius;
-  const float skin = std::min(SIM_NEAR_SKIN * r, 0.99f * (1.0f / u.inv_cell - r));
+  const float skin = std::min(SIM_CANDIDATE_SKIN * r, 0.99f * (1.0f / u.inv_cell - r));
   const float search2 = (r + skin) * (r + skin);
   int whole_ticks_on_lists = 0, checked = 0;
   size_t entries = 0;
@@ -397,18 +397,18 @@ void Parity::checkCandidateLists(const SimParams& p, bool fused, bool expect_ent
   for (int t = 0; t < ticks; ++t) {
     run(sim, 1);
     run(ref, 1);
-    const glm::uvec4 state = listState(gpu);
+    const glm::uvec4 state = candidateState(gpu);
     if (state.x == 1u && state.y >= p.substeps) ++whole_ticks_on_lists;
     if (state.x != 1u || t % 15 != 0) continue;
     ++checked;
-    std::vector<uint32_t> lists(size_t(SIM_NEAR_STRIDE) * n);
+    std::vector<uint32_t> lists(size_t(SIM_CANDIDATE_STRIDE) * n);
     std::vector<glm::vec4> base(n);
-    gpu.context().download(gpu.buffer(SIM_BIND_NEAR), lists.data(), 4ull * lists.size());
-    gpu.context().download(gpu.buffer(SIM_BIND_NEAR_BASE), base.data(), 16ull * n);
+    gpu.context().download(gpu.buffer(SIM_BIND_CANDIDATES), lists.data(), 4ull * lists.size());
+    gpu.context().download(gpu.buffer(SIM_BIND_CANDIDATE_BASE), base.data(), 16ull * n);
     size_t bad = 0;
     for (uint32_t i = 0; i < n; ++i) {
-      const uint32_t* rec = &lists[size_t(SIM_NEAR_STRIDE) * i];
-      ASSERT_LE(rec[0], SIM_NEAR_CAPACITY);
+      const uint32_t* rec = &lists[size_t(SIM_CANDIDATE_STRIDE) * i];
+      ASSERT_LE(rec[0], SIM_CANDIDATE_CAPACITY);
       entries += rec[0];
       std::set<uint32_t> got(rec + 1, rec + 1 + rec[0]);
       EXPECT_TRUE(std::is_sorted(rec + 1, rec + 1 + rec[0]));
@@ -443,7 +443,7 @@ void Parity::checkCandidateLists(const SimParams& p, bool fused, bool expect_ent
 
 TEST_F(Parity, OverflowingCandidateListsFallBackToTheHash) {
   // A collision radius of 2.5 spacings reaches far past the connected neighbours: a particle has
-  // more unconnected candidates than a list holds. Both GPU paths then wait SIM_NEAR_WAIT
+  // more unconnected candidates than a list holds. Both GPU paths then wait SIM_CANDIDATE_WAIT
   // substeps before trying again, gathering from the hash meanwhile, and match the CPU.
   SimParams p = preset("tender", {"cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9", "wind=on"});
   for (bool fused : {true, false}) {
@@ -458,7 +458,7 @@ TEST_F(Parity, OverflowingCandidateListsFallBackToTheHash) {
     for (int t = 0; t < ticks; ++t) {
       run(sim, 1);
       run(ref, 1);
-      const glm::uvec4 state = listState(gpu);
+      const glm::uvec4 state = candidateState(gpu);
       if (state.x == 0u && state.z > 0u) ++waiting;
     }
     SimState a, b;

@@ -1,5 +1,5 @@
 #version 460
-// Collision candidate lists, after near_check (one invocation): the indirect arguments of the
+// Collision candidate lists, after candidates_check (one invocation): the indirect arguments of the
 // hash passes of this substep, their full grids, or none when the lists stand in for the hash.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE 1
@@ -7,6 +7,6 @@
 layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
-  bool skip = nearModeNow() == SIM_NEAR_LISTS;
+  bool skip = collideModeNow() == SIM_COLLIDE_CANDIDATES;
   for (uint k = 0u; k < p.count; ++k) hash_args[k] = skip ? uvec4(0u, 1u, 1u, 0u) : hash_args[SIM_HASH_DISPATCHES + k];
 }

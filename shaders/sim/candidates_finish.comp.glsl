@@ -7,7 +7,8 @@
 layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
-  uvec4 flags = counters.near_flags;
-  counters.near = nearNextState(counters.near, nearMode(counters.near, flags.x != 0u), flags.y != 0u);
-  counters.near_flags = uvec4(0u);
+  uvec4 flags = counters.candidate_flags;
+  counters.candidate_state = candidatesNextStateOf(
+      counters.candidate_state, collideModeOf(counters.candidate_state, flags.x != 0u), flags.y != 0u);
+  counters.candidate_flags = uvec4(0u);
 }
