@@ -11,15 +11,6 @@ namespace tender {
 
 using namespace shaderio;
 
-namespace {
-
-template <typename T>
-uint64_t bytesOf(const std::vector<T>& v) {
-  return uint64_t(v.capacity()) * sizeof(T);
-}
-
-} // namespace
-
 bool gatherReference(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_t end, float search,
                      bool build) {
   const float r = u.collision_radius, search2 = search * search;
@@ -226,10 +217,11 @@ uint32_t CpuCollision::substep(const SimUniforms& u, const vec4* pos) {
 }
 
 uint64_t CpuCollision::memoryBytes() const {
-  return bytesOf(adj_offsets_) + bytesOf(adj_list_) + bytesOf(cell_count_) + bytesOf(cell_start_) +
-         bytesOf(cell_particles_) + bytesOf(particle_cell_) + bytesOf(particle_slot_) + bytesOf(particle_coord_) +
-         bytesOf(sorted_x_) + bytesOf(sorted_y_) + bytesOf(sorted_z_) + bytesOf(sorted_coord_) + bytesOf(delta_) +
-         bytesOf(candidates_) + bytesOf(candidate_base_);
+  return capacityBytes(adj_offsets_) + capacityBytes(adj_list_) + capacityBytes(cell_count_) +
+         capacityBytes(cell_start_) + capacityBytes(cell_particles_) + capacityBytes(particle_cell_) +
+         capacityBytes(particle_slot_) + capacityBytes(particle_coord_) + capacityBytes(sorted_x_) +
+         capacityBytes(sorted_y_) + capacityBytes(sorted_z_) + capacityBytes(sorted_coord_) + capacityBytes(delta_) +
+         capacityBytes(candidates_) + capacityBytes(candidate_base_);
 }
 
 } // namespace tender

@@ -12,6 +12,12 @@ namespace tender {
 
 class WorkerPool;
 
+/// Bytes of host memory a vector holds (its capacity).
+template <typename T>
+uint64_t capacityBytes(const std::vector<T>& v) {
+  return uint64_t(v.capacity()) * sizeof(T);
+}
+
 /// Extra entries after the positions in hash order and after the adjacency list, so that 4-wide
 /// loads never leave them.
 inline constexpr uint32_t kSortedPad = 4, kAdjacencyPad = 16;

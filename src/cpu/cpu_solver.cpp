@@ -10,15 +10,6 @@ namespace tender {
 
 using namespace shaderio;
 
-namespace {
-
-template <typename T>
-uint64_t bytesOf(const std::vector<T>& v) {
-  return uint64_t(v.capacity()) * sizeof(T);
-}
-
-} // namespace
-
 CpuSolver::CpuSolver(CpuOptions options)
     : options_(options), simd_(options.simd && simd::kBuilt), pool_(std::make_unique<WorkerPool>(options.threads)),
       collision_(*pool_, options.simd, options.candidate_lists) {}
@@ -280,9 +271,10 @@ void CpuSolver::readback(SimState& out) {
 }
 
 uint64_t CpuSolver::memoryBytes() const {
-  return bytesOf(pos_) + bytesOf(prev_) + bytesOf(rest_) + bytesOf(normal_) + bytesOf(reset_from_) + bytesOf(uv_) +
-         bytesOf(constraints_) + bytesOf(colors_) + bytesOf(torn_) + bytesOf(con_a_) + bytesOf(con_b_) +
-         bytesOf(con_kind_) + bytesOf(con_id_) + bytesOf(con_rest_) + bytesOf(triangles_) + collision_.memoryBytes();
+  return capacityBytes(pos_) + capacityBytes(prev_) + capacityBytes(rest_) + capacityBytes(normal_) +
+         capacityBytes(reset_from_) + capacityBytes(uv_) + capacityBytes(constraints_) + capacityBytes(colors_) +
+         capacityBytes(torn_) + capacityBytes(con_a_) + capacityBytes(con_b_) + capacityBytes(con_kind_) +
+         capacityBytes(con_id_) + capacityBytes(con_rest_) + capacityBytes(triangles_) + collision_.memoryBytes();
 }
 
 } // namespace tender

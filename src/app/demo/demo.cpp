@@ -1,104 +1,15 @@
 // tender-demo: the interactive window. GLFW + Vulkan swapchain, the scene renderer, the solver,
-// mouse and keyboard interaction, the ImGui HUD, input recording and replay.
-#include <algorithm>
-#include <chrono>
-#include <cstdio>
-#include <memory>
-#include <optional>
-
-#define GLFW_INCLUDE_VULKAN
-#include <GLFW/glfw3.h>
-#include <imgui.h>
-#include <imgui_impl_glfw.h>
-#include <imgui_impl_vulkan.h>
-
-#include "../commands.h"
-#include "core/output.h"
-#include "core/simulation.h"
-#include "gpu/gpu_solver.h"
-#include "hud.h"
-#include "render/paper_mesh.h"
-#include "render/renderer.h"
-#include "swapchain.h"
-#include "window_icon.h"
+// the ImGui HUD, the frame loop, input recording and replay (input.cpp handles the input).
+#include "demo_app.h"
 
 namespace tender {
 namespace {
 
-constexpr uint32_t kFramesInFlight = 2;
-constexpr const char* kTitle = "Tender \xe2\x80\x94 Receipt Paper Physics";
-
-// Per frame in flight: command buffer, acquire semaphore, fence.
-struct FrameSync {
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  VkSemaphore acquired = VK_NULL_HANDLE;
-  VkFence done = VK_NULL_HANDLE;
-};
-
-// Mouse and keyboard state, filled by the GLFW callbacks.
-struct Input {
-  bool grabbing = false, orbiting = false, panning = false;
-  double x = 0.0, y = 0.0;
-  glm::vec3 plane_point{0.0f}, plane_normal{0.0f};
-  std::optional<glm::vec3> pending_move;
-  bool resized = false;
-};
-
-class DemoApp {
-public:
-  DemoApp(const CommonOptions& common, const DemoOptions& options) : common_(common), options_(options) {}
-  ~DemoApp();
-  int run();
-
-private:
-  bool init();
-  void initImGui(float scale);
-  void createSolver();
-  void attachPaper();
-  void recreateSwapchain();
-  void drawFrame(const render::SceneView& view);
-  void apply(ScriptEvent e);
-  void handleActions(const demo::HudActions& a);
-  void switchParams(const SimParams& p, bool new_receipt);
-  render::Ray cursorRay() const;
-
-  static void onMouseButton(GLFWwindow* w, int button, int action, int mods);
-  static void onCursor(GLFWwindow* w, double x, double y);
-  static void onScroll(GLFWwindow* w, double dx, double dy);
-  static void onKey(GLFWwindow* w, int key, int scancode, int action, int mods);
-  static void onResize(GLFWwindow* w, int width, int height);
-
-  CommonOptions common_;
-  DemoOptions options_;
-  GLFWwindow* window_ = nullptr;
-  std::unique_ptr<gpu::VulkanContext> ctx_;
-  VkSurfaceKHR surface_ = VK_NULL_HANDLE;
-  std::unique_ptr<demo::Swapchain> swapchain_;
-  std::unique_ptr<render::Renderer> renderer_;
-  Backend backend_;
-  std::unique_ptr<Simulation> sim_;
-  std::vector<std::unique_ptr<render::HostPaperMesh>> host_meshes_;
-  std::unique_ptr<demo::Hud> hud_;
-  SimParams panel_params_;
-  FrameSync frames_[kFramesInFlight];
-  std::vector<VkSemaphore> rendered_; // per swapchain image
-  VkDescriptorPool imgui_pool_ = VK_NULL_HANDLE;
-  bool imgui_ready_ = false;
-  uint32_t slot_ = 0;
-  render::OrbitCamera camera_;
-  Input input_;
-  bool show_fps_ = false;
-  uint32_t grabs_ = 0;      // grabs that caught a particle
-  OutputSet record_;        // --record: written when the session ends
-  std::string record_text_; // the events of the session so far, as an input script
-  SimState state_;
-};
-
-DemoApp* appOf(GLFWwindow* w) { return static_cast<DemoApp*>(glfwGetWindowUserPointer(w)); }
-
 // The newest GLFW error, for the one line that reports a failed start.
 std::string g_glfw_error;
 bool g_glfw_started = false;
+
+} // namespace
 
 bool DemoApp::init() {
   glfwSetErrorCallback([](int code, const char* text) {
@@ -305,153 +216,6 @@ DemoApp::~DemoApp() {
   glfwTerminate();
 }
 
-render::Ray DemoApp::cursorRay() const {
-  int w = 0, h = 0;
-  glfwGetWindowSize(window_, &w, &h);
-  return camera_.ray(float(input_.x), float(input_.y), float(std::max(w, 1)), float(std::max(h, 1)));
-}
-
-void DemoApp::apply(ScriptEvent e) {
-  e.tick = sim_->frameCount();
-  sim_->apply(e);
-  if (!options_.record.empty()) record_text_ += formatEvent(e) + "\n";
-}
-
-void DemoApp::onMouseButton(GLFWwindow* w, int button, int action, int) {
-  DemoApp& app = *appOf(w);
-  Input& in = app.input_;
-  glfwGetCursorPos(w, &in.x, &in.y);
-  const bool press = action == GLFW_PRESS;
-  if (press && ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse) return;
-  if (!app.renderer_->ready()) return;
-  if (button == GLFW_MOUSE_BUTTON_LEFT) {
-    if (press) {
-      // Grab the nearest particle within the pick radius of the cursor's ray.
-      render::Ray r = app.cursorRay();
-      ScriptEvent e;
-      e.kind = EventKind::GrabRay;
-      e.a = r.origin;
-      e.b = r.dir;
-      app.apply(e);
-      if (app.sim_->grabbed() != SIM_NONE) {
-        ++app.grabs_;
-        in.grabbing = true;
-        in.plane_point = app.sim_->grabTarget();
-        in.plane_normal = app.camera_.forward();
-      }
-    } else if (in.grabbing) {
-      if (in.pending_move) {
-        ScriptEvent m;
-        m.kind = EventKind::Move;
-        m.a = *in.pending_move;
-        app.apply(m);
-        in.pending_move.reset();
-      }
-      ScriptEvent e;
-      e.kind = EventKind::Release;
-      app.apply(e);
-      in.grabbing = false;
-    }
-  } else if (button == GLFW_MOUSE_BUTTON_RIGHT) {
-    in.orbiting = press;
-  } else if (button == GLFW_MOUSE_BUTTON_MIDDLE) {
-    in.panning = press;
-  }
-}
-
-void DemoApp::onCursor(GLFWwindow* w, double x, double y) {
-  DemoApp& app = *appOf(w);
-  Input& in = app.input_;
-  const float dx = float(x - in.x), dy = float(y - in.y);
-  in.x = x;
-  in.y = y;
-  if (in.grabbing) {
-    // The grabbed particle follows the cursor on the camera-facing plane through the grab point.
-    if (auto p = render::intersectPlane(app.cursorRay(), in.plane_point, in.plane_normal)) in.pending_move = *p;
-  }
-  if (in.orbiting) app.camera_.orbit(dx, dy);
-  if (in.panning) {
-    int ww = 0, wh = 0;
-    glfwGetWindowSize(w, &ww, &wh);
-    app.camera_.pan(dx, dy, float(wh));
-  }
-}
-
-void DemoApp::onScroll(GLFWwindow* w, double, double dy) {
-  if (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse) return;
-  appOf(w)->camera_.zoom(float(dy));
-}
-
-void DemoApp::onKey(GLFWwindow* w, int key, int, int action, int) {
-  if (action != GLFW_PRESS) return;
-  if (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureKeyboard) return;
-  DemoApp& app = *appOf(w);
-  if (!app.sim_) return;
-  ScriptEvent e;
-  e.toggle = Toggle::Flip;
-  switch (key) {
-  case GLFW_KEY_R:
-    e.kind = EventKind::Reset;
-    break;
-  case GLFW_KEY_W:
-    e.kind = EventKind::Wind;
-    break;
-  case GLFW_KEY_P:
-    e.kind = EventKind::Pins;
-    break;
-  case GLFW_KEY_SPACE:
-    e.kind = EventKind::Pause;
-    break;
-  case GLFW_KEY_I:
-    app.show_fps_ = !app.show_fps_;
-    return;
-  case GLFW_KEY_ESCAPE:
-    glfwSetWindowShouldClose(w, GLFW_TRUE);
-    return;
-  default:
-    return;
-  }
-  if (e.kind == EventKind::Reset) app.input_.grabbing = false;
-  app.apply(e);
-}
-
-void DemoApp::onResize(GLFWwindow* w, int, int) { appOf(w)->input_.resized = true; }
-
-void DemoApp::switchParams(const SimParams& p, bool new_receipt) {
-  ctx_->waitIdle();
-  input_.grabbing = false;
-  input_.pending_move.reset();
-  if (new_receipt) renderer_->setReceipt(render::rasterizeReceipt(render::receiptText(p.preset)));
-  sim_->rebuild(p);
-  panel_params_ = p;
-  attachPaper();
-}
-
-void DemoApp::handleActions(const demo::HudActions& a) {
-  ScriptEvent e;
-  e.toggle = Toggle::Flip;
-  if (a.toggle_wind) e.kind = EventKind::Wind, apply(e);
-  if (a.toggle_pins) e.kind = EventKind::Pins, apply(e);
-  if (a.toggle_pause) e.kind = EventKind::Pause, apply(e);
-  if (a.reset) e.kind = EventKind::Reset, apply(e);
-  if (a.preset) {
-    if (auto p = presetParams(*a.preset)) switchParams(*p, true);
-  } else if (a.rebuild) {
-    if (auto err = validate(panel_params_, common_.backend))
-      std::fprintf(stderr, "tender-demo: %s\n", err->c_str());
-    else
-      switchParams(panel_params_, false);
-  } else if (a.live_changed) {
-    if (!validate(panel_params_, common_.backend)) {
-      // Grid size edits wait for "Rebuild sheet"; everything else applies now.
-      SimParams live = panel_params_;
-      live.cols = sim_->params().cols;
-      live.rows = sim_->params().rows;
-      sim_->setLiveParams(live);
-    }
-  }
-}
-
 void DemoApp::drawFrame(const render::SceneView& view) {
   VkDevice dev = ctx_->device();
   FrameSync& f = frames_[slot_];
@@ -590,8 +354,6 @@ int DemoApp::run() {
     return fail(std::to_string(ctx_->validationMessages()) + " validation messages");
   return 0;
 }
-
-} // namespace
 
 int runDemo(const CommonOptions& common, const DemoOptions& options) {
   DemoApp app(common, options);

@@ -1,0 +1,99 @@
+#pragma once
+/// The tender-demo application: window, swapchain, renderer, solver, HUD and input. demo.cpp sets
+/// it up and runs the frame loop; input.cpp turns mouse, keyboard and HUD actions into events.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <optional>
+
+#define GLFW_INCLUDE_VULKAN
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_vulkan.h>
+
+#include "../commands.h"
+#include "core/output.h"
+#include "core/simulation.h"
+#include "gpu/gpu_solver.h"
+#include "hud.h"
+#include "render/paper_mesh.h"
+#include "render/renderer.h"
+#include "swapchain.h"
+#include "window_icon.h"
+
+namespace tender {
+
+constexpr uint32_t kFramesInFlight = 2;
+constexpr const char* kTitle = "Tender \xe2\x80\x94 Receipt Paper Physics";
+
+/// Per frame in flight: command buffer, acquire semaphore, fence.
+struct FrameSync {
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkSemaphore acquired = VK_NULL_HANDLE;
+  VkFence done = VK_NULL_HANDLE;
+};
+
+/// Mouse and keyboard state, filled by the GLFW callbacks.
+struct Input {
+  bool grabbing = false, orbiting = false, panning = false;
+  double x = 0.0, y = 0.0;
+  glm::vec3 plane_point{0.0f}, plane_normal{0.0f};
+  std::optional<glm::vec3> pending_move;
+  bool resized = false;
+};
+
+class DemoApp {
+public:
+  DemoApp(const CommonOptions& common, const DemoOptions& options) : common_(common), options_(options) {}
+  ~DemoApp();
+  int run();
+
+private:
+  bool init();
+  void initImGui(float scale);
+  void createSolver();
+  void attachPaper();
+  void recreateSwapchain();
+  void drawFrame(const render::SceneView& view);
+  void apply(ScriptEvent e);
+  void handleActions(const demo::HudActions& a);
+  void switchParams(const SimParams& p, bool new_receipt);
+  render::Ray cursorRay() const;
+
+  static void onMouseButton(GLFWwindow* w, int button, int action, int mods);
+  static void onCursor(GLFWwindow* w, double x, double y);
+  static void onScroll(GLFWwindow* w, double dx, double dy);
+  static void onKey(GLFWwindow* w, int key, int scancode, int action, int mods);
+  static void onResize(GLFWwindow* w, int width, int height);
+
+  CommonOptions common_;
+  DemoOptions options_;
+  GLFWwindow* window_ = nullptr;
+  std::unique_ptr<gpu::VulkanContext> ctx_;
+  VkSurfaceKHR surface_ = VK_NULL_HANDLE;
+  std::unique_ptr<demo::Swapchain> swapchain_;
+  std::unique_ptr<render::Renderer> renderer_;
+  Backend backend_;
+  std::unique_ptr<Simulation> sim_;
+  std::vector<std::unique_ptr<render::HostPaperMesh>> host_meshes_;
+  std::unique_ptr<demo::Hud> hud_;
+  SimParams panel_params_;
+  FrameSync frames_[kFramesInFlight];
+  std::vector<VkSemaphore> rendered_; // per swapchain image
+  VkDescriptorPool imgui_pool_ = VK_NULL_HANDLE;
+  bool imgui_ready_ = false;
+  uint32_t slot_ = 0;
+  render::OrbitCamera camera_;
+  Input input_;
+  bool show_fps_ = false;
+  uint32_t grabs_ = 0;      // grabs that caught a particle
+  OutputSet record_;        // --record: written when the session ends
+  std::string record_text_; // the events of the session so far, as an input script
+  SimState state_;
+};
+
+inline DemoApp* appOf(GLFWwindow* w) { return static_cast<DemoApp*>(glfwGetWindowUserPointer(w)); }
+
+} // namespace tender
