@@ -35,23 +35,11 @@ bool gatherReference(const GatherArrays& g, const SimUniforms& u, uint32_t begin
             const vec3 pj(g.x[m], g.y[m], g.z[m]);
             // Candidate list: insert j in order, while it has room; count every candidate.
             const vec3 d = pi - pj;
-            if (candidates && dot(d, d) < search2) {
-              if (found < SIM_CANDIDATE_CAPACITY) {
-                uint32_t e = found + 1;
-                for (; e > 1 && candidates[e - 1] > j; --e) candidates[e] = candidates[e - 1];
-                candidates[e] = j;
-              }
-              ++found;
-            }
+            if (candidates && dot(d, d) < search2) found = addCandidate(candidates, found, j);
             sum += repulsion(pi, pj, r, u.collision_stiffness);
           }
         }
-    g.delta[k] = vec4(sum, 0.0f);
-    if (candidates) {
-      candidates[0] = found <= SIM_CANDIDATE_CAPACITY ? found : 0u;
-      g.candidate_base[i] = pi;
-      fits = fits && found <= SIM_CANDIDATE_CAPACITY;
-    }
+    fits = endGather(g, k, i, pi, sum, candidates, found) && fits;
   }
   return fits;
 }

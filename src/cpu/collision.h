@@ -38,6 +38,29 @@ struct GatherArrays {
   glm::vec3* candidate_base = nullptr;   ///< out when building: where each particle was
 };
 
+/// Adds particle j to the candidate list being built at `list` (`found` candidates so far),
+/// keeping the list ascending while it has room; returns the new count (a count over
+/// SIM_CANDIDATE_CAPACITY means the list overflowed).
+inline uint32_t addCandidate(uint32_t* list, uint32_t found, uint32_t j) {
+  if (found < SIM_CANDIDATE_CAPACITY) {
+    uint32_t e = found + 1;
+    for (; e > 1 && list[e - 1] > j; --e) list[e] = list[e - 1];
+    list[e] = j;
+  }
+  return found + 1;
+}
+
+/// Ends the gather of slot k (particle i at pi): its delta and, when building (`list` set), the
+/// list's count (0 when it overflowed) and base. Returns false when the list overflowed.
+inline bool endGather(const GatherArrays& g, uint32_t k, uint32_t i, glm::vec3 pi, glm::vec3 sum, uint32_t* list,
+                      uint32_t found) {
+  g.delta[k] = glm::vec4(sum, 0.0f);
+  if (!list) return true;
+  list[0] = found <= SIM_CANDIDATE_CAPACITY ? found : 0u;
+  g.candidate_base[i] = pi;
+  return found <= SIM_CANDIDATE_CAPACITY;
+}
+
 /// The collision gather of hash slots [begin, end), the reference: each particle sums the
 /// repulsion of the particles not connected to it in its 27 neighbour cells, cells in dz, dy, dx
 /// order (cellCode), the particles of a cell in ascending index, as the GPU sums them. With

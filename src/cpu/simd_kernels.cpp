@@ -241,14 +241,7 @@ bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_
         const uint32_t m = hit_slot[t];
         if (m == k || coords[m] != bucket_cell[hit_bucket[t]] || adjacency.contains(slots[m])) continue;
         const vec3 pj(sx[m], sy[m], sz[m]);
-        if (candidates) {
-          if (found < SIM_CANDIDATE_CAPACITY) {
-            uint32_t e = found + 1;
-            for (; e > 1 && candidates[e - 1] > slots[m]; --e) candidates[e] = candidates[e - 1];
-            candidates[e] = slots[m];
-          }
-          ++found;
-        }
+        if (candidates) found = addCandidate(candidates, found, slots[m]);
         const vec3 d = pi - pj;
         if (dot(d, d) < r2) sum += repulsion(pi, pj, r, u.collision_stiffness);
       }
@@ -278,12 +271,7 @@ bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_
       }
     }
     flush();
-    g.delta[k] = vec4(sum, 0.0f);
-    if (candidates) {
-      candidates[0] = found <= SIM_CANDIDATE_CAPACITY ? found : 0u;
-      g.candidate_base[i] = pi;
-      fits = fits && found <= SIM_CANDIDATE_CAPACITY;
-    }
+    fits = endGather(g, k, i, pi, sum, candidates, found) && fits;
   }
   return fits;
 }

@@ -50,7 +50,7 @@ uint32_t GpuSolver::scanSumsSize(uint32_t count) {
   return groups + (groups > 1 ? scanSumsSize(groups) : 0);
 }
 
-std::vector<GpuSolver::BindingSpec> GpuSolver::bindingTable(StartData& d) const {
+std::vector<GpuSolver::BindingSpec> GpuSolver::bindingTable(StartData& d, bool particle_data) const {
   const SheetTopology& topo = topo_;
   const uint32_t n = topo.particleCount(), m = topo.constraintCount(), t = topo.triangleCount();
   const uint32_t cells = topo.hash_size;
@@ -60,11 +60,13 @@ std::vector<GpuSolver::BindingSpec> GpuSolver::bindingTable(StartData& d) const 
   const VkDeviceSize list_bytes = candidates_fit_ ? 4ull * SIM_CANDIDATE_STRIDE * n : 16,
                      list_base = candidates_fit_ ? 16ull * n : 16;
 
-  // Start contents derived from the topology.
-  d.pos.resize(n);
-  for (uint32_t i = 0; i < n; ++i) d.pos[i] = startPosition(topo.rest_pos[i]);
-  d.normal.assign(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
-  d.adj_mask = adjacencyMasks(topo);
+  // Start contents derived from the topology; the per-particle ones only for an upload.
+  if (particle_data) {
+    d.pos.resize(n);
+    for (uint32_t i = 0; i < n; ++i) d.pos[i] = startPosition(topo.rest_pos[i]);
+    d.normal.assign(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
+    d.adj_mask = adjacencyMasks(topo);
+  }
   d.last_start = n; // cell_start[T] = N, always
   d.colors.clear();
   for (const ColorRange& c : topo.colors) d.colors.emplace_back(c.first, c.count);
@@ -156,7 +158,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
   uniform_stride_ = (sizeof(SimUniforms) + align - 1) / align * align;
   buf_[SIM_BIND_UNIFORMS] = ctx_.createHostBuffer(uniform_stride_ * (kSlots + 1), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   StartData start;
-  const std::vector<BindingSpec> table = bindingTable(start);
+  const std::vector<BindingSpec> table = bindingTable(start, true);
   // A sheet whose arrays exceed what the device binds is refused with one line, before allocating.
   for (const BindingSpec& b : table)
     if (b.bytes > max_range)
@@ -236,7 +238,7 @@ void GpuSolver::stageBindings(VkCommandBuffer cmd, const std::vector<BindingSpec
 void GpuSolver::beginReset() {
   finish();
   StartData start;
-  const std::vector<BindingSpec> table = bindingTable(start);
+  const std::vector<BindingSpec> table = bindingTable(start, false);
   std::vector<Buffer> staging;
   ctx_.submitOnce([&](VkCommandBuffer cmd) {
     // The reset animates from where the sheet is now; what tearing changed is restored.
@@ -250,7 +252,7 @@ void GpuSolver::beginReset() {
 void GpuSolver::readback(SimState& out) {
   finish();
   StartData start;
-  const std::vector<BindingSpec> table = bindingTable(start);
+  const std::vector<BindingSpec> table = bindingTable(start, false);
   // Every read-back binding into one staging buffer, one after the other.
   std::array<VkDeviceSize, kBindingCount> offset{};
   VkDeviceSize total = 0;

@@ -151,8 +151,10 @@ private:
     uint32_t last_start = 0;
     shaderio::Counters counters{};
   };
-  /// The table of bindings of the uploaded topology (every storage binding, once).
-  std::vector<BindingSpec> bindingTable(StartData& start) const;
+  /// The table of bindings of the uploaded topology (every storage binding, once). Without
+  /// `particle_data` the per-particle start contents (positions, normals, adjacency masks) are left
+  /// out: what a reset restores and what readback needs are cheap to point at.
+  std::vector<BindingSpec> bindingTable(StartData& start, bool particle_data) const;
   /// Records the start contents of the table's bindings (only those a reset restores).
   void stageBindings(VkCommandBuffer cmd, const std::vector<BindingSpec>& table, bool restored_only,
                      std::vector<Buffer>& staging);
