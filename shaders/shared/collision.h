@@ -2,6 +2,7 @@
 // rules of the collision candidate lists (SIM_CANDIDATE_* in sim_config.h). Included by xpbd.h.
 #ifndef SIM_COLLISION_H
 #define SIM_COLLISION_H
+#include "exact_math.h"
 #include "sim_types.h"
 
 /// Integer cell of a position in the spatial hash, clamped to +-2^29 so that the conversion and the
@@ -19,11 +20,11 @@ SIM_INLINE uint hashCell(ivec3 c, uint mask) {
 /// Repulsion of particle i away from j when closer than radius (half the overlap, scaled).
 SIM_INLINE vec3 repulsion(vec3 pi, vec3 pj, float radius, float stiffness) {
   vec3 d = pi - pj;
-  float d2 = dot(d, d);
+  float d2 = dot3(d, d);
   vec3 r = vec3(0.0f);
   if (d2 < radius * radius && d2 > 1e-12f) {
-    float len = sqrt(d2);
-    r = d * (stiffness * 0.5f * (radius - len) / len);
+    float len = simSqrt(d2);
+    r = d * simDiv(stiffness * 0.5f * (radius - len), len);
   }
   return r;
 }
@@ -32,7 +33,7 @@ SIM_INLINE vec3 repulsion(vec3 pi, vec3 pj, float radius, float stiffness) {
 /// 1 / inv_cell: SIM_CANDIDATE_SKIN x r, at most 0.99 x (cell - r) so that the lists come from the 27
 /// cells around a particle; 0 (no lists) below SIM_CANDIDATE_MIN_SKIN x r.
 SIM_INLINE float candidateSkin(float r, float inv_cell) {
-  float skin = min(SIM_CANDIDATE_SKIN * r, 0.99f * (1.0f / inv_cell - r));
+  float skin = min(SIM_CANDIDATE_SKIN * r, 0.99f * (simDiv(1.0f, inv_cell) - r));
   return skin >= SIM_CANDIDATE_MIN_SKIN * r ? skin : 0.0f;
 }
 
@@ -47,7 +48,7 @@ SIM_INLINE bool candidatesCurrent(uvec4 state, float skin, float search) {
 SIM_INLINE bool travelledTooFar(vec3 p, vec3 base, float skin) {
   vec3 d = p - base;
   float travel = SIM_CANDIDATE_TRAVEL * skin;
-  return !(dot(d, d) < travel * travel);
+  return !(dot3(d, d) < travel * travel);
 }
 
 /// True when the lists of `state` were outgrown within SIM_CANDIDATE_MIN_AGE substeps.

@@ -14,6 +14,10 @@
 #define SIM_WG_SCAN 256
 // Elements scanned per thread in the block scan
 #define SIM_SCAN_PER_THREAD 4
+// Specialization constants of every simulation shader (see exact_math.h): emulate an inexact
+// device's sqrt and divide; correct them (off only to show what the correction is for)
+#define SIM_SPEC_INEXACT_MATH 1
+#define SIM_SPEC_CORRECT_MATH 2
 // Largest number of substeps per tick (per-substep inputs are arrays of this size)
 #define SIM_MAX_SUBSTEPS 32
 // Largest number of constraint colours

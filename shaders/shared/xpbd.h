@@ -2,6 +2,7 @@
 // Functions take values and return values (no inout) so that one body compiles as both.
 #ifndef SIM_XPBD_H
 #define SIM_XPBD_H
+#include "exact_math.h"
 #include "sim_types.h"
 
 /// Position and previous position of one particle.
@@ -76,9 +77,9 @@ SIM_INLINE PairDelta solveDistance(vec4 pa, vec4 pb, float rest, float stiffness
   r.db = vec3(0.0f);
   float wsum = pa.w + pb.w;
   vec3 d = vec3(pb) - vec3(pa);
-  float len = sqrt(dot(d, d));
+  float len = simSqrt(dot3(d, d));
   if (wsum > 0.0f && len > 1e-9f) {
-    float s = stiffness * (len - rest) / (len * wsum);
+    float s = simDiv(stiffness * (len - rest), len * wsum);
     r.da = d * (s * pa.w);
     r.db = d * (-s * pb.w);
   }
@@ -113,21 +114,23 @@ SIM_INLINE VerletState floorParticle(vec4 pos, vec4 prev, vec3 collision_delta, 
 SIM_INLINE bool shouldTear(vec4 pa, vec4 pb, float rest, uint kind, float tear_factor, uint tear_kinds) {
   bool tearable = tearingOn(tear_factor) && (tear_kinds & (1u << kind)) != 0u;
   vec3 d = vec3(pb) - vec3(pa);
-  return tearable && sqrt(dot(d, d)) > rest * tear_factor;
+  return tearable && simSqrt(dot3(d, d)) > rest * tear_factor;
 }
 
 /// Smooth normal of grid particle (i, j) from central differences of its neighbours.
 SIM_INLINE vec3 gridNormal(vec3 left, vec3 right, vec3 up, vec3 down) {
-  vec3 n = cross(right - left, up - down);
-  float l2 = dot(n, n);
-  return l2 > 1e-20f ? n / sqrt(l2) : vec3(0.0f, 0.0f, 1.0f);
+  vec3 n = cross3(right - left, up - down);
+  float l2 = dot3(n, n);
+  if (!(l2 > 1e-20f)) return vec3(0.0f, 0.0f, 1.0f);
+  float len = simSqrt(l2);
+  return vec3(simDiv(n.x, len), simDiv(n.y, len), simDiv(n.z, len));
 }
 
 /// Squared distance from point p to the ray o + t d (|d| = 1), and t; t < 0 gives a huge distance.
 SIM_INLINE vec2 rayPointDistance2(vec3 o, vec3 d, vec3 p) {
-  float t = dot(p - o, d);
+  float t = dot3(p - o, d);
   vec3 q = o + d * t - p;
-  return vec2(t < 0.0f ? 3.0e38f : dot(q, q), t);
+  return vec2(t < 0.0f ? 3.0e38f : dot3(q, q), t);
 }
 
 #include "collision.h"

@@ -9,7 +9,7 @@ void main() {
   uint i = threadIndex();
   if (i >= p.count) return;
   float w = inverseMass(rest_pos[i], false, u.flags);
-  vec4 q = vec4(mix(vec3(reset_from[i]), vec3(rest_pos[i]), u.reset_alpha), w);
+  vec4 q = vec4(blend3(vec3(reset_from[i]), vec3(rest_pos[i]), u.reset_alpha), w);
   pos[i] = q;
   prev[i] = q;
 }

@@ -48,7 +48,7 @@ void hashSort(uint i, vec3 p) {
   uint rank = 0u;
   for (uint k = first; k < end; ++k) rank += cell_scatter[k] < i ? 1u : 0u;
   cell_particles[first + rank] = i;
-  cell_pos[first + rank] = uvec4(floatBitsToUint(p), packGrid(gridOf(i, 1.0f / float(u.cols))));
+  cell_pos[first + rank] = uvec4(floatBitsToUint(p), packGrid(gridOf(i, simDiv(1.0f, float(u.cols)))));
 }
 
 // True when particles i and j share a constraint (binary search in i's sorted adjacency list).
@@ -100,7 +100,7 @@ vec3 gatherRepulsion(uint i, vec3 pi, float search, uint list, out bool fits) {
   ivec3 ci = cellOf(pi, u.inv_cell);
   vec3 scaled = pi * u.inv_cell;
   float reach = search * u.inv_cell + 1e-3f;
-  ivec2 gi = gridOf(i, 1.0f / float(u.cols));
+  ivec2 gi = gridOf(i, simDiv(1.0f, float(u.cols)));
   uint grid_i = packGrid(gi);
   uint mask_i = adj_mask[i];
   uint visit = 0x7FFFFFFu;
@@ -130,7 +130,7 @@ vec3 gatherRepulsion(uint i, vec3 pi, float search, uint list, out bool fits) {
         uvec4 q = cell_pos[k];
         vec3 d = pi - uintBitsToFloat(q.xyz);
         bool may_repel = q.w != grid_i && adjacencyOf(gi, mask_i, q.w) != SIM_CONNECTED;
-        close |= dot(d, d) < search2 && may_repel ? 1u << (k - first) : 0u;
+        close |= dot3(d, d) < search2 && may_repel ? 1u << (k - first) : 0u;
       }
       for (; close != 0u; close &= close - 1u) {
         uvec4 q = cell_pos[first + uint(findLSB(close))];
@@ -150,7 +150,7 @@ vec3 gatherRepulsion(uint i, vec3 pi, float search, uint list, out bool fits) {
           ++listed;
         }
         vec3 d = pi - pj;
-        if (dot(d, d) < r2) sum += repulsion(pi, pj, r, u.collision_stiffness);
+        if (dot3(d, d) < r2) sum += repulsion(pi, pj, r, u.collision_stiffness);
       }
     }
   }
@@ -172,7 +172,7 @@ vec3 candidateRepulsion(uint i, vec3 pi) {
     vec3 pj = vec3(SIM_POSITION(candidates[list + e]));
     vec3 d = pi - pj;
     ivec3 o = cellOf(pj, u.inv_cell) - ci;
-    if (dot(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1)))) codes |= 1u << cellCode(o);
+    if (dot3(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1)))) codes |= 1u << cellCode(o);
   }
   vec3 sum = vec3(0.0f);
   for (; codes != 0u; codes &= codes - 1u) {
@@ -181,7 +181,7 @@ vec3 candidateRepulsion(uint i, vec3 pi) {
       vec3 pj = vec3(SIM_POSITION(candidates[list + e]));
       vec3 d = pi - pj;
       ivec3 o = cellOf(pj, u.inv_cell) - ci;
-      if (dot(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1))) && cellCode(o) == b)
+      if (dot3(d, d) < r2 && all(lessThanEqual(abs(o), ivec3(1))) && cellCode(o) == b)
         sum += repulsion(pi, pj, r, u.collision_stiffness);
     }
   }

@@ -50,6 +50,9 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   j["physics_ticks"] = sim.physicsTicks();
   j["ms_per_tick"] = median;
   j["dispatches_per_tick"] = solver.dispatchesPerTick();
+  const Arithmetic arith = solver.arithmetic();
+  j["arithmetic"] = {{"rounding", arith.rounding}, {"denormals", arith.denormals}, {"corrected", arith.corrected}};
+  j["inexact_math_emulated"] = arith.inexact_math_emulated;
   nlohmann::json passes = nlohmann::json::object();
   for (auto& [name, t] : solver.passTimes().ms) passes[name] = t;
   if (backend.gpu) j["gpu_ms_per_pass"] = passes;

@@ -25,6 +25,14 @@ struct PassTimes {
   std::vector<std::pair<std::string, double>> ms;
 };
 
+/// How a backend's float arithmetic runs (the stats JSON and `tender diff` report it).
+struct Arithmetic {
+  std::string rounding = "nearest even"; ///< "nearest even", or "device default" where it cannot be asked for
+  std::string denormals = "preserve";    ///< "preserve", "flush to zero" or "device default"
+  bool inexact_math_emulated = false;    ///< sqrt and divide start from deliberately inexact ones
+  bool corrected = true;                 ///< sqrt and divide corrected to the correctly rounded result
+};
+
 /// A simulation backend: the CPU reference or the Vulkan compute solver.
 /// Both run the same passes in the same order on the same arrays.
 class Solver {
@@ -57,6 +65,8 @@ public:
   virtual uint32_t dispatchesPerTick() const { return 0; }
   /// Bytes of device (or host) memory the solver's arrays take.
   virtual uint64_t memoryBytes() const { return 0; }
+  /// How its float arithmetic runs (the CPU reference: IEEE, round to nearest even, denormals kept).
+  virtual Arithmetic arithmetic() const { return {}; }
 };
 
 } // namespace tender

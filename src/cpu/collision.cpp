@@ -35,7 +35,7 @@ bool gatherReference(const GatherArrays& g, const SimUniforms& u, uint32_t begin
             const vec3 pj(g.x[m], g.y[m], g.z[m]);
             // Candidate list: insert j in order, while it has room; count every candidate.
             const vec3 d = pi - pj;
-            if (candidates && dot(d, d) < search2) found = addCandidate(candidates, found, j);
+            if (candidates && dot3(d, d) < search2) found = addCandidate(candidates, found, j);
             sum += repulsion(pi, pj, r, u.collision_stiffness);
           }
         }
@@ -162,7 +162,7 @@ vec3 CpuCollision::candidateRepulsion(const SimUniforms& u, const vec4* pos, uin
     const vec3 pj(pos[candidates[e + 1]]);
     const vec3 d = pi - pj;
     const ivec3 o = cellOf(pj, u.inv_cell) - ci;
-    const bool in_reach = dot(d, d) < r2 && std::abs(o.x) <= 1 && std::abs(o.y) <= 1 && std::abs(o.z) <= 1;
+    const bool in_reach = dot3(d, d) < r2 && std::abs(o.x) <= 1 && std::abs(o.y) <= 1 && std::abs(o.z) <= 1;
     code[e] = in_reach ? cellCode(o) : 27u;
   }
   for (uint32_t b = 0; b < 27; ++b)

@@ -195,7 +195,7 @@ void CpuSolver::resetPass(const SimUniforms& u) {
   pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
     for (uint32_t i = begin; i < end; ++i) {
       const float w = inverseMass(rest_[i], false, u.flags);
-      pos_[i] = vec4(mix(vec3(reset_from_[i]), vec3(rest_[i]), u.reset_alpha), w);
+      pos_[i] = vec4(blend3(vec3(reset_from_[i]), vec3(rest_[i]), u.reset_alpha), w);
       prev_[i] = pos_[i];
     }
   });

@@ -243,7 +243,7 @@ bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_
         const vec3 pj(sx[m], sy[m], sz[m]);
         if (candidates) found = addCandidate(candidates, found, slots[m]);
         const vec3 d = pi - pj;
-        if (dot(d, d) < r2) sum += repulsion(pi, pj, r, u.collision_stiffness);
+        if (dot3(d, d) < r2) sum += repulsion(pi, pj, r, u.collision_stiffness);
       }
       hit_count = 0;
     };
@@ -253,7 +253,7 @@ bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_
       visit &= visit - 1u;
       const uint32_t first = bucket_first[b], last = bucket_last[b];
       for (uint32_t m = first; m < last; m += 4) {
-        // d = pi - pj; the same dot(d, d) < search2 test as the scalar maths, four at a time
+        // d = pi - pj; the same dot3(d, d) < search2 test as the scalar maths, four at a time
         const __m128 dx = _mm_sub_ps(px, _mm_loadu_ps(sx + m));
         const __m128 dy = _mm_sub_ps(py, _mm_loadu_ps(sy + m));
         const __m128 dz = _mm_sub_ps(pz, _mm_loadu_ps(sz + m));

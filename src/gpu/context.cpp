@@ -75,8 +75,17 @@ std::optional<uint32_t> findQueueFamily(VkPhysicalDevice pd, bool graphics) {
 }
 
 DeviceInfo describe(VkPhysicalDevice pd, uint32_t index) {
+  VkPhysicalDeviceProperties basic{};
+  vkGetPhysicalDeviceProperties(pd, &basic);
+  // Float controls are core from Vulkan 1.2; older devices are listed but not usable
+  VkPhysicalDeviceFloatControlsProperties floats{};
+  floats.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FLOAT_CONTROLS_PROPERTIES;
+  VkPhysicalDeviceSubgroupProperties subgroup{};
+  subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+  subgroup.pNext = basic.apiVersion >= VK_API_VERSION_1_2 ? &floats : nullptr;
   VkPhysicalDeviceDriverProperties driver{};
   driver.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES;
+  driver.pNext = &subgroup;
   VkPhysicalDeviceProperties2 props2{};
   props2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
   props2.pNext = &driver;
@@ -95,6 +104,11 @@ DeviceInfo describe(VkPhysicalDevice pd, uint32_t index) {
       d.memory_bytes = std::max<uint64_t>(d.memory_bytes, mem.memoryHeaps[h].size);
   d.api_version = p.apiVersion;
   d.usable = p.apiVersion >= VK_API_VERSION_1_3 && findQueueFamily(pd, false).has_value();
+  d.floats.rounding_rte = floats.shaderRoundingModeRTEFloat32;
+  d.floats.denorm_preserve = floats.shaderDenormPreserveFloat32;
+  d.floats.denorm_flush = floats.shaderDenormFlushToZeroFloat32;
+  d.subgroup_size = subgroup.subgroupSize;
+  d.shared_memory = p.limits.maxComputeSharedMemorySize;
   return d;
 }
 

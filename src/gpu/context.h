@@ -25,6 +25,8 @@
 
 #include <vulkan/vulkan.h>
 
+#include "gpu/spirv_rules.h"
+
 namespace tender::gpu {
 
 /// A Vulkan call failed at run time: what() is one line for the user ("Vulkan error
@@ -100,7 +102,10 @@ struct DeviceInfo {
   std::string driver;        ///< driver name and info
   uint64_t memory_bytes = 0; ///< largest device-local heap
   uint32_t api_version = 0;
-  bool usable = false; ///< Vulkan 1.3 with a compute queue
+  bool usable = false;        ///< Vulkan 1.3 with a compute queue
+  FloatControls floats;       ///< the 32-bit float controls it can be asked for
+  uint32_t subgroup_size = 0; ///< invocations per subgroup
+  uint32_t shared_memory = 0; ///< bytes of shared memory per workgroup
 };
 
 /// Lists the Vulkan devices, or fails with one line when Vulkan or a device is missing.
@@ -137,6 +142,8 @@ public:
   const VkPhysicalDeviceProperties& properties() const { return props_; }
   /// The chosen device as `tender devices` describes it.
   const DeviceInfo& info() const { return info_; }
+  /// The 32-bit float controls the device can be asked for.
+  const FloatControls& floatControls() const { return info_.floats; }
   /// Validation warnings and errors reported so far (0 without validation).
   uint32_t validationMessages() const { return validation_messages_.load(); }
   bool validationEnabled() const { return validation_; }

@@ -90,20 +90,36 @@ void GpuSolver::createPipelines(FusedShape fused) {
   pli.pPushConstantRanges = &range;
   VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &layout_));
 
+  // The rules of float arithmetic (NoContraction everywhere, the device's float controls) and the
+  // switches of exact_math.h: the environment may ask for an emulated inexact device
+  // (TENDER_EMULATE_INEXACT_MATH=1) and, to show what the correction does, for none
+  // (TENDER_UNCORRECTED_MATH=1).
+  float_rules_ = floatRulesFor(ctx_.floatControls());
+  auto env_on = [](const char* name) {
+    const char* v = std::getenv(name);
+    return v && *v && std::string_view(v) != "0";
+  };
+  inexact_math_ = env_on("TENDER_EMULATE_INEXACT_MATH");
+  corrected_math_ = !env_on("TENDER_UNCORRECTED_MATH");
   // spec: specialization constant 0 when >= 0 (the step of a pick pass, the fused tick's workgroup size)
   auto make = [&](const char* key, uint32_t push_size, uint32_t per_invocation, int spec = -1) {
-    std::span<const uint32_t> code = simShader(key);
-    if (code.empty()) vkCheckFailed(VK_ERROR_INITIALIZATION_FAILED, key, __FILE__, __LINE__);
+    std::span<const uint32_t> embedded = simShader(key);
+    if (embedded.empty()) vkCheckFailed(VK_ERROR_INITIALIZATION_FAILED, key, __FILE__, __LINE__);
+    const std::vector<uint32_t> code = applyFloatRules(embedded, float_rules_);
     VkShaderModuleCreateInfo mi{};
     mi.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-    mi.codeSize = code.size_bytes();
+    mi.codeSize = code.size() * sizeof(uint32_t);
     mi.pCode = code.data();
     VkShaderModule module;
     VK_CHECK(vkCreateShaderModule(dev, &mi, nullptr, &module));
     modules_.push_back(module);
-    uint32_t spec_value = spec < 0 ? 0u : uint32_t(spec);
-    VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
-    VkSpecializationInfo spec_info{1, &entry, sizeof(uint32_t), &spec_value};
+    const uint32_t spec_values[3] = {spec < 0 ? 0u : uint32_t(spec), inexact_math_ ? VK_TRUE : VK_FALSE,
+                                     corrected_math_ ? VK_TRUE : VK_FALSE};
+    const VkSpecializationMapEntry entries[3] = {
+        {0, 0, 4}, {SIM_SPEC_INEXACT_MATH, 4, 4}, {SIM_SPEC_CORRECT_MATH, 8, 4}};
+    // Constant 0 only where the pass has one; the math switches everywhere (a pass without them ignores them)
+    VkSpecializationInfo spec_info{spec >= 0 ? 3u : 2u, spec >= 0 ? entries : entries + 1, sizeof(spec_values),
+                                   spec_values};
     VkComputePipelineCreateInfo ci{};
     ci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
     ci.stage = {};
@@ -111,14 +127,15 @@ void GpuSolver::createPipelines(FusedShape fused) {
     ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     ci.stage.module = module;
     ci.stage.pName = "main";
-    ci.stage.pSpecializationInfo = spec >= 0 ? &spec_info : nullptr;
+    ci.stage.pSpecializationInfo = &spec_info;
     ci.layout = layout_;
     ComputePipeline p;
     VK_CHECK(vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &p.pipeline));
     pipelines_.push_back(p.pipeline);
     p.push_size = push_size;
     // The workgroup size comes from the shader itself (its local_size_x, or the specialised size).
-    const uint32_t local = spec >= 0 && std::string_view(key) == "tick_fused.comp" ? uint32_t(spec) : localSizeX(code);
+    const uint32_t local =
+        spec >= 0 && std::string_view(key) == "tick_fused.comp" ? uint32_t(spec) : localSizeX(embedded);
     if (local == 0) vkCheckFailed(VK_ERROR_INITIALIZATION_FAILED, key, __FILE__, __LINE__);
     p.workgroup = local * per_invocation;
     return p;
@@ -318,6 +335,15 @@ PassTimes GpuSolver::passTimes() const {
   PassTimes t;
   for (int c = 0; c < kCategoryCount; ++c) t.ms.emplace_back(kNames[c], last_ms_[size_t(c)]);
   return t;
+}
+
+Arithmetic GpuSolver::arithmetic() const {
+  Arithmetic a;
+  a.rounding = float_rules_.rounding_rte ? "nearest even" : "device default";
+  a.denormals = denormalsName(float_rules_.denormals);
+  a.inexact_math_emulated = inexact_math_;
+  a.corrected = corrected_math_;
+  return a;
 }
 
 bool GpuSolver::usesFusedPath() const {
