@@ -1,12 +1,7 @@
 // Resources and helpers of every simulation pass: one descriptor set, bindings from sim_config.h.
 #ifndef SIM_COMMON_GLSL
 #define SIM_COMMON_GLSL
-#include "sim_config.h"
-// The exact arithmetic of exact_math.h, with its two switches as specialization constants
-layout(constant_id = SIM_SPEC_INEXACT_MATH) const bool kInexactMath = false;
-layout(constant_id = SIM_SPEC_CORRECT_MATH) const bool kCorrectMath = true;
-#define SIM_INEXACT_MATH kInexactMath
-#define SIM_CORRECT_MATH kCorrectMath
+#include "exact_math.glsl"
 #include "xpbd.h"
 
 // Every pass defines its workgroup size before including this file.

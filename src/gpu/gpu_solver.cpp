@@ -10,6 +10,7 @@
 
 #include "gpu/barriers.h"
 #include "gpu/shaders.h"
+#include "gpu/sim_pipeline.h"
 
 namespace tender::gpu {
 
@@ -95,47 +96,19 @@ void GpuSolver::createPipelines(FusedShape fused) {
   // (TENDER_EMULATE_INEXACT_MATH=1) and, to show what the correction does, for none
   // (TENDER_UNCORRECTED_MATH=1).
   float_rules_ = floatRulesFor(ctx_.floatControls());
-  auto env_on = [](const char* name) {
-    const char* v = std::getenv(name);
-    return v && *v && std::string_view(v) != "0";
-  };
-  inexact_math_ = env_on("TENDER_EMULATE_INEXACT_MATH");
-  corrected_math_ = !env_on("TENDER_UNCORRECTED_MATH");
+  math_ = MathSwitches::fromEnvironment();
   // spec: specialization constant 0 when >= 0 (the step of a pick pass, the fused tick's workgroup size)
   auto make = [&](const char* key, uint32_t push_size, uint32_t per_invocation, int spec = -1) {
-    std::span<const uint32_t> embedded = simShader(key);
-    if (embedded.empty()) vkCheckFailed(VK_ERROR_INITIALIZATION_FAILED, key, __FILE__, __LINE__);
-    const std::vector<uint32_t> code = applyFloatRules(embedded, float_rules_);
-    VkShaderModuleCreateInfo mi{};
-    mi.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-    mi.codeSize = code.size() * sizeof(uint32_t);
-    mi.pCode = code.data();
-    VkShaderModule module;
-    VK_CHECK(vkCreateShaderModule(dev, &mi, nullptr, &module));
-    modules_.push_back(module);
-    const uint32_t spec_values[3] = {spec < 0 ? 0u : uint32_t(spec), inexact_math_ ? VK_TRUE : VK_FALSE,
-                                     corrected_math_ ? VK_TRUE : VK_FALSE};
-    const VkSpecializationMapEntry entries[3] = {
-        {0, 0, 4}, {SIM_SPEC_INEXACT_MATH, 4, 4}, {SIM_SPEC_CORRECT_MATH, 8, 4}};
-    // Constant 0 only where the pass has one; the math switches everywhere (a pass without them ignores them)
-    VkSpecializationInfo spec_info{spec >= 0 ? 3u : 2u, spec >= 0 ? entries : entries + 1, sizeof(spec_values),
-                                   spec_values};
-    VkComputePipelineCreateInfo ci{};
-    ci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-    ci.stage = {};
-    ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    ci.stage.module = module;
-    ci.stage.pName = "main";
-    ci.stage.pSpecializationInfo = &spec_info;
-    ci.layout = layout_;
     ComputePipeline p;
-    VK_CHECK(vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &p.pipeline));
+    VkShaderModule module = VK_NULL_HANDLE;
+    p.pipeline = createSimPipeline(ctx_, key, layout_, float_rules_, math_,
+                                   spec >= 0 ? std::optional<uint32_t>(uint32_t(spec)) : std::nullopt, module);
+    modules_.push_back(module);
     pipelines_.push_back(p.pipeline);
     p.push_size = push_size;
     // The workgroup size comes from the shader itself (its local_size_x, or the specialised size).
     const uint32_t local =
-        spec >= 0 && std::string_view(key) == "tick_fused.comp" ? uint32_t(spec) : localSizeX(embedded);
+        spec >= 0 && std::string_view(key) == "tick_fused.comp" ? uint32_t(spec) : localSizeX(simShader(key));
     if (local == 0) vkCheckFailed(VK_ERROR_INITIALIZATION_FAILED, key, __FILE__, __LINE__);
     p.workgroup = local * per_invocation;
     return p;
@@ -341,8 +314,8 @@ Arithmetic GpuSolver::arithmetic() const {
   Arithmetic a;
   a.rounding = float_rules_.rounding_rte ? "nearest even" : "device default";
   a.denormals = denormalsName(float_rules_.denormals);
-  a.inexact_math_emulated = inexact_math_;
-  a.corrected = corrected_math_;
+  a.inexact_math_emulated = math_.inexact;
+  a.corrected = math_.corrected;
   return a;
 }
 

@@ -11,6 +11,7 @@
 
 #include "core/solver.h"
 #include "gpu/context.h"
+#include "gpu/sim_pipeline.h"
 
 namespace tender::gpu {
 
@@ -212,15 +213,14 @@ private:
   VkPipeline bound_ = VK_NULL_HANDLE; ///< pipeline bound while recording
   uint32_t recorded_dispatches_ = 0;
   bool fused_allowed_ = true;
-  FloatRules float_rules_;                ///< what the shaders' SPIR-V asks of the device's float arithmetic
-  bool inexact_math_ = false;             ///< TENDER_EMULATE_INEXACT_MATH: an emulated inexact sqrt and divide
-  bool corrected_math_ = true;            ///< exact_math.h corrects sqrt and divide (TENDER_UNCORRECTED_MATH: not)
-  uint32_t fused_substeps_ = 1;           ///< substeps per dispatch of the fused tick
-  float fused_max_cell_spacings_ = -1.0f; ///< largest hash cell of the fused tick (< 0: any)
-  float spacing_ = 0.0f;                  ///< grid spacing: the shortest structural rest length
-  bool candidates_allowed_ = true;        ///< setCandidateLists
-  bool candidates_fit_ = false;           ///< the candidate-list buffer fits the device
-  std::vector<glm::uvec4> hash_grids_;    ///< full grids of the hash passes, in recording order
+  FloatRules float_rules_;                      ///< what the shaders' SPIR-V asks of the device's float arithmetic
+  MathSwitches math_;                           ///< the switches of exact_math.h (from the environment)
+  uint32_t fused_substeps_ = 1;                 ///< substeps per dispatch of the fused tick
+  float fused_max_cell_spacings_ = -1.0f;       ///< largest hash cell of the fused tick (< 0: any)
+  float spacing_ = 0.0f;                        ///< grid spacing: the shortest structural rest length
+  bool candidates_allowed_ = true;              ///< setCandidateLists
+  bool candidates_fit_ = false;                 ///< the candidate-list buffer fits the device
+  std::vector<glm::uvec4> hash_grids_;          ///< full grids of the hash passes, in recording order
   std::vector<glm::uvec4> hash_grids_uploaded_; ///< what SIM_BIND_HASH_ARGS holds of them
   uint32_t hash_slot_ = 0;                      ///< next live hash-pass argument while recording
   mutable std::array<double, kCategoryCount> last_ms_{};

@@ -1,0 +1,16 @@
+#version 460
+// The device's exactSqrt and exactDiv over many inputs (gpu::checkExactMath): each element holds
+// the bits of a and b and receives those of exactSqrt(a) and exactDiv(a, b).
+layout(local_size_x = 64) in;
+#include "exact_math.glsl"
+layout(std430, set = 0, binding = 0) buffer Cases { uvec4 cases[]; };
+layout(push_constant) uniform PushBlock { uint count; }
+p;
+
+void main() {
+  uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 64u + gl_GlobalInvocationID.x;
+  if (i >= p.count) return;
+  uvec4 c = cases[i];
+  float a = uintBitsToFloat(c.x), b = uintBitsToFloat(c.y);
+  cases[i] = uvec4(c.xy, floatBitsToUint(exactSqrt(a)), floatBitsToUint(exactDiv(a, b)));
+}

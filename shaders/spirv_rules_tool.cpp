@@ -1,0 +1,46 @@
+// Build step of the simulation's shaders (shaders/CMakeLists.txt):
+//   tender-spirv-rules IN.spv OUT.spv     NoContraction on every float operation (before spirv-opt,
+//                                         which would otherwise fuse a * b + c into Fma)
+//   tender-spirv-rules --embed IN.spv OUT the words as a C array initialiser
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <vector>
+
+#include "gpu/spirv_rules.h"
+
+int main(int argc, char** argv) {
+  const bool embed = argc == 4 && std::strcmp(argv[1], "--embed") == 0;
+  if (argc != 3 && !embed) {
+    std::fprintf(stderr, "usage: tender-spirv-rules [--embed] IN.spv OUT\n");
+    return 2;
+  }
+  const char* in_path = argv[argc - 2];
+  const char* out_path = argv[argc - 1];
+  std::ifstream in(in_path, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) {
+    std::fprintf(stderr, "tender-spirv-rules: error: cannot read %s\n", in_path);
+    return 2;
+  }
+  if (bytes.size() < 20 || bytes.size() % 4 != 0) {
+    std::fprintf(stderr, "tender-spirv-rules: error: %s is not SPIR-V\n", in_path);
+    return 2;
+  }
+  std::vector<uint32_t> words(bytes.size() / 4);
+  std::memcpy(words.data(), bytes.data(), bytes.size());
+  std::ofstream out(out_path, std::ios::binary | std::ios::trunc);
+  if (embed) {
+    for (size_t i = 0; i < words.size(); ++i) out << words[i] << (i % 8 == 7 ? ",\n" : ",");
+    out << "\n";
+  } else {
+    const std::vector<uint32_t> ruled = tender::gpu::applyFloatRules(words, {});
+    out.write(reinterpret_cast<const char*>(ruled.data()), std::streamsize(ruled.size() * 4));
+  }
+  if (!out.good()) {
+    std::fprintf(stderr, "tender-spirv-rules: error: cannot write %s\n", out_path);
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,141 @@
+#include "gpu/sim_pipeline.h"
+
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "core/shaderio.h"
+#include "gpu/barriers.h"
+#include "gpu/shaders.h"
+
+namespace tender::gpu {
+
+namespace {
+bool envOn(const char* name) {
+  const char* v = std::getenv(name);
+  return v && *v && std::string_view(v) != "0";
+}
+} // namespace
+
+MathSwitches MathSwitches::fromEnvironment() {
+  MathSwitches m;
+  m.inexact = envOn("TENDER_EMULATE_INEXACT_MATH");
+  m.corrected = !envOn("TENDER_UNCORRECTED_MATH");
+  return m;
+}
+
+VkPipeline createSimPipeline(VulkanContext& ctx, std::string_view key, VkPipelineLayout layout, const FloatRules& rules,
+                             MathSwitches math, std::optional<uint32_t> spec0, VkShaderModule& module) {
+  const std::string name(key);
+  std::span<const uint32_t> embedded = simShader(key);
+  if (embedded.empty()) vkCheckFailed(VK_ERROR_INITIALIZATION_FAILED, name.c_str(), __FILE__, __LINE__);
+  const std::vector<uint32_t> code = applyFloatRules(embedded, rules);
+  VkShaderModuleCreateInfo mi{};
+  mi.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+  mi.codeSize = code.size() * sizeof(uint32_t);
+  mi.pCode = code.data();
+  VK_CHECK(vkCreateShaderModule(ctx.device(), &mi, nullptr, &module));
+  const uint32_t values[3] = {spec0.value_or(0u), math.inexact ? VK_TRUE : VK_FALSE,
+                              math.corrected ? VK_TRUE : VK_FALSE};
+  const VkSpecializationMapEntry entries[3] = {{0, 0, 4}, {SIM_SPEC_INEXACT_MATH, 4, 4}, {SIM_SPEC_CORRECT_MATH, 8, 4}};
+  // Constant 0 only where the pass has one; the math switches everywhere (a shader without them ignores them)
+  VkSpecializationInfo spec{spec0 ? 3u : 2u, spec0 ? entries : entries + 1, sizeof(values), values};
+  VkComputePipelineCreateInfo ci{};
+  ci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+  ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  ci.stage.module = module;
+  ci.stage.pName = "main";
+  ci.stage.pSpecializationInfo = &spec;
+  ci.layout = layout;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkResult r = vkCreateComputePipelines(ctx.device(), VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline);
+  if (r != VK_SUCCESS) {
+    vkDestroyShaderModule(ctx.device(), module, nullptr);
+    module = VK_NULL_HANDLE;
+    vkCheckFailed(r, ("vkCreateComputePipelines " + name).c_str(), __FILE__, __LINE__);
+  }
+  return pipeline;
+}
+
+void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math) {
+  static_assert(sizeof(MathCase) == 16);
+  if (cases.empty()) return;
+  VkDevice dev = ctx.device();
+  VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  VkDescriptorSetLayoutCreateInfo sli{};
+  sli.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  sli.bindingCount = 1;
+  sli.pBindings = &binding;
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, 4};
+  VkPipelineLayoutCreateInfo pli{};
+  pli.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  pli.setLayoutCount = 1;
+  pli.pushConstantRangeCount = 1;
+  pli.pPushConstantRanges = &range;
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1};
+  VkDescriptorPoolCreateInfo dpi{};
+  dpi.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  dpi.maxSets = 1;
+  dpi.poolSizeCount = 1;
+  dpi.pPoolSizes = &size;
+  // Everything below is released on every path out (a Vulkan error throws)
+  struct Objects {
+    VkDevice dev;
+    VulkanContext& ctx;
+    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VkShaderModule module = VK_NULL_HANDLE;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    Buffer buffer;
+    ~Objects() {
+      vkDestroyPipeline(dev, pipeline, nullptr);
+      vkDestroyShaderModule(dev, module, nullptr);
+      vkDestroyDescriptorPool(dev, pool, nullptr);
+      vkDestroyPipelineLayout(dev, layout, nullptr);
+      vkDestroyDescriptorSetLayout(dev, set_layout, nullptr);
+      ctx.destroyBuffer(buffer);
+    }
+  } o{dev, ctx, VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE, {}};
+  VK_CHECK(vkCreateDescriptorSetLayout(dev, &sli, nullptr, &o.set_layout));
+  pli.pSetLayouts = &o.set_layout;
+  VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &o.layout));
+  VK_CHECK(vkCreateDescriptorPool(dev, &dpi, nullptr, &o.pool));
+  o.pipeline =
+      createSimPipeline(ctx, "math_check.comp", o.layout, floatRulesFor(ctx.floatControls()), math, {}, o.module);
+
+  // At most 2^16 - 1 workgroups of 64 per row; the rest of a batch spills into Y
+  const uint64_t per_batch = std::min<uint64_t>(cases.size(), 1u << 22);
+  o.buffer = ctx.createHostBuffer(per_batch * sizeof(MathCase), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  VkDescriptorSetAllocateInfo dai{};
+  dai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  dai.descriptorPool = o.pool;
+  dai.descriptorSetCount = 1;
+  dai.pSetLayouts = &o.set_layout;
+  VkDescriptorSet set;
+  VK_CHECK(vkAllocateDescriptorSets(dev, &dai, &set));
+  VkDescriptorBufferInfo bi{o.buffer.buffer, 0, VK_WHOLE_SIZE};
+  VkWriteDescriptorSet w{};
+  w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+  w.dstSet = set;
+  w.descriptorCount = 1;
+  w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  w.pBufferInfo = &bi;
+  vkUpdateDescriptorSets(dev, 1, &w, 0, nullptr);
+  for (size_t first = 0; first < cases.size(); first += per_batch) {
+    const uint32_t count = uint32_t(std::min<uint64_t>(per_batch, cases.size() - first));
+    std::memcpy(o.buffer.mapped, cases.data() + first, count * sizeof(MathCase));
+    ctx.submitOnce([&](VkCommandBuffer cmd) {
+      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.pipeline);
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.layout, 0, 1, &set, 0, nullptr);
+      vkCmdPushConstants(cmd, o.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, 4, &count);
+      const uint32_t groups = (count + 63u) / 64u, gx = std::min(groups, 65535u);
+      vkCmdDispatch(cmd, gx, (groups + gx - 1u) / gx, 1);
+      allToAllAndHost(cmd);
+    });
+    std::memcpy(cases.data() + first, o.buffer.mapped, count * sizeof(MathCase));
+  }
+}
+
+} // namespace tender::gpu

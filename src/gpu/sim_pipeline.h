@@ -1,0 +1,37 @@
+#pragma once
+/// Compute pipelines of the simulation's shaders: their SPIR-V under the device's float rules
+/// (spirv_rules.h) and the switches of exact_math.h as specialization constants.
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "gpu/context.h"
+
+namespace tender::gpu {
+
+/// The switches of exact_math.h. From the environment: TENDER_EMULATE_INEXACT_MATH=1 emulates an
+/// inexact device's sqrt and divide (off by -3..+3 ULP), TENDER_UNCORRECTED_MATH=1 leaves them
+/// uncorrected (to show what the correction is for: parity with the CPU is then lost).
+struct MathSwitches {
+  bool inexact = false;
+  bool corrected = true;
+  static MathSwitches fromEnvironment();
+};
+
+/// A compute pipeline of shaders/sim/<key>.glsl on `layout`; `spec0` sets specialization constant 0
+/// where the shader has one. The module goes to `module` (destroy it with the pipeline). Throws
+/// VulkanError when the shader is missing or Vulkan fails.
+VkPipeline createSimPipeline(VulkanContext& ctx, std::string_view key, VkPipelineLayout layout, const FloatRules& rules,
+                             MathSwitches math, std::optional<uint32_t> spec0, VkShaderModule& module);
+
+/// One input of the device math check and its results (bits of floats).
+struct MathCase {
+  uint32_t a = 0, b = 0;
+  uint32_t sqrt_a = 0, a_over_b = 0; ///< exactSqrt(a) and exactDiv(a, b) as the device computed them
+};
+
+/// Runs exactSqrt and exactDiv of every case on the device (the shader math_check.comp).
+void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math);
+
+} // namespace tender::gpu

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# `tender sim --backend gpu` on an emulated inexact device (TENDER_EMULATE_INEXACT_MATH=1: sqrt and
+# divide off by up to 3 ULP) gives the CPU reference's state hash and says so in its stats; with
+# the correction switched off (TENDER_UNCORRECTED_MATH=1) the hash differs.
+set -u
+T=${TENDER:?set TENDER to the tender binary}
+export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+hash_of() { sed -n 's/.*"state_hash": "\([0-9a-f]*\)".*/\1/p' "$1"; }
+
+printf '0 grab particle 1535\n1 move 4 -4 6\n40 release\n' >"$tmp/yank.txt"
+run=(sim --ticks 120 --script "$tmp/yank.txt")
+"$T" "${run[@]}" --backend cpu --stats "$tmp/cpu.json" >/dev/null || fail "cpu run failed"
+TENDER_EMULATE_INEXACT_MATH=1 "$T" "${run[@]}" --backend gpu --stats "$tmp/gpu.json" >/dev/null || fail "gpu run failed"
+TENDER_EMULATE_INEXACT_MATH=1 TENDER_UNCORRECTED_MATH=1 "$T" "${run[@]}" --backend gpu --stats "$tmp/raw.json" >/dev/null ||
+  fail "uncorrected gpu run failed"
+cpu=$(hash_of "$tmp/cpu.json") gpu=$(hash_of "$tmp/gpu.json") raw=$(hash_of "$tmp/raw.json")
+[ -n "$cpu" ] && [ "$cpu" = "$gpu" ] || fail "inexact device: gpu hash '$gpu' != cpu hash '$cpu'"
+[ -n "$raw" ] && [ "$raw" != "$cpu" ] || fail "without the correction the hash should differ from the cpu's ($raw)"
+grep -q '"inexact_math_emulated": true' "$tmp/gpu.json" || fail "the stats do not say the emulation was on"
+grep -q '"inexact_math_emulated": false' "$tmp/cpu.json" || fail "the cpu stats should say inexact_math_emulated false"
+[ "$failures" -eq 0 ] && echo "ok: inexact device gives the cpu's hash $cpu; uncorrected gives $raw"
+exit $((failures > 0))

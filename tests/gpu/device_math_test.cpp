@@ -1,0 +1,80 @@
+// exactSqrt and exactDiv as the device runs them (shader math_check.comp) under the emulated
+// inexact device: the CPU's correctly rounded bits for every significand of sqrt and millions of
+// quotients; without the correction the same device disagrees.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <random>
+
+#include "gpu/sim_pipeline.h"
+#include "gpu_test_env.h"
+
+using namespace tender;
+
+namespace {
+
+bool same(uint32_t a, uint32_t b) {
+  const float fa = std::bit_cast<float>(a), fb = std::bit_cast<float>(b);
+  return a == b || (std::isnan(fa) && std::isnan(fb));
+}
+
+std::vector<gpu::MathCase> mathCases() {
+  std::vector<gpu::MathCase> cases;
+  // sqrt: every significand at both exponent parities, and the denormals in steps
+  for (uint32_t m = 0; m < (1u << 23); ++m) {
+    gpu::MathCase c;
+    c.a = 0x3F800000u | m; // [1, 2)
+    c.b = 0x40000000u | m; // [2, 4)
+    cases.push_back(c);
+  }
+  for (uint32_t m = 1; m < (1u << 23); m += 97) cases.push_back({m, 0x3F800000u | (m * 13u & 0x7FFFFFu), 0, 0});
+  std::mt19937_64 rng(11);
+  for (int k = 0; k < 2'000'000; ++k) {
+    const uint64_t r = rng();
+    cases.push_back({uint32_t(r) & 0xFF7FFFFFu, uint32_t(r >> 32) & 0xFF7FFFFFu, 0, 0});
+  }
+  return cases;
+}
+
+} // namespace
+
+TEST(DeviceMath, ExactSqrtAndDivideOnAnInexactDeviceGiveTheCpuBits) {
+  std::string why;
+  gpu::VulkanContext* ctx = test::testContext(why);
+  if (!ctx) {
+    if (test::inCi()) FAIL() << why;
+    GTEST_SKIP() << why;
+  }
+  std::vector<gpu::MathCase> cases = mathCases();
+  gpu::runDeviceMath(*ctx, cases, {true, true});
+  uint64_t bad = 0;
+  for (const gpu::MathCase& c : cases) {
+    const float a = std::bit_cast<float>(c.a), b = std::bit_cast<float>(c.b);
+    const uint32_t want_sqrt = std::bit_cast<uint32_t>(std::sqrt(a)), want_div = std::bit_cast<uint32_t>(a / b);
+    if ((!same(c.sqrt_a, want_sqrt) || !same(c.a_over_b, want_div)) && ++bad <= 5)
+      ADD_FAILURE() << std::hexfloat << "a " << a << " b " << b << ": sqrt " << std::bit_cast<float>(c.sqrt_a)
+                    << " (want " << std::sqrt(a) << "), a / b " << std::bit_cast<float>(c.a_over_b) << " (want "
+                    << a / b << ")";
+  }
+  EXPECT_EQ(bad, 0u) << "of " << cases.size() << " cases";
+  EXPECT_EQ(ctx->validationMessages(), 0u);
+}
+
+TEST(DeviceMath, WithoutTheCorrectionTheInexactDeviceDisagrees) {
+  std::string why;
+  gpu::VulkanContext* ctx = test::testContext(why);
+  if (!ctx) {
+    if (test::inCi()) FAIL() << why;
+    GTEST_SKIP() << why;
+  }
+  std::vector<gpu::MathCase> cases;
+  for (uint32_t m = 0; m < 10000; ++m) cases.push_back({0x3F800000u | m * 797u, 0x3FC00000u | m * 31u, 0, 0});
+  gpu::runDeviceMath(*ctx, cases, {true, false});
+  int wrong = 0;
+  for (const gpu::MathCase& c : cases) {
+    const float a = std::bit_cast<float>(c.a), b = std::bit_cast<float>(c.b);
+    wrong += c.sqrt_a != std::bit_cast<uint32_t>(std::sqrt(a)) || c.a_over_b != std::bit_cast<uint32_t>(a / b);
+  }
+  EXPECT_GT(wrong, 5000);
+}

@@ -1,0 +1,116 @@
+// The float rules written into every simulation shader: NoContraction on every float operation,
+// none of the built-ins whose order or precision a device chooses, and modules that the SPIR-V
+// validator accepts under each combination of float controls.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+#include <unordered_set>
+
+#include "gpu/shaders.h"
+#include "gpu/spirv_rules.h"
+
+using namespace tender::gpu;
+
+namespace {
+
+struct Instruction {
+  uint32_t op;
+  std::span<const uint32_t> words; // the whole instruction
+};
+
+std::vector<Instruction> instructions(std::span<const uint32_t> code) {
+  std::vector<Instruction> out;
+  for (size_t w = 5; w < code.size();) {
+    const uint32_t count = code[w] >> 16;
+    if (count == 0 || w + count > code.size()) break;
+    out.push_back({code[w] & 0xFFFFu, code.subspan(w, count)});
+    w += count;
+  }
+  return out;
+}
+
+// GLSL.std.450 instructions that are exact on every device: abs, floor, min/max/clamp, bit scans,
+// sign, and Sqrt (only ever the approximation that exact_math.h corrects).
+const std::set<uint32_t> kExactExtInsts = {3 /*Trunc*/,
+                                           4 /*FAbs*/,
+                                           5 /*SAbs*/,
+                                           6 /*FSign*/,
+                                           7 /*SSign*/,
+                                           8 /*Floor*/,
+                                           9 /*Ceil*/,
+                                           31 /*Sqrt*/,
+                                           37,
+                                           38,
+                                           39,
+                                           40,
+                                           41,
+                                           42,
+                                           43,
+                                           44,
+                                           45,
+                                           /*min, max, clamp*/ 73,
+                                           74,
+                                           75 /*FindILsb, FindSMsb, FindUMsb*/};
+
+const FloatRules kAllRules[] = {{false, Denormals::DeviceDefault},
+                                {true, Denormals::Preserve},
+                                {true, Denormals::FlushToZero},
+                                {false, Denormals::Preserve}};
+
+} // namespace
+
+TEST(SpirvRules, EveryFloatOperationOfEverySimShaderIsNoContraction) {
+  ASSERT_GT(simShaderKeys().size(), 15u);
+  for (std::string_view key : simShaderKeys()) {
+    for (const FloatRules& rules : kAllRules) {
+      const std::vector<uint32_t> code = applyFloatRules(simShader(key), rules);
+      std::unordered_set<uint32_t> no_contraction, arithmetic;
+      uint32_t modes = 0;
+      for (const Instruction& in : instructions(code)) {
+        if (in.op == 71 && in.words.size() >= 3 && in.words[2] == 42) no_contraction.insert(in.words[1]);
+        if (isFloatArithmetic(in.op)) arithmetic.insert(in.words[2]);
+        if (in.op == 16 && in.words.size() == 4 && in.words[3] == 32) ++modes;
+      }
+      if (key == "project.comp" || key == "tick_fused.comp") {
+        EXPECT_GT(arithmetic.size(), 10u) << key;
+      }
+      for (uint32_t id : arithmetic) EXPECT_TRUE(no_contraction.count(id)) << key << ": %" << id << " may be fused";
+      EXPECT_EQ(modes, uint32_t(rules.rounding_rte) + uint32_t(rules.denormals != Denormals::DeviceDefault)) << key;
+    }
+  }
+}
+
+TEST(SpirvRules, NoSimShaderUsesABuiltInWhoseResultTheDeviceChooses) {
+  for (std::string_view key : simShaderKeys()) {
+    for (const Instruction& in : instructions(simShader(key))) {
+      EXPECT_NE(in.op, 148u) << key << " uses OpDot (dot(): the order of its sum is the device's)";
+      if (in.op == 12 /*OpExtInst*/) {
+        EXPECT_TRUE(kExactExtInsts.count(in.words[4])) << key << " uses GLSL.std.450 instruction " << in.words[4];
+      }
+    }
+  }
+}
+
+TEST(SpirvRules, TheValidatorAcceptsEveryRewrittenShader) {
+#ifndef TENDER_SPIRV_VAL
+  GTEST_SKIP() << "spirv-val not found at configure time";
+#else
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "tender_spirv_rules";
+  std::filesystem::create_directories(dir);
+  for (std::string_view key : simShaderKeys()) {
+    for (const FloatRules& rules : kAllRules) {
+      const std::vector<uint32_t> code = applyFloatRules(simShader(key), rules);
+      const std::filesystem::path file = dir / (std::string(key) + ".spv");
+      std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(code.data()), long(code.size() * 4));
+      const std::string cmd = std::string(TENDER_SPIRV_VAL) + " --target-env vulkan1.3 " + file.string() + " 2>&1";
+      EXPECT_EQ(std::system(cmd.c_str()), 0)
+          << key << " with rte " << rules.rounding_rte << ", denormals " << denormalsName(rules.denormals);
+    }
+  }
+  std::filesystem::remove_all(dir);
+#endif
+}
