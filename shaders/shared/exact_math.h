@@ -112,14 +112,16 @@ SIM_INLINE float exactDiv(float a, float b) {
       deviceDiv(uintBitsToFloat(0x3F800000u | (ma & 0x7FFFFFu)), uintBitsToFloat(0x3F800000u | (mb & 0x7FFFFFu)));
   uint q = clamp(uint(approx * (ge ? 8388608.0f : 16777216.0f)), 0x800000u, 0xFFFFFFu);
   int r = int((ma << shift) - q * mb);
-  for (int k = 0; k < 8; ++k) {
-    if (r < 0) {
-      q -= 1u;
-      r += int(mb);
-    } else if (r >= int(mb)) {
-      q += 1u;
-      r -= int(mb);
-    }
+  // q is off by a few units: an estimate of floor(r / mb) (within one of it) and one last step
+  int d = int(floor(float(r) * (1.0f / float(mb))));
+  q += uint(d);
+  r -= d * int(mb);
+  if (r < 0) {
+    q -= 1u;
+    r += int(mb);
+  } else if (r >= int(mb)) {
+    q += 1u;
+    r -= int(mb);
   }
   uint twice = 2u * uint(r);
   int above = twice > mb ? 1 : twice == mb ? 0 : -1;
@@ -141,15 +143,17 @@ SIM_INLINE float exactSqrt(float x) {
   float scaled = uintBitsToFloat(0x3F800000u | (m & 0x7FFFFFu)) * (odd ? 2.0f : 1.0f); // N / 2^46
   uint s = clamp(uint(deviceSqrt(scaled) * 8388608.0f), 0x800000u, 0xFFFFFFu);
   // r = N - s^2, exact modulo 2^32 and small; s is the floor when 0 <= r <= 2s
-  int r = int((m << (odd ? 24u : 23u)) - s * s);
-  for (int k = 0; k < 8; ++k) {
-    if (r < 0) {
-      s -= 1u;
-      r += int(2u * s + 1u);
-    } else if (r > int(2u * s)) {
-      r -= int(2u * s + 1u);
-      s += 1u;
-    }
+  uint n = m << (odd ? 24u : 23u);
+  int r = int(n - s * s);
+  // s is off by a few units: an estimate of the step (within one of it), then one last step
+  s += uint(int(floor(float(r) * (0.5f / float(s)))));
+  r = int(n - s * s);
+  if (r < 0) {
+    s -= 1u;
+    r += int(2u * s + 1u);
+  } else if (r > int(2u * s)) {
+    r -= int(2u * s + 1u);
+    s += 1u;
   }
   // sqrt(N) is never exactly half-way; it is above s + 1/2 when N > s^2 + s
   return packRounded(0u, half_exp + 127, s, r > int(s) ? 1 : -1, r != 0);
