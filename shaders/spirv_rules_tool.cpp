@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <string>
 #include <vector>
 
 #include "gpu/spirv_rules.h"
@@ -30,7 +31,9 @@ int main(int argc, char** argv) {
   }
   std::vector<uint32_t> words(bytes.size() / 4);
   std::memcpy(words.data(), bytes.data(), bytes.size());
-  std::ofstream out(out_path, std::ios::binary | std::ios::trunc);
+  // Written whole to a temporary name, then renamed: a failed step leaves no half-written output
+  const std::string tmp_path = std::string(out_path) + ".tmp";
+  std::ofstream out(tmp_path, std::ios::binary | std::ios::trunc);
   if (embed) {
     for (size_t i = 0; i < words.size(); ++i) out << words[i] << (i % 8 == 7 ? ",\n" : ",");
     out << "\n";
@@ -38,7 +41,9 @@ int main(int argc, char** argv) {
     const std::vector<uint32_t> ruled = tender::gpu::applyFloatRules(words, {});
     out.write(reinterpret_cast<const char*>(ruled.data()), std::streamsize(ruled.size() * 4));
   }
-  if (!out.good()) {
+  out.close();
+  if (!out.good() || std::rename(tmp_path.c_str(), out_path) != 0) {
+    std::remove(tmp_path.c_str());
     std::fprintf(stderr, "tender-spirv-rules: error: cannot write %s\n", out_path);
     return 2;
   }
