@@ -74,7 +74,7 @@ struct FusedPush {
   uint count;         // particles
   uint first_substep; // first substep of this dispatch
   uint substeps;      // substeps of this dispatch
-  uint pad;
+  uint stop;          // last pass of the tick to run (passesPerSubstep numbering), SIM_NONE: all
 };
 
 /// GPU counters: tear bookkeeping and indirect arguments (one storage buffer).

@@ -28,6 +28,15 @@ void sync() {
   barrier();
 }
 
+// Diagnosis (`tender diff`): the tick stops after pass p.stop of the tick (passesPerSubstep's
+// numbering; SIM_NONE: it runs whole). Every invocation takes the same branch, after a barrier.
+bool stopsAfter(uint pass) { return pass == p.stop; }
+
+// The positions go back to their buffer (at the end of the dispatch, or where the tick stops).
+void storePositions(uint n) {
+  for (uint i = gl_LocalInvocationID.x; i < n; i += kInvocations) pos[i] = s_pos[i];
+}
+
 // Exclusive scan by the whole workgroup of cell_count into cell_start (SIM_SCAN_HASH) or of
 // scratch[0, count) in place (SIM_SCAN_SCRATCH). Each invocation scans a contiguous chunk after
 // adding up the totals of the chunks before its own, which meet in scratch[sums + invocation].
@@ -62,7 +71,10 @@ void main() {
   float dt2 = u.dt * u.dt;
   for (uint i = lid; i < n; i += kInvocations) s_pos[i] = pos[i];
   uint end = min(p.first_substep + p.substeps, substepCount(u.substeps));
+  uint per_substep = passesPerSubstep(u.iterations, u.color_count, collision);
+  uint projects = u.iterations * u.color_count;
   for (uint s = p.first_substep; s < end; ++s) {
+    uint first_pass = s * per_substep;
     // 1. Verlet integration (as integrate.comp)
     for (uint i = lid; i < n; i += kInvocations) {
       VerletState st =
@@ -72,6 +84,10 @@ void main() {
       prev[i] = st.prev;
     }
     sync();
+    if (stopsAfter(first_pass)) {
+      storePositions(n);
+      return;
+    }
     // A new substep: no constraint torn in it yet (every invocation read the count of the last
     // substep before the barrier above).
     if (lid == 0u) counters.torn_new = 0u;
@@ -87,6 +103,10 @@ void main() {
           s_pos[k.b] = pb + vec4(d.db, 0.0f);
         }
         sync();
+        if (stopsAfter(first_pass + 1u + it * u.color_count + c)) {
+          storePositions(n);
+          return;
+        }
       }
     // 3. Collision (as candidates_check, hash_*, collide and candidates_finish). From the candidate lists
     // while they hold every pair that can touch (no particle has travelled SIM_CANDIDATE_TRAVEL x skin
@@ -122,25 +142,43 @@ void main() {
       }
     }
     // 4. Each particle takes its repulsion (from the lists, or gathered here from the hash's
-    // bucket-ordered copy of the positions) and meets the floor (as floor.comp)
+    // bucket-ordered copy of the positions) and meets the floor (as floor.comp). A tick that
+    // stops after the collision keeps the repulsion in delta (as collide.comp) instead.
+    uint collide_pass = first_pass + 1u + projects;
+    bool stop_collide = collision && stopsAfter(collide_pass);
     for (uint i = lid; i < n; i += kInvocations) {
       vec4 q = s_pos[i];
       vec3 repel = vec3(0.0f);
       bool fits = true;
       if (collision) repel = mode == SIM_COLLIDE_CANDIDATES ? vec3(delta[i]) : gatherParticle(i, vec3(q), mode, fits);
       if (!fits) atomicOr(counters.candidate_flags.y, 1u);
+      if (stop_collide) {
+        delta[i] = vec4(repel, 0.0f);
+        continue;
+      }
       VerletState st = floorParticle(q, prev[i], repel, u.flags, u.floor_y, u.restitution, u.friction);
       s_pos[i] = st.pos;
       prev[i] = st.prev;
     }
     sync();
+    uint floor_pass = collide_pass + (collision ? 1u : 0u);
+    if (stop_collide || stopsAfter(floor_pass)) {
+      storePositions(n);
+      return;
+    }
     if (collision && lid == 0u)
       counters.candidate_state = candidatesNextStateOf(state, mode, counters.candidate_flags.y != 0u);
     // 5. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
     // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
     // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
     // substep it tore in removed it), and kinds that cannot tear skip the position loads.
-    if (!tearing) continue;
+    if (!tearing) {
+      if (stopsAfter(floor_pass + 1u)) {
+        storePositions(n);
+        return;
+      }
+      continue;
+    }
     for (uint c = 0u; c < u.color_count; ++c) {
       uvec2 range = color_range[c];
       for (uint t = lid; t < range.y; t += kInvocations) {
@@ -149,13 +187,18 @@ void main() {
       }
     }
     sync();
-    if (counters.torn_new == 0u) continue;
-    uint slots = compactSlots();
-    for (uint k = lid; k < slots; k += kInvocations) tearFlags(k);
-    sync();
-    scanWorkgroup(SIM_SCAN_SCRATCH, slots, slots);
-    for (uint k = lid; k < slots; k += kInvocations) tearCompact(k);
-    sync();
+    if (counters.torn_new != 0u) {
+      uint slots = compactSlots();
+      for (uint k = lid; k < slots; k += kInvocations) tearFlags(k);
+      sync();
+      scanWorkgroup(SIM_SCAN_SCRATCH, slots, slots);
+      for (uint k = lid; k < slots; k += kInvocations) tearCompact(k);
+      sync();
+    }
+    if (stopsAfter(floor_pass + 1u)) {
+      storePositions(n);
+      return;
+    }
   }
-  for (uint i = lid; i < n; i += kInvocations) pos[i] = s_pos[i];
+  storePositions(n);
 }

@@ -36,6 +36,11 @@ struct SimOptions {
 /// Largest --ticks of `tender sim` and `tender render`.
 constexpr uint64_t kMaxTicks = 100000000;
 
+struct DiffOptions {
+  uint64_t ticks = 0;
+  std::string a, b; ///< backends: cpu, gpu, gpu:N, gpu-percolor, gpu-percolor:N
+};
+
 struct RenderOptions {
   uint64_t ticks = 0;
   std::string out = "tender.png";
@@ -58,6 +63,9 @@ std::optional<InputScript> scriptFor(const std::string& path, const SimParams& p
 
 int runSim(const CommonOptions& common, const SimOptions& o);
 int runDevices(const CommonOptions& common);
+/// `tender diff`: 0 when the two backends give bitwise the same states every tick, 1 when they
+/// part (where is printed), 2 on bad input.
+int runDiff(const CommonOptions& common, const DiffOptions& o);
 int runRender(const CommonOptions& common, const RenderOptions& o);
 int runDemo(const CommonOptions& common, const DemoOptions& o);
 

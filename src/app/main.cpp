@@ -1,4 +1,4 @@
-// tender: receipt paper physics. The interactive demo, and headless `sim`, `render`, `devices`.
+// tender: receipt paper physics. The interactive demo, and headless `sim`, `render`, `diff`, `devices`.
 #include <cstdio>
 
 #include <CLI/CLI.hpp>
@@ -100,6 +100,18 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--width", render.width, "image width")->check(CLI::Range(16u, 16384u));
   render_cmd->add_option("--height", render.height, "image height")->check(CLI::Range(16u, 16384u));
 
+  DiffOptions diff;
+  std::string diff_ticks;
+  CLI::App* diff_cmd =
+      app.add_subcommand("diff", "run the same input on two backends and find where their states first differ");
+  addCommon(*diff_cmd, common, false);
+  diff_cmd->add_option("--ticks", diff_ticks, "ticks to compare (decimal)")->required();
+  diff_cmd->add_option("--script", common.script, "input script to replay");
+  diff_cmd->add_option("--a", diff.a, "first backend: cpu, gpu, gpu:N (device N), gpu-percolor[:N]")->required();
+  diff_cmd->add_option("--b", diff.b, "second backend, as --a")->required();
+  diff_cmd->footer("Exit status: 0 identical, 1 the backends differ (the first tick, substep, pass and\n"
+                   "particle or constraint are printed), 2 bad input.");
+
   CLI::App* devices_cmd = app.add_subcommand("devices", "list the Vulkan devices");
   addCommon(*devices_cmd, common, false);
 
@@ -111,14 +123,18 @@ int main(int argc, char** argv) {
     return fail(e.what());
   }
   if (*devices_cmd) return runDevices(common);
+  if (*diff_cmd) common.backend = "cpu"; // each side is checked for its own backend
   if (auto err = resolve(common)) return fail(*err);
   if (auto err = parseWhole(sim_ticks, 0, kMaxTicks, sim.ticks)) return fail("--ticks: " + *err);
   if (auto err = parseWhole(render_ticks, 0, kMaxTicks, render.ticks)) return fail("--ticks: " + *err);
+  if (*diff_cmd)
+    if (auto err = parseWhole(diff_ticks, 1, kMaxTicks, diff.ticks)) return fail("--ticks: " + *err);
   // A write beyond the file-size limit fails like any other write error (exit 2, no fragment).
   ignoreFileSizeSignal();
   try {
     if (*sim_cmd) return runSim(common, sim);
     if (*render_cmd) return runRender(common, render);
+    if (*diff_cmd) return runDiff(common, diff);
     return runDemo(common, demo);
   } catch (const std::exception& e) { // a Vulkan error at run time, out of memory
     return fail(e.what());

@@ -35,6 +35,7 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
     co.min_chunk = o.min_chunk;
     co.simd = o.simd;
     auto cpu = std::make_unique<CpuSolver>(co);
+    cpu->setPlantedUlp(o.plant);
     out.cpu = cpu.get();
     out.solver = std::move(cpu);
     return std::nullopt;

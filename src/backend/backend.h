@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/params.h"
+#include "core/passes.h"
 #include "core/solver.h"
 
 namespace tender {
@@ -22,11 +23,12 @@ class VulkanContext;
 struct BackendOptions {
   /// "cpu"; "gpu"; or "gpu-percolor", the GPU solver without its fused small-sheet tick.
   std::string backend = "gpu";
-  int device = -1;         ///< Vulkan device index (`tender devices`), -1 = prefer a discrete GPU
-  bool validation = false; ///< VK_LAYER_KHRONOS_validation with synchronization validation
-  uint32_t threads = 0;    ///< CPU solver workers (SimParams::threads): 0 = one per hardware thread
-  uint32_t min_chunk = 0;  ///< CPU solver: smallest loop share worth a thread; 0 = tuned (CpuOptions)
-  bool simd = true;        ///< CPU solver SIMD kernels (SimParams::simd)
+  int device = -1;                 ///< Vulkan device index (`tender devices`), -1 = prefer a discrete GPU
+  bool validation = false;         ///< VK_LAYER_KHRONOS_validation with synchronization validation
+  uint32_t threads = 0;            ///< CPU solver workers (SimParams::threads): 0 = one per hardware thread
+  uint32_t min_chunk = 0;          ///< CPU solver: smallest loop share worth a thread; 0 = tuned (CpuOptions)
+  bool simd = true;                ///< CPU solver SIMD kernels (SimParams::simd)
+  std::optional<PlantedUlp> plant; ///< CPU solver: the test hook of `tender diff` (CpuOptions::plant)
   /// Run the GPU solver on this context (the renderer's) instead of creating one; it must outlive
   /// the backend.
   gpu::VulkanContext* context = nullptr;

@@ -207,7 +207,8 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
 }
 
 void Simulation::runPhysicsTick() {
-  solver_.tick(makeUniforms());
+  last_uniforms_ = makeUniforms();
+  solver_.tick(last_uniforms_);
   ++physics_ticks_;
   release_index_ = SIM_NONE;
   if (grab_index_ != SIM_NONE) {
@@ -218,7 +219,8 @@ void Simulation::runPhysicsTick() {
 }
 
 void Simulation::runResetFrame() {
-  solver_.tick(makeUniforms());
+  last_uniforms_ = makeUniforms();
+  solver_.tick(last_uniforms_);
   --reset_frame_;
 }
 

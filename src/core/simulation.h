@@ -72,6 +72,8 @@ public:
   uint64_t physicsTicks() const { return physics_ticks_; }
   /// Uniforms of the next physics tick (for tests and tools).
   shaderio::SimUniforms makeUniforms() const;
+  /// Uniforms the solver ran its last tick (or reset frame) with.
+  const shaderio::SimUniforms& lastUniforms() const { return last_uniforms_; }
 
 private:
   void grabAt(uint32_t i, glm::vec3 position);
@@ -94,6 +96,7 @@ private:
   uint32_t reset_frame_ = 0; ///< frames left in the animated reset
   uint64_t frame_ = 0, physics_ticks_ = 0;
   double accumulator_ = 0.0;
+  shaderio::SimUniforms last_uniforms_{};
 };
 
 } // namespace tender

@@ -67,6 +67,12 @@ public:
   virtual uint64_t memoryBytes() const { return 0; }
   /// How its float arithmetic runs (the CPU reference: IEEE, round to nearest even, denormals kept).
   virtual Arithmetic arithmetic() const { return {}; }
+  /// Diagnosis (`tender diff`): the next physics tick runs its passes 0..last_pass only (numbered
+  /// as passAt in passes.h) and stops there; SIM_NONE runs whole ticks. After a tick cut short
+  /// the state is fit for readback() and readDeltas() only: start again with upload().
+  virtual void stopNextTickAfter(uint32_t last_pass) = 0;
+  /// Each particle's collision delta from the last collide pass (xyz, w = 0).
+  virtual void readDeltas(std::vector<glm::vec4>& out) = 0;
 };
 
 } // namespace tender

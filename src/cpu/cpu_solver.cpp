@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 
 #include "simd_kernels.h"
 #include "worker_pool.h"
@@ -63,6 +64,8 @@ void CpuSolver::upload(const SheetTopology& topo) {
   torn_.assign(topo.constraintCount(), 0u);
   triangles_ = topo.triangles;
   triangle_count_ = topo.triangleCount();
+  ticks_ = 0;
+  stop_after_ = SIM_NONE;
   collision_.upload(topo.adj_offsets, topo.adj_list, topo.hash_size, grain_);
 }
 
@@ -98,7 +101,7 @@ void CpuSolver::projectRange(const float stiffness[4], uint32_t begin, uint32_t 
   }
 }
 
-void CpuSolver::project(const SimUniforms& u, uint32_t iterations) {
+void CpuSolver::projectColors(const SimUniforms& u, uint32_t first, uint32_t count) {
   const float stiffness[4] = {u.stiffness.x, u.stiffness.y, u.stiffness.z, u.stiffness.w};
   const uint32_t colors = uint32_t(colors_.size());
   if (colors == 0) return;
@@ -106,10 +109,10 @@ void CpuSolver::project(const SimUniforms& u, uint32_t iterations) {
   for (const ColorRange& range : colors_) largest = std::max(largest, range.count);
   const uint32_t chunks = pool_->chunksFor(largest, grain_(kGrainConstraints));
   // Gauss-Seidel over colours: one phase per colour, as many iterations per job as fit.
-  const uint32_t per_job = std::max(1u, WorkerPool::kMaxPhases / colors);
-  for (uint32_t it = 0; it < iterations; it += per_job)
-    pool_->runPhases(std::min(per_job, iterations - it) * colors, chunks, [&](uint32_t phase, uint32_t chunk) {
-      const ColorRange& range = colors_[phase % colors];
+  const uint32_t per_job = std::max(1u, WorkerPool::kMaxPhases / colors) * colors;
+  for (uint32_t done = 0; done < count; done += per_job)
+    pool_->runPhases(std::min(per_job, count - done), chunks, [&](uint32_t phase, uint32_t chunk) {
+      const ColorRange& range = colors_[(first + done + phase) % colors];
       const uint32_t begin = WorkerPool::chunkBound(range.count, chunks, chunk);
       const uint32_t end = WorkerPool::chunkBound(range.count, chunks, chunk + 1);
       projectRange(stiffness, range.first + begin, range.first + end);
@@ -202,20 +205,51 @@ void CpuSolver::resetPass(const SimUniforms& u) {
 }
 
 void CpuSolver::tick(const SimUniforms& u) {
+  const uint32_t stop = stop_after_;
+  stop_after_ = SIM_NONE;
+  const uint64_t tick = ticks_++;
   if (u.reset_active) {
     resetPass(u);
     passes_per_tick_ = 1;
     return;
   }
   const bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
+  const uint32_t projects = u.iterations * uint32_t(colors_.size());
+  std::optional<uint32_t> plant_at;
+  if (plant_ && plant_->tick == tick) plant_at = passIndex(u, plant_->pass);
+  const uint32_t plant = plant_at.value_or(SIM_NONE);
+  uint32_t pass = 0; // the tick's next pass (passes.h numbering)
+  // Ends the next `count` passes; true when the tick stops after them.
+  auto passed = [&](uint32_t count) {
+    pass += count;
+    if (plant == pass - 1 && plant_->particle < pos_.size()) {
+      float& x = pos_[plant_->particle].x;
+      x = std::nextafter(x, INFINITY);
+    }
+    return stop == pass - 1;
+  };
   uint32_t passes = 0;
   for (uint32_t s = 0; s < substepCount(u.substeps); ++s) {
-    integrate(u, s);                 // damped Verlet, gravity, wind; pins and the grab hold
-    project(u, u.iterations);        // Gauss-Seidel over the colours
-    if (collision) collide(u);       // repulsion of unconnected neighbours (Jacobi)
-    floorPass(u);                    // apply the repulsion, then the ground contact
+    integrate(u, s); // damped Verlet, gravity, wind; pins and the grab hold
+    if (passed(1)) return;
+    // Gauss-Seidel over the colours, in runs that end where the tick stops or a change is planted
+    for (uint32_t done = 0; done < projects;) {
+      uint32_t run = projects - done;
+      for (uint32_t cut : {stop, plant})
+        if (cut >= pass && cut - pass < run) run = cut - pass + 1;
+      projectColors(u, done, run);
+      done += run;
+      if (passed(run)) return;
+    }
+    if (collision) {
+      collide(u); // repulsion of unconnected neighbours (Jacobi)
+      if (passed(1)) return;
+    }
+    floorPass(u); // apply the repulsion, then the ground contact
+    if (passed(1)) return;
     if (markTears(u) > 0) compact(); // tear, then compact the colours and triangles
-    passes += 1 + u.iterations * uint32_t(colors_.size()) + (collision ? 2 : 0) + 2;
+    if (passed(1)) return;
+    passes += 1 + projects + (collision ? 2 : 0) + 2;
   }
   passes_per_tick_ = passes;
 }
@@ -257,6 +291,12 @@ PickResult CpuSolver::pick(glm::vec3 o, glm::vec3 d, float radius) {
     best.pos = pos_[best.index];
   }
   return best;
+}
+
+void CpuSolver::readDeltas(std::vector<glm::vec4>& out) {
+  out.assign(pos_.size(), vec4(0.0f));
+  if (collision_.slotDeltas().size() < pos_.size()) return; // no collide pass yet
+  for (uint32_t i = 0; i < pos_.size(); ++i) out[i] = vec4(collision_.delta(i), 0.0f);
 }
 
 void CpuSolver::readback(SimState& out) {

@@ -7,9 +7,11 @@
 /// collision gather also have SIMD kernels (simd_kernels.h) with the very bits of the scalar loops
 /// here; CpuOptions::simd = false runs the scalar reference alone.
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "collision.h"
+#include "core/passes.h"
 #include "core/solver.h"
 
 namespace tender {
@@ -44,6 +46,10 @@ public:
   shaderio::PickResult pick(glm::vec3 o, glm::vec3 d, float radius) override;
   glm::vec3 particlePosition(uint32_t index) override { return glm::vec3(pos_[index]); }
   void readback(SimState& out) override;
+  void stopNextTickAfter(uint32_t last_pass) override { stop_after_ = last_pass; }
+  /// The test hook of `tender diff`: a one-ULP change planted after one pass of one tick.
+  void setPlantedUlp(std::optional<PlantedUlp> plant) { plant_ = plant; }
+  void readDeltas(std::vector<glm::vec4>& out) override;
   uint32_t dispatchesPerTick() const override { return passes_per_tick_; }
   /// Bytes of host memory of the solver's own arrays (capacity, not size).
   uint64_t memoryBytes() const override;
@@ -58,7 +64,11 @@ public:
   /// Verlet integration with gravity, wind, damping; pins and the grab hold their particles.
   void integrate(const shaderio::SimUniforms& u, uint32_t substep);
   /// Gauss-Seidel over the colours, `iterations` times.
-  void project(const shaderio::SimUniforms& u, uint32_t iterations);
+  void project(const shaderio::SimUniforms& u, uint32_t iterations) {
+    projectColors(u, 0, iterations * uint32_t(colors_.size()));
+  }
+  /// Colour passes [first, first + count) of the Gauss-Seidel sweep (pass k: colour k % colours).
+  void projectColors(const shaderio::SimUniforms& u, uint32_t first, uint32_t count);
   /// The collision of one substep (CpuCollision::substep); returns the mode (SIM_CANDIDATE_*).
   uint32_t collide(const shaderio::SimUniforms& u) { return collision_.substep(u, pos_.data()); }
   /// Applies the collision deltas, then the ground contact.
@@ -105,6 +115,9 @@ private:
   std::vector<glm::uvec4> triangles_;
   uint32_t triangle_count_ = 0;
   uint32_t passes_per_tick_ = 0;
+  uint32_t stop_after_ = SIM_NONE; // stopNextTickAfter
+  uint64_t ticks_ = 0;             // ticks since upload (the clock of plant_)
+  std::optional<PlantedUlp> plant_;
 };
 
 } // namespace tender

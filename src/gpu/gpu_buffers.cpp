@@ -292,6 +292,12 @@ void GpuSolver::readback(SimState& out) {
   out.triangles.assign(triangles.begin(), triangles.begin() + out.triangle_count);
 }
 
+void GpuSolver::readDeltas(std::vector<glm::vec4>& out) {
+  finish();
+  out.resize(topo_.particleCount());
+  ctx_.download(buf_[SIM_BIND_DELTA], out.data(), 16ull * out.size());
+}
+
 void GpuSolver::readHash(std::vector<uint32_t>& cell_start, std::vector<uint32_t>& cell_particles) {
   finish();
   cell_start.resize(topo_.hash_size + 1);

@@ -75,13 +75,77 @@ void GpuSolver::timestamp(VkCommandBuffer cmd, Slot& slot, Category c) {
   slot.categories.push_back(uint8_t(c));
 }
 
+bool GpuSolver::recordSubstep(Slot& slot, const RecordKey& key, uint32_t s, uint32_t& pass) {
+  VkCommandBuffer cmd = slot.tick;
+  const uint32_t n = topo_.particleCount(), m = topo_.constraintCount();
+  const SimPush all{0, n, s, 0};
+  auto stops = [&] { return pass++ == key.stop; };
+  // 1. Verlet integration
+  dispatch(cmd, pipes_.integrate, Grid::Threads, n, all);
+  computeToCompute(cmd);
+  timestamp(cmd, slot, kIntegrate);
+  if (stops()) return true;
+  // 2. Gauss-Seidel over colours; constraints beyond a colour's live count exit
+  for (uint32_t it = 0; it < key.iterations; ++it)
+    for (uint32_t c = 0; c < topo_.colorCount(); ++c) {
+      const ColorRange& range = topo_.colors[c];
+      if (range.count > 0) {
+        dispatch(cmd, pipes_.project, Grid::Threads, range.count, SimPush{range.first, range.count, s, c});
+        computeToCompute(cmd);
+      }
+      if (stops()) return true;
+    }
+  timestamp(cmd, slot, kProject);
+  if (key.collision) {
+    // 3. Candidate lists still good? Spatial hash: count, scan, scatter, order within bucket
+    // (each pass does nothing when the lists stand in for it); then gather repulsion and
+    // update the lists' state
+    dispatch(cmd, pipes_.candidates_check, Grid::Threads, n, all);
+    computeToCompute(cmd);
+    dispatch(cmd, pipes_.candidates_decide, Grid::Threads, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0});
+    computeToCompute(cmd);
+    hash_slot_ = 0;
+    dispatch(cmd, pipes_.hash_count, Grid::Hash, n, all);
+    computeToCompute(cmd);
+    recordScan(cmd, SIM_SCAN_HASH, 0, topo_.hash_size, hash_sums_, Grid::Hash);
+    dispatch(cmd, pipes_.hash_scatter, Grid::Hash, n, all);
+    computeToCompute(cmd);
+    dispatch(cmd, pipes_.hash_sort, Grid::Hash, n, all);
+    computeToCompute(cmd);
+    timestamp(cmd, slot, kHash);
+    dispatch(cmd, pipes_.collide, Grid::Threads, n, all);
+    computeToCompute(cmd);
+    dispatch(cmd, pipes_.candidates_finish, Grid::Threads, 1, all);
+    computeToCompute(cmd);
+    timestamp(cmd, slot, kCollide);
+    if (stops()) return true;
+  }
+  // 4. Collision deltas and ground contact
+  dispatch(cmd, pipes_.floor, Grid::Threads, n, all);
+  computeToCompute(cmd);
+  timestamp(cmd, slot, kFloor);
+  if (stops()) return true;
+  // 5. Tear marking; the compaction runs zero workgroups unless something tore this substep
+  if (m > 0) {
+    dispatch(cmd, pipes_.tear_mark, Grid::Threads, m, SimPush{0, m, s, 0});
+    computeToCompute(cmd);
+    dispatch(cmd, pipes_.tear_flags, Grid::Compaction, 0, nullptr, 0);
+    computeToCompute(cmd);
+    recordScan(cmd, SIM_SCAN_SCRATCH, 0, tear_slots_, tear_sums_, Grid::Compaction);
+    dispatch(cmd, pipes_.tear_compact, Grid::Compaction, 0, nullptr, 0);
+    computeToCompute(cmd);
+  }
+  timestamp(cmd, slot, kTear);
+  return stops();
+}
+
 void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
   VkCommandBuffer cmd = slot.tick;
   VK_CHECK(vkResetCommandBuffer(cmd, 0));
   VkCommandBufferBeginInfo bi{};
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
-  const uint32_t n = topo_.particleCount(), m = topo_.constraintCount();
+  const uint32_t n = topo_.particleCount();
   recorded_dispatches_ = 0;
   slot.categories.clear();
   if (slot.queries) {
@@ -90,70 +154,20 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
   }
   anyToCompute(cmd); // earlier submissions (previous tick, copies, the renderer) are done
   bindSet(cmd, index);
-  SimPush all{0, n, 0, 0};
   if (key.fused) {
     // Small sheet: every pass of fused_substeps_ substeps (on a GPU: all) in one workgroup
+    const uint32_t per = passesPerSubstep(key.iterations, topo_.colorCount(), key.collision);
     for (uint32_t s = 0; s < key.substeps; s += fused_substeps_) {
       if (s > 0) computeToCompute(cmd);
-      dispatch(cmd, pipes_.tick_fused, Grid::Workgroup, 1,
-               FusedPush{n, s, std::min(fused_substeps_, key.substeps - s), 0});
+      const uint32_t count = std::min(fused_substeps_, key.substeps - s);
+      dispatch(cmd, pipes_.tick_fused, Grid::Workgroup, 1, FusedPush{n, s, count, key.stop});
+      if (key.stop != SIM_NONE && key.stop < (s + count) * per) break;
     }
     timestamp(cmd, slot, kFused);
   } else {
-    for (uint32_t s = 0; s < key.substeps; ++s) {
-      all.substep = s;
-      // 1. Verlet integration
-      dispatch(cmd, pipes_.integrate, Grid::Threads, n, all);
-      computeToCompute(cmd);
-      timestamp(cmd, slot, kIntegrate);
-      // 2. Gauss-Seidel over colours; constraints beyond a colour's live count exit
-      for (uint32_t it = 0; it < key.iterations; ++it)
-        for (uint32_t c = 0; c < topo_.colorCount(); ++c) {
-          const ColorRange& range = topo_.colors[c];
-          if (range.count == 0) continue;
-          dispatch(cmd, pipes_.project, Grid::Threads, range.count, SimPush{range.first, range.count, s, c});
-          computeToCompute(cmd);
-        }
-      timestamp(cmd, slot, kProject);
-      if (key.collision) {
-        // 3. Candidate lists still good? Spatial hash: count, scan, scatter, order within bucket
-        // (each pass does nothing when the lists stand in for it); then gather repulsion and
-        // update the lists' state
-        dispatch(cmd, pipes_.candidates_check, Grid::Threads, n, all);
-        computeToCompute(cmd);
-        dispatch(cmd, pipes_.candidates_decide, Grid::Threads, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0});
-        computeToCompute(cmd);
-        hash_slot_ = 0;
-        dispatch(cmd, pipes_.hash_count, Grid::Hash, n, all);
-        computeToCompute(cmd);
-        recordScan(cmd, SIM_SCAN_HASH, 0, topo_.hash_size, hash_sums_, Grid::Hash);
-        dispatch(cmd, pipes_.hash_scatter, Grid::Hash, n, all);
-        computeToCompute(cmd);
-        dispatch(cmd, pipes_.hash_sort, Grid::Hash, n, all);
-        computeToCompute(cmd);
-        timestamp(cmd, slot, kHash);
-        dispatch(cmd, pipes_.collide, Grid::Threads, n, all);
-        computeToCompute(cmd);
-        dispatch(cmd, pipes_.candidates_finish, Grid::Threads, 1, all);
-        computeToCompute(cmd);
-        timestamp(cmd, slot, kCollide);
-      }
-      // 4. Collision deltas and ground contact
-      dispatch(cmd, pipes_.floor, Grid::Threads, n, all);
-      computeToCompute(cmd);
-      timestamp(cmd, slot, kFloor);
-      // 5. Tear marking; the compaction runs zero workgroups unless something tore this substep
-      if (m > 0) {
-        dispatch(cmd, pipes_.tear_mark, Grid::Threads, m, SimPush{0, m, s, 0});
-        computeToCompute(cmd);
-        dispatch(cmd, pipes_.tear_flags, Grid::Compaction, 0, nullptr, 0);
-        computeToCompute(cmd);
-        recordScan(cmd, SIM_SCAN_SCRATCH, 0, tear_slots_, tear_sums_, Grid::Compaction);
-        dispatch(cmd, pipes_.tear_compact, Grid::Compaction, 0, nullptr, 0);
-        computeToCompute(cmd);
-      }
-      timestamp(cmd, slot, kTear);
-    }
+    uint32_t pass = 0;
+    for (uint32_t s = 0; s < key.substeps; ++s)
+      if (recordSubstep(slot, key, s, pass)) break;
   }
   computeToAll(cmd); // the renderer and copies see this tick
   VK_CHECK(vkEndCommandBuffer(cmd));

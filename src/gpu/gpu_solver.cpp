@@ -224,7 +224,9 @@ void GpuSolver::tick(const SimUniforms& u) {
     dispatches_per_tick_ = 1;
     return;
   }
-  RecordKey key{substepCount(u.substeps), u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u, usesFusedPath(u)};
+  RecordKey key{substepCount(u.substeps), u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u, usesFusedPath(u),
+                stop_after_};
+  stop_after_ = SIM_NONE;
   if (slot.recorded != key) recordTick(slot, index, key);
   ctx_.submit(slot.tick, slot.fence);
   slot.pending = true;

@@ -70,6 +70,8 @@ public:
   uint32_t dispatchesPerTick() const override { return dispatches_per_tick_; }
   uint64_t memoryBytes() const override;
   Arithmetic arithmetic() const override;
+  void stopNextTickAfter(uint32_t last_pass) override { stop_after_ = last_pass; }
+  void readDeltas(std::vector<glm::vec4>& out) override;
 
   /// The context the solver runs on.
   VulkanContext& context() { return ctx_; }
@@ -122,6 +124,7 @@ private:
     uint32_t substeps = 0, iterations = 0;
     bool collision = false;
     bool fused = false;
+    uint32_t stop = SIM_NONE; ///< last pass recorded (stopNextTickAfter)
     bool operator==(const RecordKey&) const = default;
   };
   struct Slot {
@@ -164,6 +167,9 @@ private:
   void destroySheet();
   void writeStaticUniforms();
   void recordTick(Slot& slot, uint32_t index, const RecordKey& key);
+  /// Records the passes of substep s of the per-colour path; `pass` counts them. Returns true
+  /// when the tick stops within it (RecordKey::stop).
+  bool recordSubstep(Slot& slot, const RecordKey& key, uint32_t s, uint32_t& pass);
   void recordReset(Slot& slot, uint32_t index);
   void recordNormals();
   void bindSet(VkCommandBuffer cmd, uint32_t uniform_slot);
@@ -223,6 +229,7 @@ private:
   std::vector<glm::uvec4> hash_grids_;          ///< full grids of the hash passes, in recording order
   std::vector<glm::uvec4> hash_grids_uploaded_; ///< what SIM_BIND_HASH_ARGS holds of them
   uint32_t hash_slot_ = 0;                      ///< next live hash-pass argument while recording
+  uint32_t stop_after_ = SIM_NONE;              ///< stopNextTickAfter
   mutable std::array<double, kCategoryCount> last_ms_{};
 };
 

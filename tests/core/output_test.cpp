@@ -120,6 +120,8 @@ TEST(Simulation, GrabTargetsStayWithinTheCoordinateLimit) {
     }
     glm::vec3 particlePosition(uint32_t i) override { return glm::vec3(topo_->rest_pos[i]); }
     void readback(SimState&) override {}
+    void stopNextTickAfter(uint32_t) override {}
+    void readDeltas(std::vector<glm::vec4>&) override {}
 
   private:
     const SheetTopology* topo_ = nullptr;

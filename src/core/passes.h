@@ -1,0 +1,43 @@
+#pragma once
+/// The passes of a tick, numbered in the order both solvers run them (passesPerSubstep in
+/// shaders/shared/xpbd.h): what `tender diff` names when two backends part, and where a tick cut
+/// short stops.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "shaderio.h"
+
+namespace tender {
+
+enum class PassKind : uint8_t { Integrate, Project, Collide, Floor, Tear, Reset };
+
+/// One pass of a tick.
+struct PassPoint {
+  uint32_t substep = 0;
+  PassKind kind = PassKind::Integrate;
+  uint32_t iteration = 0, color = 0; ///< of a Project pass
+  bool operator==(const PassPoint&) const = default;
+};
+
+/// Passes of a tick with these uniforms (a reset frame: its one pass).
+uint32_t passesPerTick(const shaderio::SimUniforms& u);
+/// The pass at `index` (< passesPerTick(u)) of a tick.
+PassPoint passAt(const shaderio::SimUniforms& u, uint32_t index);
+/// Index of a pass in a tick with these uniforms; nullopt when the tick has no such pass.
+std::optional<uint32_t> passIndex(const shaderio::SimUniforms& u, const PassPoint& p);
+/// "substep 3, project (iteration 2, colour 5)".
+std::string describePass(const PassPoint& p);
+
+/// A one-ULP change planted in one particle's position after one pass of one tick: the test hook
+/// that proves `tender diff` finds a divergence where it happens.
+struct PlantedUlp {
+  uint64_t tick = 0;     ///< the solver's tick, counted from 0 at upload
+  PassPoint pass;        ///< after this pass
+  uint32_t particle = 0; ///< its x coordinate moves to the next float up
+};
+/// Parses "TICK:SUBSTEP:PASS:PARTICLE", PASS one of integrate, project.I.C (iteration I, colour
+/// C), collide, floor, tear; nullopt and one line in `error` when malformed.
+std::optional<PlantedUlp> parsePlantedUlp(const std::string& text, std::string& error);
+
+} // namespace tender

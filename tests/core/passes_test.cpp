@@ -1,0 +1,68 @@
+// The numbering of a tick's passes (passes.h), which `tender diff` reports and stops at.
+#include <gtest/gtest.h>
+
+#include "core/passes.h"
+
+using namespace tender;
+
+namespace {
+
+shaderio::SimUniforms uniforms(uint32_t substeps, uint32_t iterations, uint32_t colors, bool collision) {
+  shaderio::SimUniforms u{};
+  u.substeps = substeps;
+  u.iterations = iterations;
+  u.color_count = colors;
+  u.flags = collision ? SIM_FLAG_COLLISION : 0u;
+  return u;
+}
+
+} // namespace
+
+TEST(Passes, OrderOfOneSubstep) {
+  const shaderio::SimUniforms u = uniforms(3, 2, 5, true);
+  ASSERT_EQ(passesPerTick(u), 3u * (1u + 10u + 1u + 1u + 1u));
+  EXPECT_EQ(passAt(u, 0), (PassPoint{0, PassKind::Integrate}));
+  EXPECT_EQ(passAt(u, 1), (PassPoint{0, PassKind::Project, 0, 0}));
+  EXPECT_EQ(passAt(u, 7), (PassPoint{0, PassKind::Project, 1, 1}));
+  EXPECT_EQ(passAt(u, 10), (PassPoint{0, PassKind::Project, 1, 4}));
+  EXPECT_EQ(passAt(u, 11), (PassPoint{0, PassKind::Collide}));
+  EXPECT_EQ(passAt(u, 12), (PassPoint{0, PassKind::Floor}));
+  EXPECT_EQ(passAt(u, 13), (PassPoint{0, PassKind::Tear}));
+  EXPECT_EQ(passAt(u, 14), (PassPoint{1, PassKind::Integrate}));
+  EXPECT_EQ(describePass(passAt(u, 21)), "substep 1, project (iteration 1, colour 1)");
+}
+
+TEST(Passes, IndexIsTheInverseOfPassAt) {
+  for (bool collision : {false, true})
+    for (const shaderio::SimUniforms& u : {uniforms(1, 1, 1, collision), uniforms(8, 4, 9, collision)}) {
+      const uint32_t n = passesPerTick(u);
+      for (uint32_t k = 0; k < n; ++k) EXPECT_EQ(passIndex(u, passAt(u, k)), k);
+    }
+  shaderio::SimUniforms u = uniforms(2, 2, 3, false);
+  EXPECT_EQ(passesPerTick(u), 2u * 9u);
+  EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::Collide}));
+  EXPECT_FALSE(passIndex(u, PassPoint{2, PassKind::Floor}));
+  EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::Project, 2, 0}));
+  EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::Project, 0, 3}));
+  u.reset_active = 1;
+  EXPECT_EQ(passesPerTick(u), 1u);
+  EXPECT_EQ(passAt(u, 0).kind, PassKind::Reset);
+  EXPECT_EQ(describePass(passAt(u, 0)), "reset");
+}
+
+TEST(Passes, PlantedUlpParsesAndRefusesMalformedText) {
+  std::string error;
+  auto p = parsePlantedUlp("12:3:project.1.4:700", error);
+  ASSERT_TRUE(p) << error;
+  EXPECT_EQ(p->tick, 12u);
+  EXPECT_EQ(p->pass, (PassPoint{3, PassKind::Project, 1, 4}));
+  EXPECT_EQ(p->particle, 700u);
+  ASSERT_TRUE(parsePlantedUlp("0:0:floor:1", error));
+  EXPECT_EQ(parsePlantedUlp("0:0:collide:1", error)->pass.kind, PassKind::Collide);
+  for (const char* bad : {"", "1:2:floor", "x:1:floor:2", "1:2:bogus:3", "1:2:project.1:3", "1:2:floor:-1",
+                          "1:2:floor:3:4", "1:2:project.a.b:3"}) {
+    error.clear();
+    EXPECT_FALSE(parsePlantedUlp(bad, error)) << bad;
+    EXPECT_FALSE(error.empty()) << bad;
+  }
+}

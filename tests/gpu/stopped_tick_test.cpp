@@ -1,0 +1,95 @@
+// A tick cut short after any pass (Solver::stopNextTickAfter, what `tender diff` bisects with)
+// leaves the GPU solver, with the fused tick and with the per-colour passes, in bitwise the CPU
+// reference's state, the collision deltas of a collide pass included.
+#include <set>
+
+#include "core/passes.h"
+#include "core/stats.h"
+#include "cpu/cpu_solver.h"
+#include "gpu/gpu_solver.h"
+#include "gpu_test_env.h"
+
+using namespace tender;
+using namespace tender::test;
+
+namespace {
+
+struct Cut {
+  SimState state;
+  std::vector<glm::vec4> deltas;
+  PassPoint pass;
+};
+
+// Runs `ticks` whole ticks from the start, then one that stops after pass `stop`.
+Cut runCut(Solver& solver, const SimParams& p, const char* text, uint64_t ticks, uint32_t stop) {
+  Simulation sim(p, solver);
+  sim.setScript(script(text));
+  for (uint64_t t = 0; t < ticks; ++t) sim.tick();
+  solver.stopNextTickAfter(stop);
+  sim.tick();
+  Cut c;
+  solver.finish();
+  solver.readback(c.state);
+  solver.readDeltas(c.deltas);
+  c.pass = passAt(sim.lastUniforms(), stop);
+  return c;
+}
+
+uint32_t tornCount(const SimState& s) {
+  uint32_t n = 0;
+  for (uint32_t t : s.torn) n += t;
+  return n;
+}
+
+class StoppedTick : public GpuTest {};
+
+} // namespace
+
+TEST_F(StoppedTick, EveryPassMatchesTheCpuFusedAndPerColour) {
+  const SimParams p = preset("tender", {"wind=off", "substeps=2", "iterations=2"});
+  const char* text = "0 grab particle 1535\n1 move 7 -4 6\n";
+  // The tick in which the first constraints tear
+  CpuSolver probe;
+  Simulation sim(p, probe);
+  sim.setScript(script(text));
+  uint64_t tick = 0;
+  for (SimState s; tick < 40; ++tick) {
+    sim.tick();
+    probe.readback(s);
+    if (tornCount(s) > 0) break;
+  }
+  ASSERT_LT(tick, 40u) << "the yank tore nothing";
+  const shaderio::SimUniforms u = sim.lastUniforms();
+  const uint32_t passes = passesPerTick(u);
+  ASSERT_EQ(passes, 2u * shaderio::passesPerSubstep(2, sim.topology().colorCount(), true));
+
+  CpuSolver cpu;
+  gpu::GpuSolver fused(ctx()), percolor(ctx());
+  percolor.setFusedPath(false);
+  std::set<uint64_t> distinct;
+  bool deltas_compared = false;
+  uint32_t torn_before_last = 0, torn_at_end = 0;
+  for (uint32_t k = 0; k < passes; ++k) {
+    const Cut ref = runCut(cpu, p, text, tick, k);
+    ASSERT_EQ(ref.pass, passAt(u, k));
+    distinct.insert(hashPositions(ref.state.pos));
+    if (k + 2 == passes) torn_before_last = tornCount(ref.state);
+    if (k + 1 == passes) torn_at_end = tornCount(ref.state);
+    for (gpu::GpuSolver* g : {&fused, &percolor}) {
+      const Cut got = runCut(*g, p, text, tick, k);
+      const char* path = g == &fused ? "fused" : "per-colour";
+      EXPECT_TRUE(sameState(ref.state, got.state)) << path << ", after pass " << k << ": " << describePass(ref.pass);
+      if (ref.pass.kind == PassKind::Collide) {
+        EXPECT_TRUE(sameBytes(ref.deltas, got.deltas)) << path << ", deltas after " << describePass(ref.pass);
+        for (const glm::vec4& d : ref.deltas) deltas_compared = deltas_compared || d != glm::vec4(0.0f);
+      }
+    }
+  }
+  EXPECT_TRUE(fused.usesFusedPath());
+  EXPECT_FALSE(percolor.usesFusedPath());
+  // The cuts really stop: positions change from pass to pass (collide and tear move none), the
+  // last tear pass tears, and the collide passes had repulsion to compare.
+  EXPECT_GE(distinct.size(), size_t(passes) - 4u);
+  EXPECT_GT(torn_at_end, torn_before_last);
+  EXPECT_TRUE(deltas_compared) << "no collide pass of the tick had a repulsion";
+}
