@@ -58,7 +58,7 @@ VkPipeline createSimPipeline(VulkanContext& ctx, std::string_view key, VkPipelin
   return pipeline;
 }
 
-void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math) {
+void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math, MathOp op) {
   static_assert(sizeof(MathCase) == 16);
   if (cases.empty()) return;
   VkDevice dev = ctx.device();
@@ -67,7 +67,7 @@ void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitche
   sli.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
   sli.bindingCount = 1;
   sli.pBindings = &binding;
-  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, 4};
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, 8};
   VkPipelineLayoutCreateInfo pli{};
   pli.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
   pli.setLayoutCount = 1;
@@ -129,7 +129,8 @@ void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitche
     ctx.submitOnce([&](VkCommandBuffer cmd) {
       vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.pipeline);
       vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.layout, 0, 1, &set, 0, nullptr);
-      vkCmdPushConstants(cmd, o.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, 4, &count);
+      const uint32_t push[2] = {count, uint32_t(op)};
+      vkCmdPushConstants(cmd, o.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, push);
       const uint32_t groups = (count + 63u) / 64u, gx = std::min(groups, 65535u);
       vkCmdDispatch(cmd, gx, (groups + gx - 1u) / gx, 1);
       allToAllAndHost(cmd);

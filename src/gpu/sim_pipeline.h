@@ -31,7 +31,13 @@ struct MathCase {
   uint32_t sqrt_a = 0, a_over_b = 0; ///< exactSqrt(a) and exactDiv(a, b) as the device computed them
 };
 
-/// Runs exactSqrt and exactDiv of every case on the device (the shader math_check.comp).
-void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math);
+/// What the device math check computes: exactSqrt(a) and exactDiv(a, b), or the plain products
+/// and sums a * b and a + b (in the sqrt_a and a_over_b fields), which show how the device's
+/// arithmetic treats denormals.
+enum class MathOp : uint32_t { ExactSqrtDiv = 0, MulAdd = 1 };
+
+/// Runs the check of every case on the device (the shader math_check.comp).
+void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math,
+                   MathOp op = MathOp::ExactSqrtDiv);
 
 } // namespace tender::gpu

@@ -67,3 +67,32 @@ TEST_F(DeviceMath, WithoutTheCorrectionTheInexactDeviceDisagrees) {
   }
   EXPECT_GT(wrong, 5000);
 }
+
+// The CPU reference keeps denormals. A device whose float controls cannot ask for that ("device
+// default") must keep them anyway for the results to be the same bits; this shows that it does
+// (products and sums with denormal results, and denormal inputs). On a device that flushed by
+// default it would fail, and parity with it would not hold.
+TEST_F(DeviceMath, PlainArithmeticKeepsDenormalsLikeTheCpu) {
+  std::vector<gpu::MathCase> cases;
+  const uint32_t tiny = 0x1E3CE508u; // 1e-20: its square is a denormal
+  cases.push_back({tiny, tiny, 0, 0});
+  cases.push_back({0x00800000u, 0x3F000000u, 0, 0}); // the smallest normal / 2
+  cases.push_back({0x00000001u, 0x40000000u, 0, 0}); // the smallest denormal x 2
+  cases.push_back({0x00400000u, 0x80000100u, 0, 0}); // denormal + a negative denormal
+  std::mt19937 rng(5);
+  for (int k = 0; k < 4096; ++k) {
+    const uint32_t a = uint32_t(rng()) & 0x807FFFFFu, b = (uint32_t(rng()) & 0x807FFFFFu) | 0x3F000000u;
+    cases.push_back({a, b, 0, 0});
+  }
+  gpu::runDeviceMath(ctx(), cases, {}, gpu::MathOp::MulAdd);
+  int bad = 0;
+  for (const gpu::MathCase& c : cases) {
+    const float a = std::bit_cast<float>(c.a), b = std::bit_cast<float>(c.b);
+    const uint32_t want_mul = std::bit_cast<uint32_t>(a * b), want_add = std::bit_cast<uint32_t>(a + b);
+    if ((c.sqrt_a != want_mul || c.a_over_b != want_add) && ++bad <= 5)
+      ADD_FAILURE() << std::hexfloat << "a " << a << " b " << b << ": a * b " << std::bit_cast<float>(c.sqrt_a)
+                    << " (want " << a * b << "), a + b " << std::bit_cast<float>(c.a_over_b) << " (want " << a + b
+                    << ")";
+  }
+  EXPECT_EQ(bad, 0) << "the device flushes denormals (tender devices: " << ctx().info().name << ")";
+}
