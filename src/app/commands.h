@@ -13,6 +13,11 @@ namespace tender {
 
 /// Exit status of every bad-input error (with one line on stderr).
 constexpr int kExitBadInput = 2;
+/// Exit status of tender-demo started by `tender` (kLaunchedVariable set) when no window can be
+/// opened: `tender` then renders a picture instead, as with no display at all.
+constexpr int kExitNoWindow = 3;
+/// Set in tender-demo's environment when `tender` starts it.
+constexpr const char* kLaunchedVariable = "TENDER_LAUNCHED";
 
 /// Options every program shares.
 struct CommonOptions {

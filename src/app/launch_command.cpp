@@ -1,7 +1,11 @@
 // `tender` with no subcommand: the interactive demo (a separate program, so that `tender` itself
 // links no window system) when a display is there; otherwise a headless render to a PNG.
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -38,23 +42,51 @@ std::vector<std::string> ownArguments() {
   return args;
 }
 
+// Runs tender-demo with this process's arguments and waits for it: its exit status, or
+// kExitNoWindow when it could not be started or could not open a window.
+int launchDemo(const std::filesystem::path& demo) {
+  std::vector<std::string> args = ownArguments();
+  if (args.empty()) args.push_back("tender");
+  args[0] = demo.string();
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::fflush(nullptr);
+  const pid_t child = fork();
+  if (child == 0) {
+    setenv(kLaunchedVariable, "1", 1);
+    execv(demo.c_str(), argv.data());
+    std::fprintf(stderr, "tender: cannot start %s; rendering a picture instead\n", demo.c_str());
+    _exit(kExitNoWindow);
+  }
+  if (child < 0) {
+    std::fprintf(stderr, "tender: cannot start %s; rendering a picture instead\n", demo.c_str());
+    return kExitNoWindow;
+  }
+  // Ctrl-C reaches the demo, which ends its session; its status is ours.
+  std::signal(SIGINT, SIG_IGN);
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0)
+    if (errno != EINTR) return kExitBadInput;
+  std::signal(SIGINT, SIG_DFL);
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
 } // namespace
 
 int runDemo(const CommonOptions& common, const DemoOptions& o) {
   std::error_code ec;
   const std::filesystem::path demo = std::filesystem::read_symlink("/proc/self/exe", ec).parent_path() / "tender-demo";
-  if (hasDisplay()) {
+  // With a display, the demo; when it cannot open a window there (an unreachable display), it
+  // says so in one line and the picture is rendered as with no display.
+  const bool display = hasDisplay();
+  if (display) {
     if (!ec && std::filesystem::exists(demo)) {
-      std::vector<std::string> args = ownArguments();
-      if (args.empty()) args.push_back("tender");
-      args[0] = demo.string();
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(demo.c_str(), argv.data());
-      std::fprintf(stderr, "tender: cannot start %s; rendering headless instead\n", demo.c_str());
+      const int status = launchDemo(demo);
+      if (status != kExitNoWindow) return status;
     } else {
-      std::fprintf(stderr, "tender: this build has no tender-demo; rendering headless instead\n");
+      std::printf("tender: this build has no tender-demo; rendering a picture instead\n");
     }
   }
   // No display: one picture of the preset after two seconds of simulation (of the replayed
@@ -71,7 +103,7 @@ int runDemo(const CommonOptions& common, const DemoOptions& o) {
   if (auto err = record.add(o.record)) return fail(*err);
   CommonOptions session = common;
   session.script = o.replay;
-  std::printf("tender: no display; rendering a picture instead\n");
+  if (!display) std::printf("tender: no display; rendering a picture instead\n");
   int status = runRender(session, r);
   if (status != 0) return status;
   if (!o.record.empty()) {

@@ -28,6 +28,18 @@ rc=$?
 grep -q "wrote $tmp/tender.png" "$tmp/out2" || fail "tender without a display does not say where the PNG is: $(cat "$tmp/out2")"
 [ "$rc" -eq 0 ] && echo "ok: tender (no display) -> $(tail -1 "$tmp/out2")"
 
+# An unreachable display: the same picture, with one line that says why, and exit 0.
+rm -f "$tmp/tender.png"
+(cd "$tmp" && env -u WAYLAND_DISPLAY DISPLAY=:9999 "$T" --backend cpu --width 80 --height 64 >"$tmp/out3" 2>"$tmp/err3")
+rc=$?
+[ "$rc" -eq 0 ] || fail "tender with an unreachable display exited $rc: $(cat "$tmp/out3" "$tmp/err3")"
+[ -f "$tmp/tender.png" ] && [ "$(png_size "$tmp/tender.png")" = "80x64" ] ||
+  fail "tender with an unreachable display wrote no 80x64 tender.png"
+head -1 "$tmp/out3" | grep -q "^tender: cannot open a window (.*); rendering a picture instead$" &&
+  grep -q "wrote $tmp/tender.png" "$tmp/out3" && [ ! -s "$tmp/err3" ] ||
+  fail "tender with an unreachable display should say why in one line, then where the PNG is: $(cat "$tmp/out3" "$tmp/err3")"
+[ "$rc" -eq 0 ] && echo "ok: tender (unreachable display) -> $(head -1 "$tmp/out3")"
+
 expect_bad() {
   "$T" "$@" >"$tmp/o" 2>"$tmp/e"
   local rc=$?

@@ -17,8 +17,12 @@ bool DemoApp::init() {
     if (g_glfw_started) std::fprintf(stderr, "tender-demo: GLFW %d: %s\n", code, g_glfw_error.c_str());
   });
   if (!glfwInit()) {
-    fail("cannot open a window (" + (g_glfw_error.empty() ? std::string("no display?") : g_glfw_error) +
-         "); try `tender render`");
+    const std::string why = g_glfw_error.empty() ? std::string("no display?") : g_glfw_error;
+    no_window_ = true;
+    if (const char* launched = std::getenv(kLaunchedVariable); launched && *launched)
+      std::printf("tender: cannot open a window (%s); rendering a picture instead\n", why.c_str());
+    else
+      fail("cannot open a window (" + why + "); try `tender render`");
     return false;
   }
   g_glfw_started = true;
@@ -274,7 +278,10 @@ void DemoApp::drawFrame(const render::SceneView& view) {
 }
 
 int DemoApp::run() {
-  if (!init()) return kExitBadInput;
+  if (!init()) {
+    const char* launched = std::getenv(kLaunchedVariable);
+    return no_window_ && launched && *launched ? kExitNoWindow : kExitBadInput;
+  }
   using Clock = std::chrono::steady_clock;
   auto last = Clock::now();
   const auto start = last;

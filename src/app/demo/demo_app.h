@@ -71,6 +71,7 @@ private:
   CommonOptions common_;
   DemoOptions options_;
   GLFWwindow* window_ = nullptr;
+  bool no_window_ = false; ///< init() could not reach the display
   std::unique_ptr<gpu::VulkanContext> ctx_;
   VkSurfaceKHR surface_ = VK_NULL_HANDLE;
   std::unique_ptr<demo::Swapchain> swapchain_;
