@@ -109,7 +109,10 @@ void Simulation::apply(const ScriptEvent& e) {
   }
 }
 
-void Simulation::grabParticle(uint32_t i) { grabAt(i, solver_.particlePosition(i)); }
+void Simulation::grabParticle(uint32_t i) {
+  grabAt(i, solver_.particlePosition(i));
+  ++grabs_;
+}
 
 void Simulation::grabAt(uint32_t i, glm::vec3 p) {
   grab_index_ = i;
@@ -125,6 +128,7 @@ bool Simulation::grabRay(glm::vec3 origin, glm::vec3 dir) {
   shaderio::PickResult r = solver_.pick(origin, dir, params_.grab_radius);
   if (r.index == SIM_NONE) return false;
   grabAt(r.index, glm::vec3(r.pos));
+  ++grabs_;
   // The particle follows the cursor: it moves onto the ray at its nearest point.
   grab_to_ = boundedTarget(origin + dir * r.t);
   return true;
@@ -148,6 +152,7 @@ void Simulation::release() {
 
 void Simulation::reset() {
   grab_index_ = release_index_ = SIM_NONE;
+  pins_ = params_.pins != PinMode::None; // the start: pinned as the preset is
   solver_.beginReset();
   reset_frame_ = SIM_RESET_FRAMES;
 }
@@ -243,17 +248,27 @@ bool Simulation::tick() {
 
 int Simulation::advance(float frame_dt) {
   applyDueEvents();
-  ++frame_;
   if (reset_frame_ > 0) {
+    ++frame_;
     runResetFrame();
     accumulator_ = 0.0;
     return 0;
   }
-  if (paused_) return 0;
+  if (paused_) {
+    ++frame_;
+    return 0;
+  }
   accumulator_ += std::min(double(frame_dt), double(params_.max_frame_dt));
   int n = 0;
   const double step = 1.0 / double(params_.tick_hz);
+  // Each physics tick is a step of the scripts' clock: events due before it apply first, so a
+  // recording replays the same whatever the frame rate (tick() runs one step at a time).
   while (accumulator_ >= step) {
+    if (n > 0) {
+      applyDueEvents();
+      if (paused_ || reset_frame_ > 0) break;
+    }
+    ++frame_;
     runPhysicsTick();
     accumulator_ -= step;
     ++n;

@@ -63,11 +63,15 @@ public:
   /// reset frame, or nothing when paused). Returns true when the solver ran physics.
   bool tick();
   /// Real-time frame: clamps dt, runs as many fixed ticks as the accumulator holds (one reset
-  /// frame while resetting). Returns the number of physics ticks run.
+  /// frame while resetting), applying each script event before the step it is due at. Returns
+  /// the number of physics ticks run.
   int advance(float frame_dt);
 
-  /// Ticks (frames) seen so far, the clock of scripts.
+  /// Steps so far, the clock of scripts: one per physics tick, reset frame or paused frame (tick()
+  /// runs one step; advance() as many as the frame's time holds).
   uint64_t frameCount() const { return frame_; }
+  /// Grabs that caught a particle so far (from input or a script).
+  uint32_t grabCount() const { return grabs_; }
   /// Physics ticks run so far (the wind's clock).
   uint64_t physicsTicks() const { return physics_ticks_; }
   /// Uniforms of the next physics tick (for tests and tools).
@@ -95,6 +99,7 @@ private:
   glm::vec3 release_velocity_{0.0f};
   uint32_t reset_frame_ = 0; ///< frames left in the animated reset
   uint64_t frame_ = 0, physics_ticks_ = 0;
+  uint32_t grabs_ = 0;
   double accumulator_ = 0.0;
   shaderio::SimUniforms last_uniforms_{};
 };

@@ -102,6 +102,15 @@ grep -Eq "[1-9][0-9]* grabs" "$tmp/demo.log" || fail "the drag did not grab the 
 for ev in "grab ray" "move" "release" "reset" "wind" "pins" "pause"; do
   grep -q "$ev" "$tmp/input.txt" || fail "the recorded input has no '$ev' event"
 done
+# The recording is the session: `tender sim` of it ends in the demo's state, step for step.
+steps=$(sed -n 's/^tender-demo: \([0-9]*\) steps, state hash \([0-9a-f]*\)$/\1/p' "$tmp/demo.log")
+hash=$(sed -n 's/^tender-demo: \([0-9]*\) steps, state hash \([0-9a-f]*\)$/\2/p' "$tmp/demo.log")
+[ -n "$steps" ] && [ -n "$hash" ] || fail "the demo printed no step count and state hash"
+"$(dirname "$DEMO")/tender" sim --backend cpu --script "$tmp/input.txt" --ticks "$steps" >"$tmp/sim.log" 2>&1 ||
+  fail "tender sim of the recording failed: $(cat "$tmp/sim.log")"
+grep -q "state hash $hash" "$tmp/sim.log" || fail "tender sim of the recording does not end at the demo's state hash $hash: $(cat "$tmp/sim.log")"
+grep -q "steps: tender sim --script <this file> --ticks $steps ends at state hash $hash" "$tmp/input.txt" ||
+  fail "the recording does not say how many steps it holds"
 # The sheet moved: the screen while dragging differs from the screen before.
 changed=$(compare -metric AE -fuzz 3% "$tmp/before.png" "$tmp/dragged.png" null: 2>&1 | cut -d' ' -f1)
 echo "pixels changed by the drag: $changed"

@@ -350,10 +350,21 @@ int DemoApp::run() {
   }
   ctx_->waitIdle();
   double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  SimState state;
+  backend_.solver->readback(state);
   std::printf("tender-demo: %llu frames in %.1f s (%.1f FPS), %llu physics ticks, %u grabs\n",
               static_cast<unsigned long long>(frames), seconds, seconds > 0 ? double(frames) / seconds : 0.0,
-              static_cast<unsigned long long>(sim_->physicsTicks()), grabs_);
+              static_cast<unsigned long long>(sim_->physicsTicks()), sim_->grabCount());
+  // The script clock's steps: `tender sim --script <the recording> --ticks <steps>` ends in this state
+  std::printf("tender-demo: %llu steps, state hash %016llx\n", static_cast<unsigned long long>(sim_->frameCount()),
+              static_cast<unsigned long long>(hashPositions(state.pos)));
   if (!options_.record.empty()) {
+    char end[160];
+    std::snprintf(
+        end, sizeof end, "# %llu steps: tender sim --script <this file> --ticks %llu ends at state hash %016llx\n",
+        static_cast<unsigned long long>(sim_->frameCount()), static_cast<unsigned long long>(sim_->frameCount()),
+        static_cast<unsigned long long>(hashPositions(state.pos)));
+    record_text_ += end;
     if (auto err = record_.stage(options_.record, record_text_)) return fail(*err);
     if (auto err = record_.commit()) return fail(*err);
   }

@@ -16,6 +16,7 @@
 #include "../commands.h"
 #include "core/output.h"
 #include "core/simulation.h"
+#include "core/stats.h"
 #include "gpu/gpu_solver.h"
 #include "hud.h"
 #include "render/paper_mesh.h"
@@ -89,7 +90,6 @@ private:
   render::OrbitCamera camera_;
   Input input_;
   bool show_fps_ = false;
-  uint32_t grabs_ = 0;      // grabs that caught a particle
   OutputSet record_;        // --record: written when the session ends
   std::string record_text_; // the events of the session so far, as an input script
   SimState state_;

@@ -36,7 +36,6 @@ void DemoApp::onMouseButton(GLFWwindow* w, int button, int action, int) {
       e.b = r.dir;
       app.apply(e);
       if (app.sim_->grabbed() != SIM_NONE) {
-        ++app.grabs_;
         in.grabbing = true;
         in.plane_point = app.sim_->grabTarget();
         in.plane_normal = app.camera_.forward();
