@@ -27,6 +27,17 @@ for key in ["cpu"] + (["gpu"] if any(b != "cpu" for b in backends) else []):
         assert key == "gpu", p; print("gpu peak skipped:", p["skipped"]); continue
     assert p["gbps"] > 0 and p["buffer_bytes"] > 0 and p["repetitions"] > 0 and p["method"], p
 assert j["tool"] == "tender-bench" and j["ticks"] == 3 and j["warmup"] == 1, j
+# The cost of an empty dispatch and barrier, measured on the device when a GPU backend runs.
+assert "dispatch_cost" in j, j.keys()
+if any(b != "cpu" for b in backends):
+    d = j["dispatch_cost"]["gpu"]
+    if "skipped" in d:
+        print("dispatch cost skipped:", d["skipped"])
+    else:
+        assert d["dispatch_us"] > 0 and d["chain"] > 0 and len(d["samples_us"]) == d["repetitions"] > 0, d
+        assert d["device"] and d["method"], d
+else:
+    assert j["dispatch_cost"] == {}, j["dispatch_cost"]
 assert "cpu_model" in j["machine"] and "cores" in j["machine"], j["machine"]
 rs = j["results"]
 assert len(rs) == 2 * len(backends), len(rs)
@@ -73,6 +84,18 @@ assert j["peak_bandwidth"] == {} and "peak_pct" not in r and r["bytes_per_tick"]
   echo "ok: --no-peak"
 else
   echo "FAIL: --no-peak"; failures=$((failures + 1))
+fi
+
+# On the device, --no-peak still measures the dispatch cost (it takes a fraction of a second).
+if [ "$backends" != cpu ]; then
+  if "$B" --sizes 8x12 --backends gpu --ticks 1 --warmup 0 --no-peak --json "$tmp/d.json" >/dev/null 2>"$tmp/err" &&
+      grep -q "^dispatch gpu: " "$tmp/err" &&
+      python3 -c 'import json, sys; j = json.load(open(sys.argv[1])); d = j["dispatch_cost"]["gpu"]
+assert j["peak_bandwidth"] == {} and ("skipped" in d or d["dispatch_us"] > 0), d' "$tmp/d.json"; then
+    echo "ok: --no-peak on the device: $(grep '^dispatch gpu' "$tmp/err")"
+  else
+    echo "FAIL: --no-peak on the device: no dispatch cost"; cat "$tmp/err"; failures=$((failures + 1))
+  fi
 fi
 
 # The plot script turns the JSON into a PNG (when gnuplot is installed).

@@ -2,8 +2,9 @@
 // physics (every substep, iteration, collision and tear check of the preset) and reports ms per
 // tick (median, p95), particle-substeps per second, dispatches per tick, memory, the bytes a tick
 // must move (bench/traffic.h) and the bandwidth that achieves against the machine's measured copy
-// bandwidth and, on the GPU, the time and bandwidth of each pass. Bench sizes keep the sheet's
-// physical size: spacing and hash cell scale with the grid (see bench/README.md).
+// bandwidth and, on the GPU, the time and bandwidth of each pass and what one empty dispatch and
+// its barrier cost on the device (bench/dispatch_cost.h). Bench sizes keep the sheet's physical
+// size: spacing and hash cell scale with the grid (see bench/README.md).
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -29,6 +31,7 @@
 #include "traffic.h"
 
 #ifdef TENDER_HAS_GPU
+#include "dispatch_cost.h"
 #include "gpu/gpu_solver.h"
 #endif
 
@@ -425,11 +428,14 @@ int main(int argc, char** argv) {
     cpu_threads = p->threads;
   }
 #ifdef TENDER_HAS_GPU
+  // The device's context, kept for the dispatch cost (released before the cases run).
+  std::unique_ptr<gpu::VulkanContext> device_ctx;
   if (std::any_of(backends.begin(), backends.end(), [](const std::string& b) { return b != "cpu"; })) {
     gpu::ContextOptions co;
     co.device = o.device;
     auto ctx = gpu::VulkanContext::create(co);
     if (!ctx) return fail(ctx.error() + " (try --backends cpu)");
+    device_ctx = std::move(ctx.value());
   }
 #endif
 
@@ -447,6 +453,7 @@ int main(int argc, char** argv) {
   Progress progress;
   Peaks peaks;
   out["peak_bandwidth"] = nlohmann::json::object();
+  out["dispatch_cost"] = nlohmann::json::object();
   auto record = [&](const char* key, const bench::PeakBandwidth& b) {
     out["peak_bandwidth"][key] = {{"gbps", b.gbps},
                                   {"buffer_bytes", b.buffer_bytes},
@@ -473,6 +480,27 @@ int main(int argc, char** argv) {
       out["peak_bandwidth"]["gpu"] = {{"skipped", error}};
       progress.update("peak gpu: skipped (" + error + ")", true);
     }
+  }
+  // What one empty dispatch and its barrier cost on the device (a fraction of a second: measured
+  // with --no-peak too).
+  if (device_ctx) {
+    std::string error;
+    if (auto cost = bench::measureDispatchCost(*device_ctx, error)) {
+      out["dispatch_cost"]["gpu"] = {{"dispatch_us", cost->us},
+                                     {"chain", cost->chain},
+                                     {"repetitions", cost->repetitions},
+                                     {"samples_us", cost->samples_us},
+                                     {"device", device_ctx->properties().deviceName},
+                                     {"method", cost->method}};
+      char buf[160];
+      std::snprintf(buf, sizeof(buf), "dispatch gpu: %.2f us per empty dispatch + barrier (median of %u chains of %u, ",
+                    cost->us, cost->repetitions, cost->chain);
+      progress.update(buf + std::string(device_ctx->properties().deviceName) + ")", true);
+    } else {
+      out["dispatch_cost"]["gpu"] = {{"skipped", error}};
+      progress.update("dispatch gpu: skipped (" + error + ")", true);
+    }
+    device_ctx.reset();
   }
 #endif
 

@@ -93,7 +93,10 @@ std::optional<std::string> OutputSet::stage(const std::string& path, const FileW
     return std::nullopt;
   }
   const fs::path target(path);
-  std::string temp = (fs::path(folderOf(path)) / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
+  std::string name = ".";
+  name += target.filename().string();
+  name += ".tmp.XXXXXX";
+  std::string temp = (fs::path(folderOf(path)) / name).string();
   const int fd = mkstemp(temp.data());
   if (fd < 0) return cannotWrite(path, std::strerror(errno));
   staged_.push_back({path, temp});

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 
 #include <ft2build.h>
@@ -175,6 +176,11 @@ ReceiptText receiptText(const std::string& preset) {
   t.thanks = {"THANK YOU FOR DINING WITH US!", "Please come again"};
   t.barcode = "4006381333931";
   return t;
+}
+
+std::string receiptFontPath() {
+  const char* font = std::getenv("TENDER_FONT");
+  return font && *font ? font : kReceiptFont;
 }
 
 ReceiptImage rasterizeReceipt(const ReceiptText& text, const std::string& font_path) {

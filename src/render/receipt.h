@@ -10,8 +10,10 @@ namespace tender::render {
 /// Size of the receipt texture in pixels.
 constexpr uint32_t kReceiptWidth = 512;
 constexpr uint32_t kReceiptHeight = 768;
-/// The monospace font the receipt is printed with.
+/// The monospace font the receipt is printed with (Debian's fonts-dejavu-core).
 constexpr const char* kReceiptFont = "/usr/share/fonts/truetype/dejavu/DejaVuSansMono.ttf";
+/// The receipt font: $TENDER_FONT when set (a self-contained bundle ships its own), else kReceiptFont.
+std::string receiptFontPath();
 
 /// One priced line of the receipt.
 struct ReceiptItem {
@@ -50,6 +52,6 @@ struct ReceiptImage {
 };
 
 /// Rasterises a receipt; throws std::runtime_error with one clear line when the font is missing.
-ReceiptImage rasterizeReceipt(const ReceiptText& text, const std::string& font_path = kReceiptFont);
+ReceiptImage rasterizeReceipt(const ReceiptText& text, const std::string& font_path = receiptFontPath());
 
 } // namespace tender::render

@@ -10,6 +10,8 @@
 //   TENDER_UPDATE_GOLDEN=1 VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 //     ./tests/tender_render_tests --gtest_filter='Golden.*'
 // and look at the new PNGs in tests/render/data before committing them.
+// The goldens are read from (and written to) $TENDER_TEST_DATA when it is set, so that a copy of
+// the test binary elsewhere (tools/gpu-bundle) finds its data; otherwise from tests/render/data.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -47,8 +49,14 @@ render::HeadlessResult renderPreset(const std::string& preset, uint64_t ticks, c
   return render::renderHeadless(o);
 }
 
+/// The folder of the golden PNGs: $TENDER_TEST_DATA, or the source tree's folder built in.
+std::string testDataDir() {
+  const char* dir = std::getenv("TENDER_TEST_DATA");
+  return dir && *dir ? dir : TENDER_TEST_DATA;
+}
+
 void compareWithGolden(const std::string& name, const render::Picture& actual) {
-  const std::string golden_path = std::string(TENDER_TEST_DATA) + "/golden_" + name + ".png";
+  const std::string golden_path = testDataDir() + "/golden_" + name + ".png";
   if (const char* u = std::getenv("TENDER_UPDATE_GOLDEN"); u && std::string(u) == "1") {
     ASSERT_FALSE(render::writePng(golden_path, actual));
     GTEST_SKIP() << "wrote " << golden_path;
