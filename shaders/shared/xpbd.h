@@ -124,6 +124,31 @@ SIM_INLINE bool shouldTear(vec4 pa, vec4 pb, float rest, uint kind, float tear_f
   return tearable && simSqrt(dot3(d, d)) > rest * tear_factor;
 }
 
+/// The two triangles (original ids: two per quad, row by row, see buildSheet) a shear or
+/// tri-bend constraint from particle a to particle b of a `cols`-wide grid stands on: for a shear
+/// the two halves of the quad it crosses, for a tri-bend the two triangles on either side of the
+/// structural edge it bends across. (SIM_NONE, SIM_NONE) for the other kinds.
+SIM_INLINE uvec2 supportTriangles(uint a, uint b, uint kind, uint cols) {
+  uint ax = a % cols, ay = a / cols, bx = b % cols, by = b / cols;
+  uint x = min(ax, bx), y = min(ay, by), dx = max(ax, bx) - x, dy = max(ay, by) - y;
+  uint quads = cols - 1u;
+  if (kind == SIM_KIND_SHEAR) return uvec2(2u * (y * quads + x), 2u * (y * quads + x) + 1u);
+  if (kind != SIM_KIND_TRIBEND) return uvec2(SIM_NONE, SIM_NONE);
+  // Across a horizontal edge (x, y + 1)-(x + 1, y + 1): the quad above's first triangle, the
+  // quad below's second; across a vertical edge (x + 1, y)-(x + 1, y + 1): the left quad's second,
+  // the right quad's first.
+  if (dx == 1u) return uvec2(2u * (y * quads + x), 2u * ((y + 1u) * quads + x) + 1u);
+  return dy == 1u ? uvec2(2u * (y * quads + x) + 1u, 2u * (y * quads + x + 1u)) : uvec2(SIM_NONE, SIM_NONE);
+}
+
+/// True when a constraint has lost what it stands on (gone0, gone1: its support triangles lost an
+/// edge): a shear once the quad it crosses has lost both triangles (the sheet has parted there, a
+/// fold tears nothing), a tri-bend once either triangle of its hinge is gone.
+SIM_INLINE bool unsupported(uint kind, bool gone0, bool gone1) {
+  if (kind == SIM_KIND_SHEAR) return gone0 && gone1;
+  return kind == SIM_KIND_TRIBEND && (gone0 || gone1);
+}
+
 /// Smooth normal of grid particle (i, j) from central differences of its neighbours.
 SIM_INLINE vec3 gridNormal(vec3 left, vec3 right, vec3 up, vec3 down) {
   vec3 n = cross3(right - left, up - down);

@@ -207,6 +207,25 @@ bool markTear(Constraint c, vec4 pa, vec4 pb) {
   return atomicAdd(counters.torn_new, 1u) == 0u;
 }
 
+// True when triangle t (original id) has lost an edge.
+bool triangleGone(uint t) {
+  uvec2 e = tri_edges[t];
+  return torn[e.x] != 0u || torn[e.y] != 0u;
+}
+
+// After the tear marks of a substep (and only when something tore): marks a shear or tri-bend
+// constraint that has lost its triangles (unsupported in xpbd.h). It reads the flags of structural
+// constraints only, which no longer change in this substep.
+void markUnsupported(Constraint c) {
+  uint kind = c.kind_id & SIM_KIND_MASK, id = c.kind_id >> SIM_KIND_BITS;
+  if ((kind != SIM_KIND_SHEAR && kind != SIM_KIND_TRIBEND) || torn[id] != 0u) return;
+  uvec2 t = supportTriangles(c.a, c.b, kind, u.cols);
+  if (!unsupported(kind, triangleGone(t.x), triangleGone(t.y))) return;
+  if (atomicExchange(torn[id], 1u) != 0u) return; // a copy marked it first
+  atomicAdd(counters.torn_total, 1u);
+  atomicAdd(counters.torn_new, 1u);
+}
+
 // Tear compaction, step 1: the keep flag of compaction slot k (a constraint slot or a triangle)
 // and a copy of the element to compact from. The scan of the flags gives every survivor its place.
 void tearFlags(uint k) {

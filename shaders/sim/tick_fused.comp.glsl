@@ -188,6 +188,12 @@ void main() {
     }
     sync();
     if (counters.torn_new != 0u) {
+      // What stood on the triangles lost goes too (as tear_unsupported), then the compaction
+      for (uint c = 0u; c < u.color_count; ++c) {
+        uvec2 range = color_range[c];
+        for (uint t = lid; t < range.y; t += kInvocations) markUnsupported(constraints[range.x + t]);
+      }
+      sync();
       uint slots = compactSlots();
       for (uint k = lid; k < slots; k += kInvocations) tearFlags(k);
       sync();

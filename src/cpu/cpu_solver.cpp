@@ -168,6 +168,29 @@ uint32_t CpuSolver::markTears(const SimUniforms& u) {
   return torn.load();
 }
 
+uint32_t CpuSolver::markUnsupported() {
+  const auto& edges = topo_->tri_edges;
+  const uint32_t cols = topo_->cols;
+  auto gone = [&](uint32_t t) { return torn_[edges[t].x] != 0u || torn_[edges[t].y] != 0u; };
+  // Reads the flags of structural constraints only and writes those of shear and tri-bend ones
+  std::atomic<uint32_t> torn{0};
+  pool_->parallelFor(uint32_t(constraints_.size()), grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
+    uint32_t count = 0;
+    for (const ColorRange& range : colors_)
+      for (uint32_t k = std::max(begin, range.first); k < std::min(end, range.first + range.count); ++k) {
+        const uint32_t kind = con_kind_[k];
+        if ((kind != SIM_KIND_SHEAR && kind != SIM_KIND_TRIBEND) || torn_[con_id_[k]] != 0u) continue;
+        const uvec2 t = supportTriangles(con_a_[k], con_b_[k], kind, cols);
+        if (unsupported(kind, gone(t.x), gone(t.y))) {
+          torn_[con_id_[k]] = 1u;
+          ++count;
+        }
+      }
+    if (count) torn.fetch_add(count, std::memory_order_relaxed);
+  });
+  return torn.load();
+}
+
 void CpuSolver::compact() {
   for (ColorRange& range : colors_) {
     uint32_t w = range.first;
@@ -247,7 +270,11 @@ void CpuSolver::tick(const SimUniforms& u) {
     }
     floorPass(u); // apply the repulsion, then the ground contact
     if (passed(1)) return;
-    if (markTears(u) > 0) compact(); // tear, then compact the colours and triangles
+    // Tear, let go of what stood on the triangles lost, compact the colours and triangles
+    if (markTears(u) > 0) {
+      markUnsupported();
+      compact();
+    }
     if (passed(1)) return;
     passes += 1 + projects + (collision ? 2 : 0) + 2;
   }

@@ -75,6 +75,9 @@ public:
   void floorPass(const shaderio::SimUniforms& u);
   /// Marks constraints beyond the tear threshold; returns how many tore.
   uint32_t markTears(const shaderio::SimUniforms& u);
+  /// After a tear: marks the shear and tri-bend constraints whose triangles are gone (unsupported
+  /// in xpbd.h); returns how many.
+  uint32_t markUnsupported();
   /// Stable compaction of the colour ranges and of the triangles that lost an edge.
   void compact();
   /// One frame of the animated reset.

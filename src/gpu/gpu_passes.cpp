@@ -125,9 +125,12 @@ bool GpuSolver::recordSubstep(Slot& slot, const RecordKey& key, uint32_t s, uint
   computeToCompute(cmd);
   timestamp(cmd, slot, kFloor);
   if (stops()) return true;
-  // 5. Tear marking; the compaction runs zero workgroups unless something tore this substep
+  // 5. Tear marking; what stood on the triangles lost and the compaction run zero workgroups
+  // unless something tore this substep
   if (m > 0) {
     dispatch(cmd, pipes_.tear_mark, Grid::Threads, m, SimPush{0, m, s, 0});
+    computeToCompute(cmd);
+    dispatch(cmd, pipes_.tear_unsupported, Grid::Compaction, 0, nullptr, 0);
     computeToCompute(cmd);
     dispatch(cmd, pipes_.tear_flags, Grid::Compaction, 0, nullptr, 0);
     computeToCompute(cmd);

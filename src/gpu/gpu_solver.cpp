@@ -134,6 +134,7 @@ void GpuSolver::createPipelines(FusedShape fused) {
       {&SimPipelines::candidates_finish, "candidates_finish.comp", kSim, 1},
       {&SimPipelines::floor, "floor.comp", kSim, 1},
       {&SimPipelines::tear_mark, "tear_mark.comp", kSim, 1},
+      {&SimPipelines::tear_unsupported, "tear_unsupported.comp", 0, 1},
       {&SimPipelines::tear_flags, "tear_flags.comp", 0, 1},
       {&SimPipelines::tear_compact, "tear_compact.comp", 0, 1},
       {&SimPipelines::normals, "normals.comp", kSim, 1},

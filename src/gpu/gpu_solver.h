@@ -35,7 +35,8 @@ struct ComputePipeline {
 /// Every pipeline of the simulation (one file per shader in shaders/sim/).
 struct SimPipelines {
   ComputePipeline integrate, project, candidates_check, candidates_decide, hash_count, scan, scan_add, hash_scatter,
-      hash_sort, collide, candidates_finish, floor, tear_mark, tear_flags, tear_compact, normals, reset;
+      hash_sort, collide, candidates_finish, floor, tear_mark, tear_unsupported, tear_flags, tear_compact, normals,
+      reset;
   ComputePipeline tick_fused; ///< null when the device has under 32 KiB of shared memory
   std::array<ComputePipeline, 3> pick;
 };
