@@ -9,10 +9,13 @@
 // correctly rounded sqrtss/divss, which give the same bits (tests/core/exact_math_test.cpp proves
 // it over every significand of sqrt and many millions of quotients).
 //
-// Before including this file a GLSL shader may define SIM_INEXACT_MATH and SIM_CORRECT_MATH
-// (sim_common.glsl makes them specialization constants): the first replaces the device's sqrt and
-// divide by deliberately inexact ones (off by -3..+3 ULP, like a real GPU's), the second, when
-// false, returns the approximation uncorrected (to show what the correction is for).
+// Before including this file a GLSL shader may define SIM_INEXACT_MATH, SIM_CORRECT_MATH and
+// SIM_FLUSH_DENORMALS (sim_common.glsl makes them specialization constants): the first replaces
+// the device's sqrt and divide by deliberately inexact ones (off by -3..+3 ULP, like a real GPU's),
+// the second, when false, returns the approximation uncorrected (to show what the correction is
+// for), the third makes them treat denormals as the CPU does with FTZ and DAZ set (on a device
+// that can only flush denormals, where the CPU reference flushes too): a denormal input reads as
+// zero, and a result below the smallest normal after rounding is zero.
 #ifndef SIM_EXACT_MATH_H
 #define SIM_EXACT_MATH_H
 #include "prelude.h"
@@ -22,6 +25,9 @@
 #endif
 #ifndef SIM_CORRECT_MATH
 #define SIM_CORRECT_MATH true
+#endif
+#ifndef SIM_FLUSH_DENORMALS
+#define SIM_FLUSH_DENORMALS false
 #endif
 
 /// a . b in a fixed order: (ax bx + ay by) + az bz.
@@ -76,6 +82,11 @@ SIM_INLINE ivec2 splitFloat(uint bits) {
 /// below, 0 exactly half, 1 above; `inexact`: anything at all beyond q).
 SIM_INLINE float packRounded(uint sign, int biased, uint q, int above, bool inexact) {
   if (biased >= 255) return uintBitsToFloat(sign | 0x7F800000u);
+  if (SIM_FLUSH_DENORMALS && biased <= 0) {
+    // Flushed unless it rounds up to the smallest normal (tininess after rounding, as x86 FTZ)
+    uint up = above > 0 || (above == 0 && (q & 1u) != 0u) ? 1u : 0u;
+    return uintBitsToFloat(sign | (biased == 0 && q + up == 0x1000000u ? 0x800000u : 0u));
+  }
   if (biased >= 1) {
     uint up = above > 0 || (above == 0 && (q & 1u) != 0u) ? 1u : 0u;
     // A carry out of the significand moves into the exponent (up to infinity)
@@ -94,6 +105,10 @@ SIM_INLINE float packRounded(uint sign, int biased, uint q, int above, bool inex
 SIM_INLINE float exactDiv(float a, float b) {
   if (!SIM_CORRECT_MATH) return deviceDiv(a, b);
   uint ua = floatBitsToUint(a), ub = floatBitsToUint(b);
+  if (SIM_FLUSH_DENORMALS) { // denormal inputs read as zero
+    if ((ua & 0x7F800000u) == 0u) ua &= 0x80000000u;
+    if ((ub & 0x7F800000u) == 0u) ub &= 0x80000000u;
+  }
   uint sign = (ua ^ ub) & 0x80000000u;
   uint xa = ua & 0x7FFFFFFFu, xb = ub & 0x7FFFFFFFu;
   const uint kInf = 0x7F800000u, kNaN = 0x7FC00000u;
@@ -132,7 +147,8 @@ SIM_INLINE float exactDiv(float a, float b) {
 SIM_INLINE float exactSqrt(float x) {
   if (!SIM_CORRECT_MATH) return deviceSqrt(x);
   uint ux = floatBitsToUint(x);
-  if ((ux & 0x7FFFFFFFu) == 0u || ux == 0x7F800000u) return x;
+  if (SIM_FLUSH_DENORMALS && (ux & 0x7F800000u) == 0u) ux &= 0x80000000u; // a denormal reads as zero
+  if ((ux & 0x7FFFFFFFu) == 0u || ux == 0x7F800000u) return uintBitsToFloat(ux);
   if (ux > 0x7F800000u) return uintBitsToFloat(0x7FC00000u); // NaN or negative
   ivec2 f = splitFloat(ux);
   uint m = uint(f.x);

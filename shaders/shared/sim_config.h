@@ -18,6 +18,7 @@
 // device's sqrt and divide; correct them (off only to show what the correction is for)
 #define SIM_SPEC_INEXACT_MATH 1
 #define SIM_SPEC_CORRECT_MATH 2
+#define SIM_SPEC_FLUSH_DENORMALS 3
 // Largest number of substeps per tick (per-substep inputs are arrays of this size)
 #define SIM_MAX_SUBSTEPS 32
 // Largest number of constraint colours

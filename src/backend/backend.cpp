@@ -34,6 +34,7 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
     co.threads = o.threads;
     co.min_chunk = o.min_chunk;
     co.simd = o.simd;
+    co.flush_denormals = o.flush_denormals;
     auto cpu = std::make_unique<CpuSolver>(co);
     cpu->setPlantedUlp(o.plant);
     out.cpu = cpu.get();

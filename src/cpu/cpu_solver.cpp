@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 
+#include "denormal_mode.h"
 #include "simd_kernels.h"
 #include "worker_pool.h"
 
@@ -12,7 +13,8 @@ namespace tender {
 using namespace shaderio;
 
 CpuSolver::CpuSolver(CpuOptions options)
-    : options_(options), simd_(options.simd && simd::kBuilt), pool_(std::make_unique<WorkerPool>(options.threads)),
+    : options_(options), simd_(options.simd && simd::kBuilt),
+      pool_(std::make_unique<WorkerPool>(options.threads, options.flush_denormals)),
       collision_(*pool_, options.simd, options.candidate_lists) {}
 
 // The constraints of each colour, reordered by their first particle, into one array per field
@@ -227,7 +229,14 @@ void CpuSolver::resetPass(const SimUniforms& u) {
   });
 }
 
+Arithmetic CpuSolver::arithmetic() const {
+  Arithmetic a;
+  a.denormals = options_.flush_denormals ? "flush to zero" : "preserve";
+  return a;
+}
+
 void CpuSolver::tick(const SimUniforms& u) {
+  const DenormalMode mode(options_.flush_denormals);
   const uint32_t stop = stop_after_;
   stop_after_ = SIM_NONE;
   const uint64_t tick = ticks_++;
@@ -292,6 +301,7 @@ void CpuSolver::beginReset() {
 }
 
 void CpuSolver::computeNormals() {
+  const DenormalMode mode(options_.flush_denormals);
   const uint32_t W = topo_->cols, H = topo_->rows;
   for (uint32_t j = 0; j < H; ++j)
     for (uint32_t i = 0; i < W; ++i) {
@@ -302,6 +312,7 @@ void CpuSolver::computeNormals() {
 }
 
 PickResult CpuSolver::pick(glm::vec3 o, glm::vec3 d, float radius) {
+  const DenormalMode mode(options_.flush_denormals);
   PickResult best{};
   best.index = SIM_NONE;
   float best_d2 = radius * radius;

@@ -30,6 +30,9 @@ struct CpuOptions {
   /// the tear test and the collision gather; off runs the scalar reference alone. The results are
   /// bitwise the same either way.
   bool simd = true;
+  /// Flush denormals (x86 FTZ and DAZ) in every pass, as a device that can only flush them does
+  /// (its shaders then flush too: SIM_FLUSH_DENORMALS in exact_math.h); off keeps them (IEEE).
+  bool flush_denormals = false;
 };
 
 class CpuSolver final : public Solver {
@@ -50,6 +53,7 @@ public:
   /// The test hook of `tender diff`: a one-ULP change planted after one pass of one tick.
   void setPlantedUlp(std::optional<PlantedUlp> plant) { plant_ = plant; }
   void readDeltas(std::vector<glm::vec4>& out) override;
+  Arithmetic arithmetic() const override;
   uint32_t dispatchesPerTick() const override { return passes_per_tick_; }
   /// Bytes of host memory of the solver's own arrays (capacity, not size).
   uint64_t memoryBytes() const override;

@@ -6,6 +6,8 @@
 #include <immintrin.h>
 #endif
 
+#include "denormal_mode.h"
+
 namespace tender {
 namespace {
 
@@ -44,7 +46,7 @@ void waitUntil(Done done) {
 
 } // namespace
 
-WorkerPool::WorkerPool(uint32_t threads) {
+WorkerPool::WorkerPool(uint32_t threads, bool flush_denormals) : flush_denormals_(flush_denormals) {
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   size_ = std::min(threads, 64u);
   helpers_.reserve(size_ - 1);
@@ -111,7 +113,10 @@ void WorkerPool::dispatch(void* ctx, Call call, uint32_t phases, uint32_t chunks
   claim_.store(job_id_ << kJobShift, std::memory_order_release);
   ticket_.fetch_add(1);
   if (sleepers_.load() > 0) wakeHelpers();
-  work(0);
+  {
+    const DenormalMode mode(flush_denormals_);
+    work(0);
+  }
   // Every chunk is claimed; wait for those still running. Only a helper that claimed a chunk can
   // hold this up: one that arrives later finds nothing to claim and never touches this job.
   const uint32_t total = phases * chunks;
@@ -119,6 +124,7 @@ void WorkerPool::dispatch(void* ctx, Call call, uint32_t phases, uint32_t chunks
 }
 
 void WorkerPool::helperLoop(uint32_t worker) {
+  const DenormalMode mode(flush_denormals_); // for the thread's whole life: it runs only jobs
   uint32_t seen = 0;
   for (;;) {
     uint32_t t = ticket_.load(std::memory_order_acquire);

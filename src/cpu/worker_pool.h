@@ -21,7 +21,8 @@ namespace tender {
 class WorkerPool {
 public:
   /// Starts `threads - 1` helper threads; 0 means one worker per hardware thread (at most 64).
-  explicit WorkerPool(uint32_t threads);
+  /// With `flush_denormals` every job runs with denormals flushed (DenormalMode) on every worker.
+  explicit WorkerPool(uint32_t threads, bool flush_denormals = false);
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
@@ -94,6 +95,7 @@ private:
   void helperLoop(uint32_t worker);
 
   uint32_t size_ = 1;
+  bool flush_denormals_ = false;
   std::vector<std::thread> helpers_;
   uint64_t job_id_ = 0;
   // The current job in one word: job id << 44 | phase << 32 | bit mask of its claimed chunks;

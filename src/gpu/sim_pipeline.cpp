@@ -35,11 +35,14 @@ VkPipeline createSimPipeline(VulkanContext& ctx, std::string_view key, VkPipelin
   mi.codeSize = code.size() * sizeof(uint32_t);
   mi.pCode = code.data();
   VK_CHECK(vkCreateShaderModule(ctx.device(), &mi, nullptr, &module));
-  const uint32_t values[3] = {spec0.value_or(0u), math.inexact ? VK_TRUE : VK_FALSE,
-                              math.corrected ? VK_TRUE : VK_FALSE};
-  const VkSpecializationMapEntry entries[3] = {{0, 0, 4}, {SIM_SPEC_INEXACT_MATH, 4, 4}, {SIM_SPEC_CORRECT_MATH, 8, 4}};
+  // exact_math.h flushes denormals where the device's arithmetic is asked to
+  const bool flush = rules.denormals == Denormals::FlushToZero || math.flush;
+  const uint32_t values[4] = {spec0.value_or(0u), math.inexact ? VK_TRUE : VK_FALSE,
+                              math.corrected ? VK_TRUE : VK_FALSE, flush ? VK_TRUE : VK_FALSE};
+  const VkSpecializationMapEntry entries[4] = {
+      {0, 0, 4}, {SIM_SPEC_INEXACT_MATH, 4, 4}, {SIM_SPEC_CORRECT_MATH, 8, 4}, {SIM_SPEC_FLUSH_DENORMALS, 12, 4}};
   // Constant 0 only where the pass has one; the math switches everywhere (a shader without them ignores them)
-  VkSpecializationInfo spec{spec0 ? 3u : 2u, spec0 ? entries : entries + 1, sizeof(values), values};
+  VkSpecializationInfo spec{spec0 ? 4u : 3u, spec0 ? entries : entries + 1, sizeof(values), values};
   VkComputePipelineCreateInfo ci{};
   ci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
   ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;

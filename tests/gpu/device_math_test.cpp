@@ -7,12 +7,20 @@
 #include <cmath>
 #include <random>
 
+#include "cpu/denormal_mode.h"
 #include "gpu/sim_pipeline.h"
+#include "gpu/spirv_rules.h"
 #include "gpu_test_env.h"
 
 using namespace tender;
 
 namespace {
+
+// True when the simulation's shaders flush denormals on this device (it can only flush them); the
+// CPU's results to compare with are then computed with FTZ and DAZ set.
+bool flushes(gpu::VulkanContext& ctx) {
+  return gpu::floatRulesFor(ctx.floatControls()).denormals == gpu::Denormals::FlushToZero;
+}
 
 bool same(uint32_t a, uint32_t b) {
   const float fa = std::bit_cast<float>(a), fb = std::bit_cast<float>(b);
@@ -45,9 +53,12 @@ TEST_F(DeviceMath, ExactSqrtAndDivideOnAnInexactDeviceGiveTheCpuBits) {
   std::vector<gpu::MathCase> cases = mathCases();
   gpu::runDeviceMath(ctx(), cases, {true, true});
   uint64_t bad = 0;
+  const DenormalMode mode(flushes(ctx()));
   for (const gpu::MathCase& c : cases) {
-    const float a = std::bit_cast<float>(c.a), b = std::bit_cast<float>(c.b);
-    const uint32_t want_sqrt = std::bit_cast<uint32_t>(std::sqrt(a)), want_div = std::bit_cast<uint32_t>(a / b);
+    volatile float va = std::bit_cast<float>(c.a), vb = std::bit_cast<float>(c.b);
+    const float a = va, b = vb;
+    volatile float vsqrt = std::sqrt(a), vdiv = a / b;
+    const uint32_t want_sqrt = std::bit_cast<uint32_t>(float(vsqrt)), want_div = std::bit_cast<uint32_t>(float(vdiv));
     if ((!same(c.sqrt_a, want_sqrt) || !same(c.a_over_b, want_div)) && ++bad <= 5)
       ADD_FAILURE() << std::hexfloat << "a " << a << " b " << b << ": sqrt " << std::bit_cast<float>(c.sqrt_a)
                     << " (want " << std::sqrt(a) << "), a / b " << std::bit_cast<float>(c.a_over_b) << " (want "
@@ -68,11 +79,12 @@ TEST_F(DeviceMath, WithoutTheCorrectionTheInexactDeviceDisagrees) {
   EXPECT_GT(wrong, 5000);
 }
 
-// The CPU reference keeps denormals. A device whose float controls cannot ask for that ("device
-// default") must keep them anyway for the results to be the same bits; this shows that it does
-// (products and sums with denormal results, and denormal inputs). On a device that flushed by
-// default it would fail, and parity with it would not hold.
-TEST_F(DeviceMath, PlainArithmeticKeepsDenormalsLikeTheCpu) {
+// The CPU reference keeps denormals, or flushes them where the device can only flush them. A
+// device whose float controls can be asked for neither ("device default") must keep them anyway
+// for the results to be the same bits; this shows that it does (products and sums with denormal
+// results, and denormal inputs). On a device that flushed by default it would fail, and parity
+// with it would not hold.
+TEST_F(DeviceMath, PlainArithmeticTreatsDenormalsLikeTheCpu) {
   std::vector<gpu::MathCase> cases;
   const uint32_t tiny = 0x1E3CE508u; // 1e-20: its square is a denormal
   cases.push_back({tiny, tiny, 0, 0});
@@ -86,13 +98,47 @@ TEST_F(DeviceMath, PlainArithmeticKeepsDenormalsLikeTheCpu) {
   }
   gpu::runDeviceMath(ctx(), cases, {}, gpu::MathOp::MulAdd);
   int bad = 0;
+  const DenormalMode mode(flushes(ctx()));
   for (const gpu::MathCase& c : cases) {
-    const float a = std::bit_cast<float>(c.a), b = std::bit_cast<float>(c.b);
-    const uint32_t want_mul = std::bit_cast<uint32_t>(a * b), want_add = std::bit_cast<uint32_t>(a + b);
+    volatile float va = std::bit_cast<float>(c.a), vb = std::bit_cast<float>(c.b);
+    const float a = va, b = vb;
+    volatile float vmul = a * b, vadd = a + b;
+    const uint32_t want_mul = std::bit_cast<uint32_t>(float(vmul)), want_add = std::bit_cast<uint32_t>(float(vadd));
     if ((c.sqrt_a != want_mul || c.a_over_b != want_add) && ++bad <= 5)
       ADD_FAILURE() << std::hexfloat << "a " << a << " b " << b << ": a * b " << std::bit_cast<float>(c.sqrt_a)
                     << " (want " << a * b << "), a + b " << std::bit_cast<float>(c.a_over_b) << " (want " << a + b
                     << ")";
   }
-  EXPECT_EQ(bad, 0) << "the device flushes denormals (tender devices: " << ctx().info().name << ")";
+  EXPECT_EQ(bad, 0) << "the device does not treat denormals as asked (tender devices: " << ctx().info().name << ")";
+}
+
+// The shaders' flushing exactSqrt and exactDiv (SIM_FLUSH_DENORMALS, for a device that can only
+// flush denormals) on this device give the CPU's bits with FTZ and DAZ set: denormal inputs, tiny
+// quotients, and quotients that round up to the smallest normal.
+TEST_F(DeviceMath, FlushingExactMathGivesTheCpuBitsWithFtzAndDaz) {
+  std::vector<gpu::MathCase> cases;
+  std::mt19937 rng(9);
+  for (uint32_t m = 0; m < 0x800000u; m += 101) cases.push_back({m, 0x3F800000u | (m * 7u & 0x7FFFFFu), 0, 0});
+  for (int k = 0; k < 400'000; ++k) {
+    const uint32_t ma = uint32_t(rng()) & 0x7FFFFFu, mb = uint32_t(rng()) & 0x7FFFFFu;
+    cases.push_back({(1u + uint32_t(rng()) % 20u) << 23 | ma, (126u + uint32_t(rng()) % 3u) << 23 | mb, 0, 0});
+    cases.push_back({uint32_t(rng()) % 40u << 23 | ma, (127u + uint32_t(rng()) % 30u) << 23 | mb, 0, 0});
+  }
+  for (uint32_t m = 0x7FF000u; m < 0x800000u; ++m) cases.push_back({0x00800000u | m, 0x3F800000u | m, 0, 0});
+  gpu::MathSwitches math;
+  math.inexact = true;
+  math.flush = true;
+  gpu::runDeviceMath(ctx(), cases, math);
+  int bad = 0;
+  const DenormalMode mode(true);
+  for (const gpu::MathCase& c : cases) {
+    volatile float va = std::bit_cast<float>(c.a), vb = std::bit_cast<float>(c.b);
+    const float a = va, b = vb;
+    volatile float vsqrt = std::sqrt(a), vdiv = a / b;
+    const uint32_t want_sqrt = std::bit_cast<uint32_t>(float(vsqrt)), want_div = std::bit_cast<uint32_t>(float(vdiv));
+    if ((!same(c.sqrt_a, want_sqrt) || !same(c.a_over_b, want_div)) && ++bad <= 5)
+      ADD_FAILURE() << std::hex << "a " << c.a << " b " << c.b << ": sqrt " << c.sqrt_a << " (want " << want_sqrt
+                    << "), a / b " << c.a_over_b << " (want " << want_div << ")";
+  }
+  EXPECT_EQ(bad, 0) << "of " << cases.size() << " cases";
 }

@@ -11,9 +11,17 @@
 #include <string>
 
 #include "common/sim_helpers.h"
+#include "cpu/cpu_solver.h"
 #include "gpu/context.h"
 
 namespace tender::test {
+
+/// CPU reference options that treat denormals as the GPU solver's device does: flushed where the
+/// device can only flush them (its shaders then flush too), kept otherwise.
+inline CpuOptions cpuOptionsLike(const Solver& gpu, CpuOptions o = {}) {
+  o.flush_denormals = gpu.arithmetic().denormals == "flush to zero";
+  return o;
+}
 
 /// The shared context of this test process, or nullptr (and `why`) when there is no device.
 inline gpu::VulkanContext* testContext(std::string& why) {

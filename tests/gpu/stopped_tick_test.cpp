@@ -63,9 +63,9 @@ TEST_F(StoppedTick, EveryPassMatchesTheCpuFusedAndPerColour) {
   const uint32_t passes = passesPerTick(u);
   ASSERT_EQ(passes, 2u * shaderio::passesPerSubstep(2, sim.topology().colorCount(), true));
 
-  CpuSolver cpu;
   gpu::GpuSolver fused(ctx()), percolor(ctx());
   percolor.setFusedPath(false);
+  CpuSolver cpu(cpuOptionsLike(fused));
   std::set<uint64_t> distinct;
   bool deltas_compared = false;
   uint32_t torn_before_last = 0, torn_at_end = 0;

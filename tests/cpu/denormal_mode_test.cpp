@@ -1,0 +1,44 @@
+// The CPU reference's denormal modes: kept by default; flushed on every worker of the pool (and
+// the calling thread) when the solver flushes, as a device that can only flush them does.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <vector>
+
+#include "cpu/cpu_solver.h"
+#include "cpu/denormal_mode.h"
+#include "cpu/worker_pool.h"
+
+using namespace tender;
+
+namespace {
+
+// a * b on every chunk of a job over `pool` (each chunk on whichever worker claims it)
+std::vector<uint32_t> products(WorkerPool& pool, float a, float b) {
+  std::vector<uint32_t> out(32);
+  pool.run(32, [&](uint32_t chunk) {
+    volatile float x = a, y = b;
+    out[chunk] = std::bit_cast<uint32_t>(float(x * y));
+  });
+  return out;
+}
+
+} // namespace
+
+TEST(DenormalMode, ThePoolFlushesOnEveryWorkerOnlyWhenAsked) {
+  const float tiny = 1e-20f; // its square is a denormal
+  WorkerPool keep(4), flush(4, true);
+  for (uint32_t r : products(keep, tiny, tiny)) EXPECT_NE(r & 0x7FFFFFFFu, 0u);
+  for (uint32_t r : products(flush, tiny, tiny)) EXPECT_EQ(r, 0u);
+  // Denormal inputs read as zero (DAZ), and the calling thread's mode is restored after the job
+  for (uint32_t r : products(flush, std::bit_cast<float>(0x00400000u), 4.0f)) EXPECT_EQ(r, 0u);
+  volatile float x = tiny;
+  EXPECT_NE(std::bit_cast<uint32_t>(float(x * x)), 0u);
+}
+
+TEST(DenormalMode, TheSolverSaysHowItTreatsDenormals) {
+  CpuOptions o;
+  EXPECT_EQ(CpuSolver(o).arithmetic().denormals, "preserve");
+  o.flush_denormals = true;
+  EXPECT_EQ(CpuSolver(o).arithmetic().denormals, "flush to zero");
+}
