@@ -107,6 +107,9 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
   ImGui::SameLine();
   if (ImGui::Button("Reset")) a.reset = true;
   ImGui::SameLine();
+  if (ImGui::Button("View")) a.reset_view = true;
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("the camera back to the start view (C)");
+  ImGui::SameLine();
   if (ImGui::Button(s.pins ? "Pins: on" : "Pins: off")) a.toggle_pins = true;
   ImGui::SameLine();
   if (ImGui::Button(s.paused ? "Resume" : "Pause")) a.toggle_pause = true;
@@ -150,9 +153,12 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
     if (s.triangles > 0) ImGui::Text("%u triangles", s.triangles);
     if (s.times && !s.times->ms.empty() &&
         ImGui::CollapsingHeader("GPU time per pass", ImGuiTreeNodeFlags_DefaultOpen)) {
+      // What the last tick measured: each pass, or on the fused path the one dispatch that runs
+      // them all (the passes it fuses have no time of their own)
       double total = 0.0;
       for (auto& [name, ms] : s.times->ms) {
-        ImGui::Text("%-10s %7.3f ms", name.c_str(), ms);
+        if (ms <= 0.0) continue;
+        ImGui::Text("%-10s %7.3f ms", name == "fused_tick" ? "fused tick" : name.c_str(), ms);
         total += ms;
       }
       ImGui::Text("%-10s %7.3f ms", "total", total);

@@ -27,6 +27,7 @@ struct HudState {
 /// What the user asked for through the HUD this frame.
 struct HudActions {
   bool toggle_wind = false, reset = false, toggle_pins = false, toggle_pause = false;
+  bool reset_view = false;           ///< the camera back to the start view
   bool live_changed = false;         ///< `params` changed in ways that need no rebuild
   bool rebuild = false;              ///< `params` needs a rebuild (grid size)
   std::optional<std::string> preset; ///< switch to this preset

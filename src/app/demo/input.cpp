@@ -106,6 +106,9 @@ void DemoApp::onKey(GLFWwindow* w, int key, int, int action, int) {
   case GLFW_KEY_I:
     app.show_fps_ = !app.show_fps_;
     return;
+  case GLFW_KEY_C:
+    app.camera_ = render::OrbitCamera();
+    return;
   case GLFW_KEY_ESCAPE:
     glfwSetWindowShouldClose(w, GLFW_TRUE);
     return;
@@ -135,6 +138,7 @@ void DemoApp::handleActions(const demo::HudActions& a) {
   if (a.toggle_pins) e.kind = EventKind::Pins, apply(e);
   if (a.toggle_pause) e.kind = EventKind::Pause, apply(e);
   if (a.reset) e.kind = EventKind::Reset, apply(e);
+  if (a.reset_view) camera_ = render::OrbitCamera();
   if (a.preset) {
     if (auto p = presetParams(*a.preset)) switchParams(*p, true);
   } else if (a.rebuild) {
