@@ -22,6 +22,7 @@ constexpr const char* kLaunchedVariable = "TENDER_LAUNCHED";
 /// Options every program shares.
 struct CommonOptions {
   std::string preset = "tender";
+  std::string preset_file;       ///< a preset as JSON (--preset-file), instead of --preset
   std::vector<std::string> sets; ///< key=value overrides
   std::string backend = "gpu";   ///< cpu or gpu
   int device = -1;               ///< Vulkan device index, -1 = best
@@ -35,7 +36,8 @@ struct CommonOptions {
 
 struct SimOptions {
   uint64_t ticks = 120;
-  std::string stats, out;
+  std::string stats, out;    ///< out: .ply, .glb, .gltf (by extension), or a folder with frames_every
+  uint64_t frames_every = 0; ///< --frames-every K: a frame every K ticks (glTF); 0 = the end state only
 };
 
 /// Largest --ticks of `tender sim` and `tender render`.
@@ -50,6 +52,11 @@ struct RenderOptions {
   uint64_t ticks = 0;
   std::string out = "tender.png";
   uint32_t width = 1280, height = 720;
+  // A video instead of a picture (--video): every frame, encoded by ffmpeg.
+  std::string video;      ///< the MP4 to write; empty: a PNG
+  std::string fps = "60"; ///< frames per second (decimal, at most 3 places)
+  std::string seconds;    ///< length (decimal); empty: from --ticks
+  bool ticks_given = false;
 };
 
 struct DemoOptions {
@@ -68,10 +75,14 @@ std::optional<InputScript> scriptFor(const std::string& path, const SimParams& p
 
 int runSim(const CommonOptions& common, const SimOptions& o);
 int runDevices(const CommonOptions& common);
+/// `tender presets`: the names of the presets, or (`name` given) that preset as JSON.
+int runPresets(const std::string& name);
 /// `tender diff`: 0 when the two backends give bitwise the same states every tick, 1 when they
 /// part (where is printed), 2 on bad input.
 int runDiff(const CommonOptions& common, const DiffOptions& o);
 int runRender(const CommonOptions& common, const RenderOptions& o);
+/// `tender render --video`: every frame of the run piped to ffmpeg (H.264 MP4).
+int runVideo(const CommonOptions& common, const RenderOptions& o);
 int runDemo(const CommonOptions& common, const DemoOptions& o);
 
 } // namespace tender

@@ -28,7 +28,10 @@ std::optional<InputScript> scriptFor(const std::string& path, const SimParams& p
 namespace {
 
 void addCommon(CLI::App& app, CommonOptions& o, bool with_backend) {
-  app.add_option("--preset", o.preset, "tender, crumple, tender-low or crumple-low")->capture_default_str();
+  CLI::Option* preset =
+      app.add_option("--preset", o.preset, "tender, crumple, tender-low or crumple-low")->capture_default_str();
+  app.add_option("--preset-file", o.preset_file, "a preset as JSON (see `tender presets --dump NAME`)")
+      ->excludes(preset);
   app.add_option("--set", o.sets, "override a parameter: key=value (repeatable; see the key list below)");
   if (with_backend) app.add_option("--backend", o.backend, "cpu or gpu")->capture_default_str();
   app.add_option("--device", o.device, "Vulkan device index (see `tender devices`)");
@@ -47,7 +50,14 @@ std::string keyList() {
 
 // Resolves the preset and the overrides; returns an error message.
 std::optional<std::string> resolve(CommonOptions& o) {
-  auto p = presetParams(o.preset);
+  std::optional<SimParams> p;
+  if (!o.preset_file.empty()) {
+    SimParams loaded;
+    if (auto err = loadPresetFile(o.preset_file, loaded)) return *err;
+    p = loaded;
+  } else {
+    p = presetParams(o.preset);
+  }
   if (!p) {
     std::string names;
     for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
@@ -89,14 +99,27 @@ int main(int argc, char** argv) {
   sim_cmd->add_option("--ticks", sim_ticks, "ticks to run (decimal, at most 100000000)")->capture_default_str();
   sim_cmd->add_option("--script", common.script, "input script to replay");
   sim_cmd->add_option("--stats", sim.stats, "write stats JSON here");
-  sim_cmd->add_option("--out", sim.out, "write the final state as PLY here");
+  sim_cmd->add_option("--out", sim.out, "write the final state here: FILE.ply, FILE.glb or FILE.gltf (glTF 2.0)");
+  std::string frames_every;
+  sim_cmd->add_option("--frames-every", frames_every,
+                      "a frame every K ticks: --out DIR/ writes frame_000000.glb..., --out FILE.glb one animation");
 
   RenderOptions render;
-  CLI::App* render_cmd = app.add_subcommand("render", "render a preset offscreen to a PNG");
+  CLI::App* render_cmd = app.add_subcommand("render", "render a preset offscreen to a PNG, or a video of the run");
   addCommon(*render_cmd, common, true);
-  render_cmd->add_option("--ticks", render_ticks, "ticks to run before rendering (decimal)")->capture_default_str();
+  CLI::Option* render_ticks_opt =
+      render_cmd->add_option("--ticks", render_ticks, "ticks to run before rendering (decimal)")->capture_default_str();
   render_cmd->add_option("--script", common.script, "input script to replay");
-  render_cmd->add_option("--out", render.out, "PNG to write")->capture_default_str();
+  CLI::Option* render_out = render_cmd->add_option("--out", render.out, "PNG to write")->capture_default_str();
+  CLI::Option* video =
+      render_cmd->add_option("--video", render.video, "write a video of the run instead (H.264 MP4, needs ffmpeg)")
+          ->excludes(render_out);
+  render_cmd->add_option("--fps", render.fps, "video frames per second (at most 240)")
+      ->capture_default_str()
+      ->needs(video);
+  render_cmd->add_option("--seconds", render.seconds, "video length (default: --ticks, or the script and 1 s, or 5 s)")
+      ->excludes(render_ticks_opt)
+      ->needs(video);
   render_cmd->add_option("--width", render.width, "image width")->check(CLI::Range(16u, 16384u));
   render_cmd->add_option("--height", render.height, "image height")->check(CLI::Range(16u, 16384u));
 
@@ -115,6 +138,10 @@ int main(int argc, char** argv) {
   CLI::App* devices_cmd = app.add_subcommand("devices", "list the Vulkan devices");
   addCommon(*devices_cmd, common, false);
 
+  std::string dump_preset;
+  CLI::App* presets_cmd = app.add_subcommand("presets", "list the presets, or print one as a --preset-file");
+  presets_cmd->add_option("--dump", dump_preset, "print this preset as JSON, every key (a file for --preset-file)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) { // --help, --version
@@ -123,10 +150,14 @@ int main(int argc, char** argv) {
     return fail(e.what());
   }
   if (*devices_cmd) return runDevices(common);
+  if (*presets_cmd) return runPresets(dump_preset);
   if (*diff_cmd) common.backend = "cpu"; // each side is checked for its own backend
   if (auto err = resolve(common)) return fail(*err);
   if (auto err = parseWhole(sim_ticks, 0, kMaxTicks, sim.ticks)) return fail("--ticks: " + *err);
+  if (!frames_every.empty())
+    if (auto err = parseWhole(frames_every, 1, kMaxTicks, sim.frames_every)) return fail("--frames-every: " + *err);
   if (auto err = parseWhole(render_ticks, 0, kMaxTicks, render.ticks)) return fail("--ticks: " + *err);
+  render.ticks_given = render_ticks_opt->count() > 0;
   if (*diff_cmd)
     if (auto err = parseWhole(diff_ticks, 1, kMaxTicks, diff.ticks)) return fail("--ticks: " + *err);
   // A write beyond the file-size limit fails like any other write error (exit 2, no fragment).

@@ -8,6 +8,7 @@
 namespace tender {
 
 int runRender(const CommonOptions& common, const RenderOptions& o) {
+  if (!o.video.empty()) return runVideo(common, o);
   OutputSet outputs;
   if (auto err = outputs.add(o.out)) return fail(*err);
   render::HeadlessOptions h;

@@ -1,20 +1,105 @@
-// `tender sim`: run a preset headless, print a summary, write stats JSON and a PLY.
+// `tender sim`: run a preset headless, print a summary, write stats JSON and the sheet (PLY or
+// glTF: the end state, a numbered sequence of frames, or one animated file).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 
 #include "commands.h"
 #include "core/output.h"
 #include "core/simulation.h"
 #include "core/stats.h"
+#include "export/gltf.h"
 
 namespace tender {
+namespace {
+
+/// Most frames of one animated file (its weights track grows with the square of the frames).
+constexpr uint64_t kMaxAnimationFrames = 1000;
+/// Most files of a numbered sequence.
+constexpr uint64_t kMaxSequenceFrames = 100000;
+
+/// What --out (with --frames-every) asks for.
+struct MeshPlan {
+  enum Kind { None, Ply, Gltf, Animation, Sequence } kind = None;
+  bool binary = true;                ///< .glb (the sequence is always .glb)
+  std::vector<std::string> frames;   ///< the sequence's files
+  std::vector<uint64_t> frame_ticks; ///< the ticks the frames are taken at (animation, sequence)
+};
+
+/// The ticks a frame is taken at: 0, K, 2K, ... and the last tick.
+std::vector<uint64_t> frameTicks(uint64_t ticks, uint64_t every) {
+  std::vector<uint64_t> t;
+  for (uint64_t k = 0; k <= ticks; k += every) t.push_back(k);
+  if (t.back() != ticks) t.push_back(ticks);
+  return t;
+}
+
+std::optional<std::string> planMesh(const SimOptions& o, MeshPlan& plan) {
+  if (o.out.empty()) {
+    if (o.frames_every) return "--frames-every needs --out DIR/ or --out FILE.glb|FILE.gltf";
+    return std::nullopt;
+  }
+  std::error_code ec;
+  const bool folder = o.out.back() == '/' || std::filesystem::is_directory(o.out, ec);
+  if (folder) {
+    if (!o.frames_every)
+      return "--out '" + o.out + "' is a folder: name a file, or add --frames-every K for a sequence";
+    const uint64_t count = o.ticks / o.frames_every + 2;
+    if (count > kMaxSequenceFrames + 1)
+      return "--frames-every " + std::to_string(o.frames_every) + " over " + std::to_string(o.ticks) +
+             " ticks makes more than " + std::to_string(kMaxSequenceFrames) + " files";
+    plan.kind = MeshPlan::Sequence;
+    plan.frame_ticks = frameTicks(o.ticks, o.frames_every);
+    const std::string dir = o.out.back() == '/' ? o.out : o.out + "/";
+    for (size_t k = 0; k < plan.frame_ticks.size(); ++k) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "frame_%06zu.glb", k);
+      plan.frames.push_back(dir + name);
+    }
+    return std::nullopt;
+  }
+  auto format = meshFormatFor(o.out);
+  if (!format) return "--out '" + o.out + "': unknown extension (.ply, .glb or .gltf, or a folder DIR/)";
+  if (*format == MeshFormat::Ply) {
+    if (o.frames_every) return "--frames-every writes glTF: --out DIR/, FILE.glb or FILE.gltf, not PLY";
+    plan.kind = MeshPlan::Ply;
+    return std::nullopt;
+  }
+  plan.binary = *format == MeshFormat::Glb;
+  if (!o.frames_every) {
+    plan.kind = MeshPlan::Gltf;
+    return std::nullopt;
+  }
+  if (o.ticks / o.frames_every + 2 > kMaxAnimationFrames + 1)
+    return "--frames-every " + std::to_string(o.frames_every) + " over " + std::to_string(o.ticks) +
+           " ticks makes more than " + std::to_string(kMaxAnimationFrames) +
+           " frames for one animated file (write a sequence: --out DIR/)";
+  plan.kind = MeshPlan::Animation;
+  plan.frame_ticks = frameTicks(o.ticks, o.frames_every);
+  return std::nullopt;
+}
+
+} // namespace
 
 int runSim(const CommonOptions& common, const SimOptions& o) {
   // Every output is checked before the run, and written only when the run has succeeded.
+  MeshPlan plan;
+  if (auto err = planMesh(o, plan)) return fail(*err);
   OutputSet outputs;
-  for (const std::string& path : {o.stats, o.out})
-    if (auto err = outputs.add(path)) return fail(*err);
+  if (auto err = outputs.add(o.stats)) return fail(*err);
+  if (plan.kind == MeshPlan::Sequence) {
+    for (const std::string& path : plan.frames)
+      if (auto err = outputs.add(path)) return fail(*err);
+  } else if (auto err = outputs.add(o.out)) {
+    return fail(*err);
+  }
+  // The receipt texture of a glTF file, rasterised before the run (a missing font fails early).
+  MeshScene scene;
+  if (plan.kind != MeshPlan::None && plan.kind != MeshPlan::Ply) {
+    scene.uv = buildSheet(common.params).uv;
+    scene.texture_png = receiptPng(common.params.preset);
+  }
   std::string error;
   auto script = scriptFor(common.script, common.params, error);
   if (!script) return fail(error);
@@ -24,14 +109,38 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   Simulation sim(common.params, solver);
   sim.setScript(*script);
 
+  // Frames (--frames-every): the sequence's files are staged as they are taken, the animation's
+  // frames kept for the one file written at the end.
+  std::vector<MeshFrame> frames;
+  size_t next_frame = 0;
+  auto takeFrame = [&](uint64_t tick) -> std::optional<std::string> {
+    if (next_frame >= plan.frame_ticks.size() || plan.frame_ticks[next_frame] != tick) return std::nullopt;
+    solver.computeNormals();
+    SimState s;
+    solver.readback(s);
+    MeshFrame f = meshFrame(s, double(tick) / double(common.params.tick_hz));
+    if (plan.kind == MeshPlan::Animation) {
+      frames.push_back(std::move(f));
+    } else {
+      std::string err;
+      auto bytes = encodeGltf(scene, {f}, true, err);
+      if (!bytes) return err;
+      if (auto e = outputs.stage(plan.frames[next_frame], *bytes)) return e;
+    }
+    ++next_frame;
+    return std::nullopt;
+  };
+
   std::vector<double> ms;
   ms.reserve(size_t(std::min<uint64_t>(o.ticks, 1u << 20)));
+  if (auto err = takeFrame(0)) return fail(*err);
   for (uint64_t t = 0; t < o.ticks; ++t) {
     auto t0 = std::chrono::steady_clock::now();
     bool ran = sim.tick();
     if (ran) solver.finish();
     auto t1 = std::chrono::steady_clock::now();
     if (ran) ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    if (auto err = takeFrame(t + 1)) return fail(*err);
   }
   solver.computeNormals();
   SimState state;
@@ -73,8 +182,14 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
 
   if (!o.stats.empty())
     if (auto err = outputs.stage(o.stats, j.dump(2) + "\n")) return fail(*err);
-  if (!o.out.empty())
+  if (plan.kind == MeshPlan::Ply)
     if (auto err = outputs.stage(o.out, [&](std::FILE* f) { return writePly(f, state); })) return fail(*err);
+  if (plan.kind == MeshPlan::Gltf || plan.kind == MeshPlan::Animation) {
+    if (plan.kind == MeshPlan::Gltf) frames = {meshFrame(state, 0.0)};
+    auto bytes = encodeGltf(scene, frames, plan.binary, error);
+    if (!bytes) return fail(error);
+    if (auto err = outputs.stage(o.out, *bytes)) return fail(*err);
+  }
   if (auto err = outputs.commit()) return fail(*err);
   return 0;
 }

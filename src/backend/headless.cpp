@@ -10,18 +10,15 @@
 
 namespace tender::render {
 
-HeadlessResult renderHeadless(const HeadlessOptions& o) {
-  HeadlessResult result;
+std::optional<std::string> renderSequence(const HeadlessOptions& o, const FrameSequence& seq,
+                                          uint32_t* validation_messages) {
   gpu::ContextOptions co;
   co.device = o.device;
   co.validation = o.validation;
   co.quiet = o.quiet;
   co.graphics = true;
   auto created = gpu::VulkanContext::create(co);
-  if (!created) {
-    result.error = created.error();
-    return result;
-  }
+  if (!created) return created.error();
   std::unique_ptr<gpu::VulkanContext> ctx = std::move(created.value());
   try {
     // The receipt first: a missing font is reported before any work.
@@ -29,16 +26,10 @@ HeadlessResult renderHeadless(const HeadlessOptions& o) {
     BackendOptions bo = backendOptionsFor(o.backend, o.params);
     bo.context = ctx.get();
     Backend backend;
-    if (auto err = createBackend(bo, backend)) {
-      result.error = *err;
-      return result;
-    }
+    if (auto err = createBackend(bo, backend)) return *err;
     Solver& solver = *backend.solver;
     Simulation sim(o.params, solver);
     sim.setScript(o.script);
-    for (uint64_t t = 0; t < o.ticks; ++t) sim.tick();
-    solver.computeNormals();
-    solver.finish();
 
     RendererOptions ro;
     ro.color_format = OffscreenTarget::kFormat;
@@ -47,23 +38,46 @@ HeadlessResult renderHeadless(const HeadlessOptions& o) {
     Renderer renderer(*ctx, ro, receipt);
     renderer.buildAll();
     std::unique_ptr<HostPaperMesh> host;
-    if (backend.gpu) {
+    if (backend.gpu)
       renderer.setPaper(0, gpuPaperBuffers(*backend.gpu));
-    } else {
-      SimState state;
-      solver.readback(state);
+    else
       host = std::make_unique<HostPaperMesh>(*ctx, sim.topology());
-      host->update(state);
-      renderer.setPaper(0, host->buffers());
-    }
+    if (host) renderer.setPaper(0, host->buffers());
     OffscreenTarget target(*ctx, renderer, o.width, o.height);
-    result.picture = target.render(defaultSceneView(sim.params()));
+    const SceneView view = defaultSceneView(sim.params());
+    uint64_t ticks = 0;
+    SimState state;
+    for (uint64_t frame = 0; frame < seq.frames; ++frame) {
+      for (const uint64_t due = seq.ticks_before(frame); ticks < due; ++ticks) sim.tick();
+      solver.computeNormals();
+      solver.finish();
+      if (host) {
+        solver.readback(state);
+        host->update(state);
+      }
+      if (auto err = seq.sink(target.render(view), frame)) {
+        ctx->waitIdle();
+        return err;
+      }
+    }
     ctx->waitIdle();
   } catch (const std::exception& e) {
-    result.error = e.what();
-    return result;
+    return std::string(e.what());
   }
-  result.validation_messages = ctx->validationMessages();
+  if (validation_messages) *validation_messages = ctx->validationMessages();
+  return std::nullopt;
+}
+
+HeadlessResult renderHeadless(const HeadlessOptions& o) {
+  HeadlessResult result;
+  FrameSequence one;
+  one.frames = 1;
+  one.ticks_before = [&](uint64_t) { return o.ticks; };
+  one.sink = [&](const Picture& picture, uint64_t) -> std::optional<std::string> {
+    result.picture = picture;
+    return std::nullopt;
+  };
+  if (auto err = renderSequence(o, one, &result.validation_messages)) result.error = *err;
   return result;
 }
 

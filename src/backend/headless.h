@@ -3,6 +3,8 @@
 /// renderer's Vulkan context), run N ticks (optionally replaying an input script), render it
 /// offscreen.
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <string>
 
 #include "core/params.h"
@@ -33,5 +35,19 @@ struct HeadlessResult {
 /// Runs the simulation and renders it; a missing device, a Vulkan error or a missing font set
 /// `error`.
 HeadlessResult renderHeadless(const HeadlessOptions& options);
+
+/// The frames of a sequence (a video): how many, and the ticks run before each.
+struct FrameSequence {
+  uint64_t frames = 0;
+  /// Total ticks run before frame k (0-based); never decreasing. options.ticks is not used.
+  std::function<uint64_t(uint64_t frame)> ticks_before;
+  /// Takes each frame's picture in order; an error stops the run and is returned.
+  std::function<std::optional<std::string>(const Picture& picture, uint64_t frame)> sink;
+};
+
+/// Runs the simulation once and renders every frame of the sequence; returns the first error (of
+/// Vulkan, the font, or the sink). `validation_messages`, when given, receives their count.
+std::optional<std::string> renderSequence(const HeadlessOptions& options, const FrameSequence& sequence,
+                                          uint32_t* validation_messages = nullptr);
 
 } // namespace tender::render

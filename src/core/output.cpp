@@ -1,5 +1,6 @@
 #include "output.h"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -47,6 +48,25 @@ mode_t fileMode() {
   return 0666 & ~mask;
 }
 
+// Creates the temporary file of `path` beside it, with the mode a new file gets; its descriptor,
+// or -1 (errno set).
+int makeTemp(const std::string& path, std::string& temp) {
+  std::string name = ".";
+  name += fs::path(path).filename().string();
+  name += ".tmp.XXXXXX";
+  temp = (fs::path(folderOf(path)) / name).string();
+  const int fd = mkstemp(temp.data());
+  if (fd < 0) return -1;
+  if (fchmod(fd, fileMode()) != 0) {
+    const int saved = errno;
+    close(fd);
+    std::remove(temp.c_str());
+    errno = saved;
+    return -1;
+  }
+  return fd;
+}
+
 } // namespace
 
 std::optional<std::string> checkOutputPath(const std::string& path) {
@@ -92,19 +112,10 @@ std::optional<std::string> OutputSet::stage(const std::string& path, const FileW
     staged_.push_back({path, ""});
     return std::nullopt;
   }
-  const fs::path target(path);
-  std::string name = ".";
-  name += target.filename().string();
-  name += ".tmp.XXXXXX";
-  std::string temp = (fs::path(folderOf(path)) / name).string();
-  const int fd = mkstemp(temp.data());
+  std::string temp;
+  const int fd = makeTemp(path, temp);
   if (fd < 0) return cannotWrite(path, std::strerror(errno));
   staged_.push_back({path, temp});
-  if (fchmod(fd, fileMode()) != 0) {
-    const int saved = errno;
-    close(fd);
-    return cannotWrite(path, std::strerror(saved));
-  }
   std::FILE* f = fdopen(fd, "wb");
   if (!f) {
     const int saved = errno;
@@ -117,6 +128,32 @@ std::optional<std::string> OutputSet::stage(const std::string& path, const FileW
 
 std::optional<std::string> OutputSet::stage(const std::string& path, const std::string& bytes) {
   return stage(path, [&](std::FILE* f) { return std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size(); });
+}
+
+std::optional<std::string> OutputSet::stageAt(const std::string& path, const PathWriter& write) {
+  if (isSpecial(path)) {
+    if (auto why = write(path)) return cannotWrite(path, *why);
+    staged_.push_back({path, ""});
+    return std::nullopt;
+  }
+  std::string temp;
+  const int fd = makeTemp(path, temp);
+  if (fd < 0) return cannotWrite(path, std::strerror(errno));
+  close(fd);
+  staged_.push_back({path, temp});
+  std::optional<std::string> why = write(temp);
+  if (!why) {
+    // Flushed to the disk before the rename, as stage() does.
+    const int synced = open(temp.c_str(), O_RDONLY | O_CLOEXEC);
+    if (synced < 0 || (fsync(synced) != 0 && errno != EINVAL)) why = std::strerror(errno);
+    if (synced >= 0) close(synced);
+  }
+  if (why) {
+    std::remove(temp.c_str());
+    staged_.back().temp.clear();
+    return cannotWrite(path, *why);
+  }
+  return std::nullopt;
 }
 
 std::optional<std::string> OutputSet::commit() {

@@ -14,6 +14,8 @@ namespace tender {
 
 /// Writes a file's bytes to an open stream; returns false on failure (errno set).
 using FileWriter = std::function<bool(std::FILE*)>;
+/// Writes a whole file at the path it is given (through another program); returns why it failed.
+using PathWriter = std::function<std::optional<std::string>(const std::string& path)>;
 
 /// Checks that `path` can be written: its folder exists and is writable, and it is not a folder.
 /// Returns "cannot write '<path>': <why>" on failure.
@@ -35,6 +37,10 @@ public:
   std::optional<std::string> stage(const std::string& path, const FileWriter& write);
   /// As stage(), with the bytes given.
   std::optional<std::string> stage(const std::string& path, const std::string& bytes);
+  /// As stage(), for a writer that opens the file itself: `write` gets the temporary path (the
+  /// target itself when that is a device or a pipe); on failure the temporary file is removed and
+  /// "cannot write '<path>': <why>" returned.
+  std::optional<std::string> stageAt(const std::string& path, const PathWriter& write);
   /// Renames every staged file into place; returns the first error.
   std::optional<std::string> commit();
 

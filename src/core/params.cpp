@@ -1,20 +1,40 @@
 #include "params.h"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <functional>
-#include <unistd.h>
+
+#include <nlohmann/json.hpp>
 
 #include "sim_config.h"
 
 namespace tender {
 namespace {
 
+std::string fmt(float v) {
+  char buf[32];
+  snprintf(buf, sizeof(buf), "%g", double(v));
+  return buf;
+}
+
 struct Param {
   ParamInfo info;
   std::function<std::optional<std::string>(SimParams&, const std::string&)> set;
+  std::function<std::string(const SimParams&)> get; ///< the value, spelled as `set` takes it
+  bool whole = false;                               ///< a whole number (else a float, if a number)
 };
+
+// The shortest decimal that reads back as the same float.
+std::string shortest(float v) {
+  char buf[64];
+  auto [ptr, ec] = std::to_chars(buf, buf + sizeof(buf), v);
+  return ec == std::errc() ? std::string(buf, ptr) : fmt(v);
+}
 
 std::optional<std::string> parseFloat(const std::string& s, float lo, float hi, float& out) {
   float v = 0.0f;
@@ -43,34 +63,40 @@ std::optional<std::string> parseBool(const std::string& s, bool& out) {
   return "'" + s + "' is not on/off";
 }
 
-std::string fmt(float v) {
-  char buf[32];
-  snprintf(buf, sizeof(buf), "%g", double(v));
-  return buf;
-}
-
 // Limits of the sheet size: a 16384-wide grid or 2^24 particles at most.
 constexpr uint32_t kMaxSide = 16384;
 
 Param floatParam(const char* key, float SimParams::*m, float lo, float hi, const char* help) {
-  return {{key, help, lo, hi}, [m, lo, hi](SimParams& p, const std::string& v) { return parseFloat(v, lo, hi, p.*m); }};
+  return {{key, help, lo, hi},
+          [m, lo, hi](SimParams& p, const std::string& v) { return parseFloat(v, lo, hi, p.*m); },
+          [m](const SimParams& p) { return shortest(p.*m); }};
 }
 Param uintParam(const char* key, uint32_t SimParams::*m, uint32_t lo, uint32_t hi, const char* help) {
   return {{key, help, double(lo), double(hi)},
-          [m, lo, hi](SimParams& p, const std::string& v) { return parseUint(v, lo, hi, p.*m); }};
+          [m, lo, hi](SimParams& p, const std::string& v) { return parseUint(v, lo, hi, p.*m); },
+          [m](const SimParams& p) { return std::to_string(p.*m); },
+          true};
 }
 Param boolParam(const char* key, bool SimParams::*m, const char* help) {
-  return {{key, help}, [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); }};
+  return {{key, help},
+          [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); },
+          [m](const SimParams& p) { return std::string(p.*m ? "on" : "off"); }};
 }
 template <typename E>
 Param enumParam(const char* key, E SimParams::*m, std::vector<std::pair<std::string, E>> names, const char* help) {
-  return {{key, help}, [m, names](SimParams& p, const std::string& v) -> std::optional<std::string> {
+  return {{key, help},
+          [m, names](SimParams& p, const std::string& v) -> std::optional<std::string> {
             std::string all;
             for (auto& [n, e] : names) {
               if (n == v) return p.*m = e, std::nullopt;
               all += (all.empty() ? "" : ", ") + n;
             }
             return "'" + v + "' is not one of " + all;
+          },
+          [m, names](const SimParams& p) {
+            for (auto& [n, e] : names)
+              if (p.*m == e) return n;
+            return std::string();
           }};
 }
 
@@ -195,6 +221,101 @@ std::optional<std::string> applyOverride(SimParams& p, const std::string& assign
 std::optional<ParamInfo> paramInfo(const std::string& key) {
   for (auto& param : params())
     if (param.info.key == key) return param.info;
+  return std::nullopt;
+}
+
+std::vector<std::pair<std::string, std::string>> paramValues(const SimParams& p) {
+  std::vector<std::pair<std::string, std::string>> values;
+  for (auto& param : params()) values.emplace_back(param.info.key, param.get(p));
+  return values;
+}
+
+std::string presetJson(const SimParams& p) {
+  // Keys in the order of paramKeys(), after "preset".
+  nlohmann::ordered_json j;
+  j["preset"] = p.preset;
+  for (auto& param : params()) {
+    const std::string v = param.get(p);
+    if (param.info.lo == param.info.hi) {
+      if (v == "on" || v == "off")
+        j[param.info.key] = v == "on";
+      else
+        j[param.info.key] = v;
+    } else if (param.whole) {
+      j[param.info.key] = std::stoull(v);
+    } else {
+      // The float's shortest decimal as a double prints as the same digits.
+      double d = 0.0;
+      std::from_chars(v.data(), v.data() + v.size(), d);
+      j[param.info.key] = d;
+    }
+  }
+  return j.dump(2) + "\n";
+}
+
+std::optional<std::string> loadPresetFile(const std::string& path, SimParams& out) {
+  std::string text;
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return path + ": cannot read: " + std::strerror(errno);
+  char buf[65536];
+  size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof(buf), f)) > 0) {
+    text.append(buf, n);
+    if (text.size() > (64u << 20)) {
+      std::fclose(f);
+      return path + ": too large for a preset file";
+    }
+  }
+  const bool failed = std::ferror(f);
+  const int saved = errno;
+  std::fclose(f);
+  if (failed) return path + ": cannot read: " + std::strerror(saved);
+
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    std::string why = e.what();
+    if (auto close = why.find("] "); why.rfind("[json.exception", 0) == 0 && close != std::string::npos)
+      why = why.substr(close + 2);
+    for (char& c : why)
+      if (c == '\n' || c == '\r') c = ' ';
+    return path + ": malformed JSON: " + why;
+  }
+  if (!j.is_object()) return path + ": expected a JSON object of parameters (as `tender presets --dump NAME` prints)";
+
+  std::string base = "tender";
+  if (auto it = j.find("preset"); it != j.end()) {
+    if (!it->is_string()) return path + ": preset: expected the name of a preset";
+    base = it->get<std::string>();
+  }
+  std::optional<SimParams> p = presetParams(base);
+  if (!p) {
+    std::string names;
+    for (auto& name : presetNames()) names += (names.empty() ? "" : ", ") + name;
+    return path + ": unknown preset '" + base + "' (one of " + names + ")";
+  }
+  for (auto& [key, value] : j.items()) {
+    if (key == "preset") continue;
+    std::string spelled;
+    if (value.is_string()) {
+      spelled = value.get<std::string>();
+    } else if (value.is_boolean()) {
+      spelled = value.get<bool>() ? "on" : "off";
+    } else if (value.is_number_unsigned()) {
+      spelled = std::to_string(value.get<uint64_t>());
+    } else if (value.is_number_integer()) {
+      spelled = std::to_string(value.get<int64_t>());
+    } else if (value.is_number_float()) {
+      char num[64];
+      auto [ptr, ec] = std::to_chars(num, num + sizeof(num), value.get<double>());
+      spelled = ec == std::errc() ? std::string(num, ptr) : std::string("?");
+    } else {
+      return path + ": " + key + ": expected a number, a string or true/false, got " + value.dump();
+    }
+    if (auto err = applyOverride(*p, key + "=" + spelled)) return path + ": " + *err;
+  }
+  out = *p;
   return std::nullopt;
 }
 

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tender {
@@ -92,6 +93,17 @@ std::optional<std::string> applyOverride(SimParams& p, const std::string& assign
 /// machine's memory on the given backend ("cpu", or a GPU backend: its buffers counted as host
 /// memory, as on a CPU device or a GPU with shared memory); returns an error message.
 std::optional<std::string> validate(const SimParams& p, const std::string& backend = "gpu");
+
+/// Every key's value in `p`, spelled as `--set` takes it, in the order of paramKeys().
+std::vector<std::pair<std::string, std::string>> paramValues(const SimParams& p);
+/// `p` as a preset file: a JSON object of "preset" (the name of `p`) and every key, numbers as
+/// JSON numbers, on/off as true/false, names as strings (`tender presets --dump NAME`).
+std::string presetJson(const SimParams& p);
+/// Loads a preset file (--preset-file): a JSON object of keys and values as `--set` takes them
+/// (numbers, strings, true/false), optionally "preset": the built-in preset to start from
+/// (`tender` when absent). Returns "<path>: <why>" on failure (unreadable, malformed JSON, an
+/// unknown key or preset, a bad value).
+std::optional<std::string> loadPresetFile(const std::string& path, SimParams& out);
 
 /// Sizes of the sheet a SimParams describes, counted without building it.
 struct SheetCounts {

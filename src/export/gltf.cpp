@@ -1,0 +1,315 @@
+#include "gltf.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <sstream>
+
+#include <stb/stb_image_write.h>
+#include <tiny_gltf.h>
+
+#ifdef TENDER_HAS_RECEIPT
+#include "render/receipt.h"
+#endif
+
+namespace tender {
+namespace {
+
+// glTF enumerations (the specification's numbers).
+constexpr int kArrayBuffer = 34962;
+constexpr int kElementArrayBuffer = 34963;
+constexpr int kLinear = 9729;
+constexpr int kLinearMipmapLinear = 9987;
+constexpr int kClampToEdge = 33071;
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return s;
+}
+
+// A finite copy of a position (a non-finite coordinate, which a healthy run never has, becomes 0:
+// a glTF accessor may hold no NaN).
+glm::vec3 finite(glm::vec3 p) {
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(p[k])) p[k] = 0.0f;
+  return p;
+}
+
+// A unit normal: the normals pass gives one per particle; a zero or broken one becomes +z.
+glm::vec3 unitNormal(glm::vec3 n) {
+  float len = glm::length(n);
+  if (!std::isfinite(len) || len < 1e-12f) return glm::vec3(0.0f, 0.0f, 1.0f);
+  return n / len;
+}
+
+// Builds the model: one buffer, views appended 4-byte aligned.
+class Builder {
+public:
+  explicit Builder(tinygltf::Model& m) : m_(m) { m_.buffers.emplace_back(); }
+
+  int view(const void* data, size_t bytes, int target) {
+    auto& buf = m_.buffers[0].data;
+    while (buf.size() % 4) buf.push_back(0);
+    tinygltf::BufferView v;
+    v.buffer = 0;
+    v.byteOffset = buf.size();
+    v.byteLength = bytes;
+    v.target = target;
+    auto p = static_cast<const unsigned char*>(data);
+    buf.insert(buf.end(), p, p + bytes);
+    m_.bufferViews.push_back(v);
+    return int(m_.bufferViews.size() - 1);
+  }
+
+  // A VEC3 float accessor with its min and max.
+  int vec3(const std::vector<glm::vec3>& v) {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
+    for (const glm::vec3& p : v) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    tinygltf::Accessor a = accessor(view(v.data(), v.size() * sizeof(glm::vec3), kArrayBuffer), v.size(),
+                                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3);
+    a.minValues = {lo.x, lo.y, lo.z};
+    a.maxValues = {hi.x, hi.y, hi.z};
+    return push(a);
+  }
+
+  int vec2(const std::vector<glm::vec2>& v) {
+    return push(accessor(view(v.data(), v.size() * sizeof(glm::vec2), kArrayBuffer), v.size(),
+                         TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2));
+  }
+
+  int indices(const std::vector<uint32_t>& idx) {
+    tinygltf::Accessor a = accessor(view(idx.data(), idx.size() * 4, kElementArrayBuffer), idx.size(),
+                                    TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR);
+    a.minValues = {double(*std::min_element(idx.begin(), idx.end()))};
+    a.maxValues = {double(*std::max_element(idx.begin(), idx.end()))};
+    return push(a);
+  }
+
+  // Scalar floats of animation data (no buffer target: not vertex data).
+  int scalars(const std::vector<float>& v, bool with_range) {
+    tinygltf::Accessor a =
+        accessor(view(v.data(), v.size() * 4, 0), v.size(), TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR);
+    if (with_range) {
+      a.minValues = {*std::min_element(v.begin(), v.end())};
+      a.maxValues = {*std::max_element(v.begin(), v.end())};
+    }
+    return push(a);
+  }
+
+private:
+  static tinygltf::Accessor accessor(int view, size_t count, int component, int type) {
+    tinygltf::Accessor a;
+    a.bufferView = view;
+    a.byteOffset = 0;
+    a.count = count;
+    a.componentType = component;
+    a.type = type;
+    return a;
+  }
+  int push(const tinygltf::Accessor& a) {
+    m_.accessors.push_back(a);
+    return int(m_.accessors.size() - 1);
+  }
+
+  tinygltf::Model& m_;
+};
+
+std::vector<glm::vec3> positions(const MeshFrame& f) {
+  std::vector<glm::vec3> out(f.pos.size());
+  for (size_t i = 0; i < f.pos.size(); ++i) out[i] = finite(glm::vec3(f.pos[i]));
+  return out;
+}
+
+std::vector<glm::vec3> normals(const MeshFrame& f, size_t n) {
+  std::vector<glm::vec3> out(n, glm::vec3(0.0f, 0.0f, 1.0f));
+  for (size_t i = 0; i < n && i < f.normal.size(); ++i) out[i] = unitNormal(glm::vec3(f.normal[i]));
+  return out;
+}
+
+} // namespace
+
+std::optional<MeshFormat> meshFormatFor(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  const size_t dot = name.find_last_of('.');
+  if (dot == std::string::npos || dot == 0) return MeshFormat::Ply;
+  const std::string ext = lower(name.substr(dot));
+  if (ext == ".ply") return MeshFormat::Ply;
+  if (ext == ".glb") return MeshFormat::Glb;
+  if (ext == ".gltf") return MeshFormat::Gltf;
+  return std::nullopt;
+}
+
+MeshFrame meshFrame(const SimState& state, double time) {
+  MeshFrame f;
+  f.time = time;
+  f.pos = state.pos;
+  f.normal = state.normal;
+  const uint32_t n = std::min<uint32_t>(state.triangle_count, uint32_t(state.triangles.size()));
+  f.triangles.reserve(n);
+  for (uint32_t k = 0; k < n; ++k) f.triangles.emplace_back(glm::uvec3(state.triangles[k]));
+  return f;
+}
+
+std::optional<std::string> encodeGltf(const MeshScene& scene, const std::vector<MeshFrame>& frames, bool binary,
+                                      std::string& error) {
+  if (frames.empty()) {
+    error = "glTF export: no frame to write";
+    return std::nullopt;
+  }
+  const MeshFrame& first = frames.front();
+  const size_t n = first.pos.size();
+  if (n == 0) {
+    error = "glTF export: the sheet has no particles";
+    return std::nullopt;
+  }
+  for (const MeshFrame& f : frames)
+    if (f.pos.size() != n) {
+      error = "glTF export: the particle count changed between frames";
+      return std::nullopt;
+    }
+  const MeshFrame& last = frames.back();
+  for (const glm::uvec3& t : last.triangles)
+    if (t.x >= n || t.y >= n || t.z >= n) {
+      error = "glTF export: a triangle names a particle beyond the sheet";
+      return std::nullopt;
+    }
+
+  tinygltf::Model m;
+  m.asset.version = "2.0";
+  m.asset.generator = std::string("Tender ") + TENDER_VERSION;
+  Builder b(m);
+
+  // Geometry: the first frame's particles, the last frame's triangles.
+  const std::vector<glm::vec3> base_pos = positions(first);
+  const std::vector<glm::vec3> base_normal = normals(first, n);
+  tinygltf::Primitive prim;
+  prim.attributes["POSITION"] = b.vec3(base_pos);
+  prim.attributes["NORMAL"] = b.vec3(base_normal);
+  std::vector<glm::vec2> uv(n, glm::vec2(0.0f));
+  for (size_t i = 0; i < n && i < scene.uv.size(); ++i) uv[i] = scene.uv[i];
+  prim.attributes["TEXCOORD_0"] = b.vec2(uv);
+  if (!last.triangles.empty()) {
+    std::vector<uint32_t> idx;
+    idx.reserve(last.triangles.size() * 3);
+    for (const glm::uvec3& t : last.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
+    prim.indices = b.indices(idx);
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+  } else {
+    prim.mode = TINYGLTF_MODE_POINTS; // every triangle torn: the particles alone
+  }
+
+  // Material: the renderer's paper (white times the receipt, roughness 0.7, no metal, both faces).
+  tinygltf::Material mat;
+  mat.name = "receipt paper";
+  mat.doubleSided = true;
+  mat.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
+  mat.pbrMetallicRoughness.metallicFactor = 0.0;
+  mat.pbrMetallicRoughness.roughnessFactor = kPaperRoughness;
+  if (!scene.texture_png.empty()) {
+    tinygltf::Image img;
+    img.name = "receipt";
+    img.mimeType = "image/png";
+    img.bufferView = b.view(scene.texture_png.data(), scene.texture_png.size(), 0);
+    m.images.push_back(img);
+    tinygltf::Sampler s;
+    s.magFilter = kLinear;
+    s.minFilter = kLinearMipmapLinear;
+    s.wrapS = kClampToEdge;
+    s.wrapT = kClampToEdge;
+    m.samplers.push_back(s);
+    tinygltf::Texture tex;
+    tex.sampler = 0;
+    tex.source = 0;
+    m.textures.push_back(tex);
+    mat.pbrMetallicRoughness.baseColorTexture.index = 0;
+  }
+  m.materials.push_back(mat);
+  prim.material = 0;
+
+  tinygltf::Mesh mesh;
+  mesh.name = scene.name;
+
+  // Animation: frame k > 0 is morph target k - 1 (position and normal deltas from the first
+  // frame), shown alone by a step-interpolated weights track.
+  const size_t targets = frames.size() - 1;
+  if (targets > 0) {
+    for (size_t k = 1; k < frames.size(); ++k) {
+      const std::vector<glm::vec3> p = positions(frames[k]);
+      const std::vector<glm::vec3> nn = normals(frames[k], n);
+      std::vector<glm::vec3> dp(n), dn(n);
+      for (size_t i = 0; i < n; ++i) dp[i] = p[i] - base_pos[i], dn[i] = nn[i] - base_normal[i];
+      prim.targets.push_back({{"POSITION", b.vec3(dp)}, {"NORMAL", b.vec3(dn)}});
+    }
+    mesh.weights.assign(targets, 0.0);
+    std::vector<float> times(frames.size());
+    for (size_t k = 0; k < frames.size(); ++k) times[k] = float(frames[k].time);
+    for (size_t k = 1; k < times.size(); ++k)
+      if (!(times[k] > times[k - 1])) {
+        error = "glTF export: frame times must increase";
+        return std::nullopt;
+      }
+    std::vector<float> weights(frames.size() * targets, 0.0f);
+    for (size_t k = 1; k < frames.size(); ++k) weights[k * targets + (k - 1)] = 1.0f;
+    tinygltf::AnimationSampler s;
+    s.input = b.scalars(times, true);
+    s.output = b.scalars(weights, false);
+    s.interpolation = "STEP";
+    tinygltf::AnimationChannel c;
+    c.sampler = 0;
+    c.target_node = 0;
+    c.target_path = "weights";
+    tinygltf::Animation anim;
+    anim.name = "simulation";
+    anim.samplers.push_back(s);
+    anim.channels.push_back(c);
+    m.animations.push_back(anim);
+  }
+  mesh.primitives.push_back(prim);
+  m.meshes.push_back(mesh);
+
+  tinygltf::Node node;
+  node.name = scene.name;
+  node.mesh = 0;
+  m.nodes.push_back(node);
+  tinygltf::Scene sc;
+  sc.nodes = {0};
+  m.scenes.push_back(sc);
+  m.defaultScene = 0;
+  m.buffers[0].name = "sheet";
+
+  std::ostringstream out;
+  tinygltf::TinyGLTF gltf;
+  if (!gltf.WriteGltfSceneToStream(&m, out, false, binary) || !out) {
+    error = "glTF export: cannot encode the file";
+    return std::nullopt;
+  }
+  return out.str();
+}
+
+bool haveReceiptTexture() {
+#ifdef TENDER_HAS_RECEIPT
+  return true;
+#else
+  return false;
+#endif
+}
+
+std::string receiptPng(const std::string& preset) {
+#ifdef TENDER_HAS_RECEIPT
+  const render::ReceiptImage img = render::rasterizeReceipt(render::receiptText(preset));
+  std::string bytes;
+  stbi_write_png_to_func(
+      [](void* context, void* data, int size) {
+        static_cast<std::string*>(context)->append(static_cast<char*>(data), size_t(size));
+      },
+      &bytes, int(img.width), int(img.height), 4, img.rgba.data(), int(img.width * 4));
+  return bytes;
+#else
+  (void)preset;
+  return {};
+#endif
+}
+
+} // namespace tender

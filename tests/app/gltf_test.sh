@@ -1,0 +1,252 @@
+#!/usr/bin/env bash
+# glTF export of `tender sim`: .glb and .gltf of the end state, a numbered sequence (--out DIR/)
+# and one animated file (--frames-every K --out FILE.glb). Every file is read back here (counts,
+# index ranges, accessor bounds, the embedded PNG), checked by the Khronos glTF-Validator when
+# tools/setup installed it (npm), and imported by Blender when it is installed. Bad input exits 2
+# with one line and writes nothing.
+set -u
+T=${TENDER:?set TENDER to the tender binary}
+here=$(cd "$(dirname "$0")" && pwd)
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+passed=0
+failures=0
+ok() { echo "ok: $*"; passed=$((passed + 1)); }
+bad() { echo "FAIL: $*"; failures=$((failures + 1)); }
+
+expect_bad() { # args...: must exit 2 with one stderr line
+  "$T" "$@" >"$tmp/out" 2>"$tmp/err"
+  local rc=$? lines
+  lines=$(wc -l <"$tmp/err")
+  if [ "$rc" -ne 2 ] || [ "$lines" -ne 1 ]; then
+    bad "tender $* -> exit $rc, $lines stderr lines: $(cat "$tmp/err")"
+  else
+    ok "tender $* -> $(cat "$tmp/err")"
+  fi
+}
+
+# A 16 x 24 sheet yanked by its free corner until it tears.
+sim=(sim --backend cpu --set cols=16 --set rows=24 --set substeps=4 --set iterations=2)
+printf '0 grab particle 383\n1 move 0 -40 4\n' >"$tmp/yank.txt"
+run=("${sim[@]}" --script "$tmp/yank.txt" --ticks 24)
+
+mkdir -p "$tmp/seq" "$tmp/bad"
+touch "$tmp/file"
+expect_bad "${run[@]}" --out "$tmp/bad/x.obj"
+expect_bad "${run[@]}" --out "$tmp/bad/x.glb.txt"
+expect_bad "${run[@]}" --frames-every 0 --out "$tmp/bad/"
+expect_bad "${run[@]}" --frames-every -3 --out "$tmp/bad/"
+expect_bad "${run[@]}" --frames-every abc --out "$tmp/bad/a.glb"
+expect_bad "${run[@]}" --frames-every 4
+expect_bad "${run[@]}" --frames-every 4 --out "$tmp/bad/x.ply"
+expect_bad "${run[@]}" --out "$tmp/bad/"
+expect_bad "${run[@]}" --frames-every 4 --out "$tmp/missing/"
+expect_bad "${run[@]}" --frames-every 4 --out "$tmp/file/"
+expect_bad "${run[@]}" --out /nonexistent/dir/x.glb
+expect_bad "${run[@]}" --frames-every 4 --out "$tmp/bad/" --stats /dev/full
+expect_bad "${run[@]}" --frames-every 4 --out "$tmp/bad/" --stats "$tmp/bad/frame_000002.glb"
+expect_bad "${sim[@]}" --ticks 100000 --frames-every 1 --out "$tmp/bad/anim.glb"
+if [ -z "$(ls -A "$tmp/bad")" ]; then ok "failed runs wrote nothing"; else bad "failed runs left $(ls "$tmp/bad")"; fi
+
+# Good runs: the end state, the sequence, the animation (frames at ticks 0, 10, 20 and 24).
+good() { "$T" "$@" >"$tmp/out" 2>"$tmp/err" && ok "tender $*" || bad "tender $* -> $(cat "$tmp/err")"; }
+good "${run[@]}" --out "$tmp/end.glb" --stats "$tmp/end.json"
+good "${run[@]}" --out "$tmp/end.gltf"
+good "${run[@]}" --frames-every 10 --out "$tmp/seq/"
+good "${run[@]}" --frames-every 10 --out "$tmp/anim.glb"
+good "${run[@]}" --frames-every 10 --out "$tmp/anim.gltf"
+good "${run[@]}" --out "$tmp/end.ply"
+files=("$tmp/end.glb" "$tmp/end.gltf" "$tmp/seq/"frame_*.glb "$tmp/anim.glb" "$tmp/anim.gltf")
+if [ "$(ls "$tmp/seq")" = "$(printf 'frame_%06d.glb\n' 0 1 2 3)" ]; then
+  ok "sequence: $(ls "$tmp/seq" | tr '\n' ' ')"
+else
+  bad "sequence folder holds: $(ls -a "$tmp/seq" | tr '\n' ' ')"
+fi
+if ls -a "$tmp" "$tmp/seq" | grep -q '\.tmp\.'; then bad "temporary files left"; else ok "no temporary files left"; fi
+
+# Read every file back (a reader independent of tinygltf): the structure, counts, index ranges,
+# accessor bounds, the embedded PNG; the animation's frames; the end state against the stats.
+if python3 - "$tmp" <<'PY'; then ok "every file reads back consistently"; else bad "read-back"; fi
+import base64, json, math, struct, sys, os
+tmp = sys.argv[1]
+
+def load(path):
+    data = open(path, "rb").read()
+    if path.endswith(".glb"):
+        magic, version, length = struct.unpack_from("<4sII", data, 0)
+        assert magic == b"glTF" and version == 2 and length == len(data), (path, magic, version, length)
+        jlen, jtype = struct.unpack_from("<II", data, 12)
+        assert jtype == 0x4E4F534A
+        doc = json.loads(data[20:20 + jlen])
+        off = 20 + jlen
+        blen, btype = struct.unpack_from("<II", data, off)
+        assert btype == 0x004E4942
+        return doc, data[off + 8:off + 8 + blen]
+    doc = json.loads(data)
+    uri = doc["buffers"][0]["uri"]
+    assert uri.startswith("data:application/octet-stream;base64,"), uri[:40]
+    return doc, base64.b64decode(uri.split(",", 1)[1])
+
+SIZES = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
+
+def values(doc, binary, index):
+    a = doc["accessors"][index]
+    v = doc["bufferViews"][a["bufferView"]]
+    n = a["count"] * SIZES[a["type"]]
+    fmt = {5126: "f", 5125: "I"}[a["componentType"]]
+    start = v.get("byteOffset", 0) + a.get("byteOffset", 0)
+    assert start + 4 * n <= v.get("byteOffset", 0) + v["byteLength"] <= len(binary)
+    flat = struct.unpack_from("<%d%s" % (n, fmt), binary, start)
+    k = SIZES[a["type"]]
+    return [flat[i:i + k] for i in range(0, n, k)]
+
+def check(path, frames):
+    doc, binary = load(path)
+    assert doc["asset"]["version"] == "2.0"
+    prim = doc["meshes"][0]["primitives"][0]
+    pos = values(doc, binary, prim["attributes"]["POSITION"])
+    n = len(pos)
+    assert n == 16 * 24, n
+    for attr in ("NORMAL", "TEXCOORD_0"):
+        assert doc["accessors"][prim["attributes"][attr]]["count"] == n, attr
+    for nrm in values(doc, binary, prim["attributes"]["NORMAL"]):
+        assert abs(math.sqrt(sum(c * c for c in nrm)) - 1) < 1e-4, nrm
+    def bounds(index):
+        a, vals = doc["accessors"][index], values(doc, binary, index)
+        for k in range(3):
+            assert math.isclose(a["min"][k], min(p[k] for p in vals), rel_tol=1e-6), (path, a["min"])
+            assert math.isclose(a["max"][k], max(p[k] for p in vals), rel_tol=1e-6), (path, a["max"])
+    bounds(prim["attributes"]["POSITION"])
+    idx = [i[0] for i in values(doc, binary, prim["indices"])]
+    assert len(idx) % 3 == 0 and idx and max(idx) < n, (len(idx), max(idx))
+    ia = doc["accessors"][prim["indices"]]
+    assert ia["min"] == [min(idx)] and ia["max"] == [max(idx)]
+    mat = doc["materials"][prim["material"]]
+    assert mat["doubleSided"] is True
+    pbr = mat["pbrMetallicRoughness"]
+    assert pbr["metallicFactor"] == 0 and abs(pbr["roughnessFactor"] - 0.7) < 1e-6, pbr
+    img = doc["images"][doc["textures"][pbr["baseColorTexture"]["index"]]["source"]]
+    assert img["mimeType"] == "image/png"
+    v = doc["bufferViews"][img["bufferView"]]
+    png = binary[v.get("byteOffset", 0):v.get("byteOffset", 0) + v["byteLength"]]
+    assert png[:8] == b"\x89PNG\r\n\x1a\n", png[:8]
+    w, h = struct.unpack(">II", png[16:24])
+    assert (w, h) == (512, 768), (w, h)
+    targets = prim.get("targets", [])
+    assert len(targets) == frames - 1, (path, len(targets))
+    for t in targets:
+        bounds(t["POSITION"])
+    if frames > 1:
+        anim = doc["animations"][0]
+        s = anim["samplers"][anim["channels"][0]["sampler"]]
+        assert s["interpolation"] == "STEP" and anim["channels"][0]["target"]["path"] == "weights"
+        times = [t[0] for t in values(doc, binary, s["input"])]
+        assert len(times) == frames and times == sorted(times) and times[0] == 0, times
+        w = values(doc, binary, s["output"])
+        assert len(w) == frames * (frames - 1)
+    return doc, binary, pos, idx
+
+stats = json.load(open(os.path.join(tmp, "end.json")))
+for name in ("end.glb", "end.gltf"):
+    doc, binary, pos, idx = check(os.path.join(tmp, name), 1)
+    assert len(idx) == 3 * stats["triangles"], (len(idx), stats["triangles"])
+    assert stats["torn"] > 0 and stats["triangles"] < 2 * 15 * 23, stats
+    for k in range(3):
+        assert math.isclose(min(p[k] for p in pos), stats["bbox_min"][k], rel_tol=1e-5, abs_tol=1e-5)
+seq = [check(os.path.join(tmp, "seq", "frame_%06d.glb" % k), 1) for k in range(4)]
+assert len(seq[0][3]) == 3 * 2 * 15 * 23 and len(seq[3][3]) == 3 * stats["triangles"]  # each frame its own triangles
+assert seq[3][2] == check(os.path.join(tmp, "end.glb"), 1)[2]  # the last frame is the end state
+for name in ("anim.glb", "anim.gltf"):
+    doc, binary, pos, idx = check(os.path.join(tmp, name), 4)
+    assert pos == seq[0][2] and idx == seq[3][3]  # frame 0's particles, the last frame's triangles
+    prim = doc["meshes"][0]["primitives"][0]
+    last = values(doc, binary, prim["targets"][2]["POSITION"])
+    for p, d, e in zip(pos, last, seq[3][2]):
+        for k in range(3):
+            assert abs(p[k] + d[k] - e[k]) < 1e-4 * max(1, abs(e[k])), (p, d, e)
+print("read back:", len(seq[3][3]) // 3, "triangles at the end,", stats["torn"], "constraints torn")
+PY
+
+# Taking frames leaves the run as it is; the GPU backend (where there is a Vulkan device) writes
+# the CPU's bytes.
+"$T" "${run[@]}" | grep -o 'state hash [0-9a-f]*' >"$tmp/hash_plain"
+"$T" "${run[@]}" --frames-every 3 --out "$tmp/anim3.glb" | grep -o 'state hash [0-9a-f]*' >"$tmp/hash_frames"
+if [ -s "$tmp/hash_plain" ] && cmp -s "$tmp/hash_plain" "$tmp/hash_frames"; then
+  ok "frames leave the $(cat "$tmp/hash_plain")"
+else
+  bad "frames change the run: $(cat "$tmp/hash_plain") vs $(cat "$tmp/hash_frames")"
+fi
+if "$T" devices >/dev/null 2>&1; then
+  gpu_run=("${run[@]}")
+  gpu_run[2]=gpu # --backend gpu
+  if "$T" "${gpu_run[@]}" --frames-every 10 --out "$tmp/anim_gpu.glb" >/dev/null 2>"$tmp/err" &&
+    cmp -s "$tmp/anim.glb" "$tmp/anim_gpu.glb"; then
+    ok "the GPU backend writes the CPU's animated file"
+  else
+    bad "GPU animated file differs from the CPU's: $(cat "$tmp/err")"
+  fi
+else
+  echo "skip: no Vulkan device for the GPU comparison"
+fi
+
+# The Khronos glTF-Validator (npm package gltf-validator; tools/setup installs it globally).
+node_path=""
+command -v npm >/dev/null && node_path=$(npm root -g 2>/dev/null)
+if command -v node >/dev/null; then
+  NODE_PATH="$node_path" node "$here/gltf_validate.js" "${files[@]}" >"$tmp/validator.txt" 2>&1
+  rc=$?
+  sed 's/^/  /' "$tmp/validator.txt"
+  case $rc in
+    0) ok "gltf-validator: no errors, no warnings in ${#files[@]} files" ;;
+    77) echo "skip: gltf-validator not installed (tools/setup installs it with npm)" ;;
+    *) bad "gltf-validator" ;;
+  esac
+else
+  echo "skip: no node for gltf-validator"
+fi
+
+# Blender (optional): its glTF importer reads the static and the animated file.
+if command -v blender >/dev/null; then
+  cat >"$tmp/import.py" <<'PY'
+import sys
+try:
+    import numpy
+except ImportError:
+    print("SKIP: no numpy for Blender's glTF importer")
+    sys.exit(0)
+if not hasattr(numpy, "bool"):
+    numpy.bool = bool  # Blender 3.4's importer uses numpy.bool, gone from newer numpy
+import bpy
+for path in sys.argv[sys.argv.index("--") + 1:]:
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.import_scene.gltf(filepath=path)
+    meshes = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+    assert len(meshes) == 1, path
+    mesh = meshes[0]
+    assert len(mesh.data.polygons) > 0, path
+    mat = mesh.active_material
+    assert mat is not None and not mat.use_backface_culling, path
+    assert any(tuple(i.size) == (512, 768) for i in bpy.data.images), path  # the receipt
+    keys = mesh.data.shape_keys
+    if "anim" in path:
+        assert keys and len(keys.key_blocks) == 4, path  # the basis and three frames
+        action = keys.animation_data.action if keys.animation_data else None
+        assert action is not None and len(action.fcurves) == 3, path
+    print("imported", path, len(mesh.data.vertices), "vertices,", len(mesh.data.polygons), "triangles,",
+          len(keys.key_blocks) if keys else 0, "shape keys")
+PY
+  timeout 120 blender --background --factory-startup --python-exit-code 1 --python "$tmp/import.py" -- \
+    "$tmp/end.glb" "$tmp/anim.glb" >"$tmp/blender.txt" 2>&1
+  if grep -q "^SKIP" "$tmp/blender.txt"; then
+    echo "skip: $(grep '^SKIP' "$tmp/blender.txt")"
+  elif grep -q "imported .*anim.glb" "$tmp/blender.txt"; then
+    ok "blender imports the files: $(grep imported "$tmp/blender.txt" | tr '\n' ' ')"
+  else
+    bad "blender import: $(tail -5 "$tmp/blender.txt")"
+  fi
+else
+  echo "skip: blender not installed"
+fi
+
+echo "$passed passed, $failures failed"
+[ "$failures" -eq 0 ]
