@@ -127,8 +127,10 @@ SIM_INLINE float exactDiv(float a, float b) {
       deviceDiv(uintBitsToFloat(0x3F800000u | (ma & 0x7FFFFFu)), uintBitsToFloat(0x3F800000u | (mb & 0x7FFFFFu)));
   uint q = clamp(uint(approx * (ge ? 8388608.0f : 16777216.0f)), 0x800000u, 0xFFFFFFu);
   int r = int((ma << shift) - q * mb);
-  // q is off by a few units: an estimate of floor(r / mb) (within one of it) and one last step
-  int d = int(floor(float(r) * (1.0f / float(mb))));
+  // q is off by a few units: an estimate of floor(r / mb) (within one of it: |r / mb| <= 5, and
+  // 1.5 - x / 2 is within 12 % of 1 / x on [1, 2), so no second division) and one last step
+  float inv_mb = (1.5f - 0.5f * uintBitsToFloat(0x3F800000u | (mb & 0x7FFFFFu))) * 1.1920929e-7f;
+  int d = int(floor(float(r) * inv_mb));
   q += uint(d);
   r -= d * int(mb);
   if (r < 0) {
@@ -161,8 +163,10 @@ SIM_INLINE float exactSqrt(float x) {
   // r = N - s^2, exact modulo 2^32 and small; s is the floor when 0 <= r <= 2s
   uint n = m << (odd ? 24u : 23u);
   int r = int(n - s * s);
-  // s is off by a few units: an estimate of the step (within one of it), then one last step
-  s += uint(int(floor(float(r) * (0.5f / float(s)))));
+  // s is off by a few units: an estimate of the step r / 2s (within one of it: |r / 2s| <= 5, and
+  // 1.5 - x / 2 is within 12 % of 1 / x on [1, 2), so no division), then one last step
+  float inv_2s = (1.5f - 0.5f * float(s) * 1.1920929e-7f) * 5.9604645e-8f;
+  s += uint(int(floor(float(r) * inv_2s)));
   r = int(n - s * s);
   if (r < 0) {
     s -= 1u;
