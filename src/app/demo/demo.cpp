@@ -337,6 +337,16 @@ int DemoApp::run() {
     hs.device = device;
     PassTimes times = backend_.solver->passTimes();
     hs.times = &times;
+    if (input_.grabbing && sim_->grabbed() != SIM_NONE) {
+      // The grab target on the screen (Vulkan clip space: y down, depth in [0, 1])
+      int ww = 0, wh = 0;
+      glfwGetWindowSize(window_, &ww, &wh);
+      const glm::vec4 clip = camera_.projection(float(std::max(ww, 1)) / float(std::max(wh, 1))) * camera_.view() *
+                             glm::vec4(sim_->grabTarget(), 1.0f);
+      if (clip.w > 0.0f)
+        hs.grab_point =
+            glm::vec2((clip.x / clip.w * 0.5f + 0.5f) * float(ww), (clip.y / clip.w * 0.5f + 0.5f) * float(wh));
+    }
 
     ImGui_ImplVulkan_NewFrame();
     ImGui_ImplGlfw_NewFrame();

@@ -16,6 +16,7 @@ constexpr const char* kSans = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 constexpr const char* kSansBold = "/usr/share/fonts/truetype/dejavu/DejaVuSans-Bold.ttf";
 // Seconds before the instruction line fades, and the fade's length.
 constexpr double kInstructionSeconds = 4.0;
+constexpr double kCrumpleInstructionSeconds = 3.0;
 constexpr double kFadeSeconds = 1.0;
 
 ImU32 rgba(uint32_t rgb, float alpha = 1.0f) {
@@ -51,6 +52,30 @@ Hud::Hud(float scale) : scale_(scale) {
   style.ScaleAllSizes(scale);
 }
 
+namespace {
+
+// A hand sprite of size `u` (about a finger's length) with its fingertips at `p`.
+void drawHand(ImDrawList* dl, ImVec2 p, float u) {
+  const ImU32 fill = IM_COL32(255, 236, 214, 235), line = IM_COL32(90, 70, 60, 255);
+  const float fw = 0.42f * u; // finger width
+  ImVec2 palm_min{p.x - 1.0f * u, p.y + 0.9f * u}, palm_max{p.x + 0.9f * u, p.y + 2.2f * u};
+  for (int k = 0; k < 4; ++k) {
+    const float x = p.x - 0.95f * u + float(k) * 0.47f * u, top = p.y + (k == 1 ? 0.0f : 0.25f * u);
+    dl->AddRectFilled({x, top}, {x + fw, palm_min.y + 0.3f * u}, fill, fw * 0.5f);
+    dl->AddRect({x, top}, {x + fw, palm_min.y + 0.3f * u}, line, fw * 0.5f, 0, 1.2f);
+  }
+  dl->AddRectFilled(palm_min, palm_max, fill, 0.35f * u);
+  dl->AddRect(palm_min, palm_max, line, 0.35f * u, 0, 1.2f);
+  const ImVec2 thumb[4] = {{palm_min.x, palm_min.y + 0.5f * u},
+                           {palm_min.x - 0.6f * u, palm_min.y + 0.1f * u},
+                           {palm_min.x - 0.75f * u, palm_min.y + 0.35f * u},
+                           {palm_min.x, palm_min.y + 1.0f * u}};
+  dl->AddConvexPolyFilled(thumb, 4, fill);
+  dl->AddPolyline(thumb, 4, line, 0, 1.2f);
+}
+
+} // namespace
+
 HudActions Hud::draw(const HudState& s, SimParams& params) {
   HudActions a;
   ImGuiIO& io = ImGui::GetIO();
@@ -66,7 +91,9 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
     // Loading: "Initialising…" centred with a progress bar, fading out once the simulation runs.
     ImDrawList* fg = ImGui::GetForegroundDrawList();
     const float al = s.init_alpha;
-    const char* text = "Initialising\xe2\x80\xa6";
+    // The crumple page's words; the tender page's otherwise
+    const bool crumple = params.release == ReleaseMode::DragVelocity;
+    const char* text = crumple ? "Initializing receipt paper\xe2\x80\xa6" : "Initialising\xe2\x80\xa6";
     ImVec2 ts = title_->CalcTextSizeA(title_->FontSize, FLT_MAX, 0.0f, text);
     ImVec2 c{size.x * 0.5f, size.y * 0.5f};
     fg->AddRectFilled({0.0f, 0.0f}, size, rgba(0xe4e0dc, al));
@@ -77,19 +104,6 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
   }
   if (s.init_progress < 1.0f) return a;
 
-  // Instruction line, centred at the bottom, fading out after 4 seconds.
-  double fade = 1.0 - std::clamp((s.seconds - kInstructionSeconds) / kFadeSeconds, 0.0, 1.0);
-  if (fade > 0.0) {
-    const char* text = params.release == ReleaseMode::DragVelocity
-                           ? "Click and drag to crumple \xc2\xb7 Right-drag to orbit"
-                           : "Click and drag to interact \xc2\xb7 Right-drag to orbit";
-    ImVec2 ts = body_->CalcTextSizeA(body, FLT_MAX, 0.0f, text);
-    textAt(dl, body_, body, {(size.x - ts.x) * 0.5f, size.y - m * 2.6f}, rgba(0x555555, float(fade)), text);
-  }
-  // Controls hint, bottom-left.
-  textAt(dl, body_, body * 0.9f, {m, size.y - m - body * 0.9f}, rgba(0x666666),
-         "R to Reset \xc2\xb7 W to toggle Wind \xc2\xb7 I to toggle FPS \xc2\xb7 P to toggle Pins \xc2\xb7 Space to "
-         "Pause");
   // FPS, top-right, hidden until I.
   if (s.show_fps) {
     char fps[32];
@@ -113,10 +127,36 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
   if (ImGui::Button(s.pins ? "Pins: on" : "Pins: off")) a.toggle_pins = true;
   ImGui::SameLine();
   if (ImGui::Button(s.paused ? "Resume" : "Pause")) a.toggle_pause = true;
+  const ImVec2 buttons = ImGui::GetWindowPos();
   ImGui::End();
 
-  // The parameter panel, collapsed at first, under the FPS counter.
-  ImGui::SetNextWindowPos({size.x - m, m + body * 1.8f}, ImGuiCond_FirstUseEver, {1.0f, 0.0f});
+  // Controls hint, bottom-left; above the buttons' row when the window is too narrow for both.
+  const char* hint = "R to Reset \xc2\xb7 W to toggle Wind \xc2\xb7 I to toggle FPS \xc2\xb7 P to toggle Pins "
+                     "\xc2\xb7 Space to Pause";
+  const float hint_size = body * 0.9f;
+  const ImVec2 hint_extent = body_->CalcTextSizeA(hint_size, FLT_MAX, 0.0f, hint);
+  float hint_y = size.y - m - hint_size;
+  if (m + hint_extent.x > buttons.x - 0.5f * m) hint_y = std::min(hint_y, buttons.y - 0.5f * m - hint_size);
+  textAt(dl, body_, hint_size, {m, hint_y}, rgba(0x666666), hint);
+
+  // Instruction line, centred at the bottom, fading out after 4 seconds ("Click and drag to
+  // crumple" alone, after 3, on the crumple page).
+  const bool crumple = params.release == ReleaseMode::DragVelocity;
+  const double shown = crumple ? kCrumpleInstructionSeconds : kInstructionSeconds;
+  double fade = 1.0 - std::clamp((s.seconds - shown) / kFadeSeconds, 0.0, 1.0);
+  if (fade > 0.0) {
+    const char* text =
+        crumple ? "Click and drag to crumple" : "Click and drag to interact \xc2\xb7 Right-drag to orbit";
+    ImVec2 ts = body_->CalcTextSizeA(body, FLT_MAX, 0.0f, text);
+    // Above the buttons (and the hint) when the window is too narrow for them side by side
+    float y = size.y - m * 2.6f;
+    if ((size.x + ts.x) * 0.5f > buttons.x - 0.5f * m) y = std::min(y, hint_y - 0.6f * m - ts.y);
+    textAt(dl, body_, body, {(size.x - ts.x) * 0.5f, y}, rgba(0x555555, float(fade)), text);
+  }
+
+  // The parameter panel, collapsed at first, under the FPS counter: anchored to the top-right
+  // corner in every frame, so a resized window keeps it there.
+  ImGui::SetNextWindowPos({size.x - m, m + body * 1.8f}, ImGuiCond_Always, {1.0f, 0.0f});
   ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize({320.0f * scale_, 0.0f}, ImGuiCond_FirstUseEver);
   if (ImGui::Begin("Parameters", nullptr, ImGuiWindowFlags_NoSavedSettings)) {
@@ -165,6 +205,9 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
     }
   }
   ImGui::End();
+
+  // While grabbing: a small hand at the grab point (palm, four fingers, a thumb)
+  if (s.grab_point) drawHand(ImGui::GetForegroundDrawList(), {s.grab_point->x, s.grab_point->y}, 9.0f * scale_);
 
   // Paused: 50% overlay with "PAUSED" centred.
   if (s.paused) {

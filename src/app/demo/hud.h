@@ -22,6 +22,8 @@ struct HudState {
   std::string device; ///< renderer device name
   const PassTimes* times = nullptr;
   uint32_t triangles = 0; ///< live triangles (0 when unknown)
+  /// Where the grab holds the paper, in window pixels, while grabbing: the hand sprite's place
+  std::optional<glm::vec2> grab_point;
 };
 
 /// What the user asked for through the HUD this frame.
