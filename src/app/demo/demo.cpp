@@ -156,6 +156,7 @@ void DemoApp::createSolver() {
     return;
   }
   sim_ = std::make_unique<Simulation>(common_.params, *backend_.solver);
+  camera_ = startView(common_.params);
   panel_params_ = common_.params;
   attachPaper();
 }

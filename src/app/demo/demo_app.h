@@ -61,6 +61,10 @@ private:
   void apply(ScriptEvent e);
   void handleActions(const demo::HudActions& a);
   void switchParams(const SimParams& p, bool new_receipt);
+  /// The camera's start view for a preset: the spec's (6, 4, 10) towards (0, 1, 0), or for a
+  /// crumple sheet, which falls to the floor at y = -10, a view from further back that shows the
+  /// floor and the shadow on it.
+  static render::OrbitCamera startView(const SimParams& p);
   render::Ray cursorRay() const;
 
   static void onMouseButton(GLFWwindow* w, int button, int action, int mods);

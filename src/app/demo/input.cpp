@@ -107,7 +107,7 @@ void DemoApp::onKey(GLFWwindow* w, int key, int, int action, int) {
     app.show_fps_ = !app.show_fps_;
     return;
   case GLFW_KEY_C:
-    app.camera_ = render::OrbitCamera();
+    app.camera_ = startView(app.sim_->params());
     return;
   case GLFW_KEY_ESCAPE:
     glfwSetWindowShouldClose(w, GLFW_TRUE);
@@ -121,11 +121,20 @@ void DemoApp::onKey(GLFWwindow* w, int key, int, int action, int) {
 
 void DemoApp::onResize(GLFWwindow* w, int, int) { appOf(w)->input_.resized = true; }
 
+render::OrbitCamera DemoApp::startView(const SimParams& p) {
+  render::OrbitCamera c;
+  if (p.preset.rfind("crumple", 0) == 0) c.lookAt({7.0f, 3.0f, 19.0f}, {0.0f, -1.8f, 0.0f});
+  return c;
+}
+
 void DemoApp::switchParams(const SimParams& p, bool new_receipt) {
   ctx_->waitIdle();
   input_.grabbing = false;
   input_.pending_move.reset();
-  if (new_receipt) renderer_->setReceipt(render::rasterizeReceipt(render::receiptText(p.preset)));
+  if (new_receipt) {
+    renderer_->setReceipt(render::rasterizeReceipt(render::receiptText(p.preset)));
+    camera_ = startView(p);
+  }
   sim_->rebuild(p);
   panel_params_ = p;
   attachPaper();
@@ -138,7 +147,7 @@ void DemoApp::handleActions(const demo::HudActions& a) {
   if (a.toggle_pins) e.kind = EventKind::Pins, apply(e);
   if (a.toggle_pause) e.kind = EventKind::Pause, apply(e);
   if (a.reset) e.kind = EventKind::Reset, apply(e);
-  if (a.reset_view) camera_ = render::OrbitCamera();
+  if (a.reset_view) camera_ = startView(sim_->params());
   if (a.preset) {
     if (auto p = presetParams(*a.preset)) switchParams(*p, true);
   } else if (a.rebuild) {
