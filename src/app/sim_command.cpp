@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "core/output.h"
+#include "core/progress.h"
 #include "core/simulation.h"
 #include "core/stats.h"
 #include "export/gltf.h"
@@ -134,14 +135,21 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   std::vector<double> ms;
   ms.reserve(size_t(std::min<uint64_t>(o.ticks, 1u << 20)));
   if (auto err = takeFrame(0)) return fail(*err);
+  // A bar on a terminal once the run has taken a second; nothing otherwise.
+  Progress progress("tender sim", "tick", o.ticks, 1.0);
   for (uint64_t t = 0; t < o.ticks; ++t) {
     auto t0 = std::chrono::steady_clock::now();
     bool ran = sim.tick();
     if (ran) solver.finish();
     auto t1 = std::chrono::steady_clock::now();
     if (ran) ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-    if (auto err = takeFrame(t + 1)) return fail(*err);
+    if (auto err = takeFrame(t + 1)) {
+      progress.clear();
+      return fail(*err);
+    }
+    progress.update(t + 1);
   }
+  progress.clear();
   solver.computeNormals();
   SimState state;
   solver.readback(state);

@@ -19,6 +19,7 @@
 #include "backend/headless.h"
 #include "commands.h"
 #include "core/output.h"
+#include "core/progress.h"
 
 namespace tender {
 namespace {
@@ -193,37 +194,6 @@ private:
   std::FILE* log_ = nullptr;
 };
 
-// A progress bar on stderr while it is a terminal; nothing otherwise.
-class Progress {
-public:
-  explicit Progress(uint64_t total) : total_(total), on_(isatty(STDERR_FILENO) == 1) {}
-  ~Progress() { clear(); }
-  void show(uint64_t done) {
-    if (!on_) return;
-    // Redrawn when the percentage changes.
-    const int percent = int(u128(done) * 100 / total_);
-    if (shown_ && percent == percent_) return;
-    percent_ = percent;
-    constexpr int kWidth = 30;
-    const int filled = int(u128(done) * kWidth / total_);
-    std::string bar(size_t(filled), '#');
-    bar.append(size_t(kWidth - filled), '-');
-    std::fprintf(stderr, "\rtender render: [%s] %3d%% frame %llu of %llu", bar.c_str(), percent,
-                 static_cast<unsigned long long>(done), static_cast<unsigned long long>(total_));
-    std::fflush(stderr);
-    shown_ = true;
-  }
-  void clear() {
-    if (shown_) std::fprintf(stderr, "\r\033[K"), std::fflush(stderr);
-    shown_ = false;
-  }
-
-private:
-  uint64_t total_;
-  bool on_, shown_ = false;
-  int percent_ = -1;
-};
-
 } // namespace
 
 int runVideo(const CommonOptions& common, const RenderOptions& o) {
@@ -280,7 +250,8 @@ int runVideo(const CommonOptions& common, const RenderOptions& o) {
   const std::string size = std::to_string(o.width) + "x" + std::to_string(o.height);
   std::optional<std::string> render_error;
   uint32_t validation_messages = 0;
-  Progress progress{uint64_t(frames)};
+  // A bar on stderr while it is a terminal; nothing otherwise.
+  Progress progress("tender render", "frame", uint64_t(frames));
   auto staged = outputs.stageAt(o.video, [&](const std::string& target) -> std::optional<std::string> {
     Encoder encoder;
     std::vector<std::string> args = {"-hide_banner", "-nostats", "-loglevel", "error", "-y"};
@@ -305,7 +276,7 @@ int runVideo(const CommonOptions& common, const RenderOptions& o) {
         if (!encoder_error) encoder_error = "ffmpeg stopped reading frames";
         return encoder_error;
       }
-      progress.show(frame + 1);
+      progress.update(frame + 1);
       return std::nullopt;
     };
     if (auto err = render::renderSequence(h, seq, &validation_messages)) {

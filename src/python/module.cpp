@@ -1,0 +1,365 @@
+// `import tender`: the simulation from Python (pybind11). The same controller, solvers, stats and
+// writers as `tender sim`, so the same run gives the same state hash.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "backend/backend.h"
+#include "core/output.h"
+#include "core/params.h"
+#include "core/script.h"
+#include "core/simulation.h"
+#include "core/stats.h"
+#include "export/gltf.h"
+#ifdef TENDER_HAS_GPU
+#include "gpu/context.h"
+#endif
+
+namespace py = pybind11;
+
+namespace tender {
+namespace {
+
+/// Keys that change the sheet (its grid, constraints or pins) or the solver (threads, SIMD): setting
+/// one rebuilds the sheet at rest. Every other key applies to the running sheet.
+bool needsRebuild(const std::string& key) {
+  static const char* keys[] = {"cols",  "rows", "spacing",  "pins",    "top_y",
+                               "shear", "bend", "tri_bend", "threads", "simd"};
+  return std::any_of(std::begin(keys), std::end(keys), [&](const char* k) { return key == k; });
+}
+
+/// A Python value spelled as `--set` takes it: True/False as on/off, numbers as their shortest
+/// decimal, strings as they are.
+std::string spell(const std::string& key, const py::handle& value) {
+  if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "on" : "off";
+  if (py::isinstance<py::int_>(value)) return py::str(value).cast<std::string>();
+  if (py::isinstance<py::float_>(value)) return py::repr(value).cast<std::string>();
+  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  // A NumPy scalar (numpy.float32, numpy.int64, numpy.bool_): its Python value.
+  if (py::hasattr(value, "item") && py::hasattr(value, "dtype")) {
+    py::object item = value.attr("item")();
+    if (py::isinstance<py::bool_>(item) || py::isinstance<py::int_>(item) || py::isinstance<py::float_>(item))
+      return spell(key, item);
+  }
+  throw py::value_error(key + ": expected a bool, an int, a float or a str, got " +
+                        py::str(py::type::of(value).attr("__name__")).cast<std::string>());
+}
+
+/// Applies key=value to `p`: an unknown key raises KeyError, a bad value ValueError (the CLI's messages).
+void applyKey(SimParams& p, const std::string& key, const py::handle& value) {
+  const std::string assignment = key + "=" + spell(key, value);
+  auto err = applyOverride(p, assignment);
+  if (!err) return;
+  if (key.empty() || !paramInfo(key)) throw py::key_error(*err);
+  throw py::value_error(*err);
+}
+
+std::string unknownPreset(const std::string& name) {
+  std::string names;
+  for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
+  return "unknown preset '" + name + "' (one of " + names + ")";
+}
+
+glm::vec3 coordinates(double x, double y, double z, const char* what) {
+  const double v[3] = {x, y, z};
+  for (double d : v)
+    if (!(std::fabs(d) <= double(kMaxCoordinate)))
+      throw py::value_error(std::string(what) + ": " + std::to_string(d) + " is out of range [-" +
+                            std::to_string(int64_t(kMaxCoordinate)) + ", " + std::to_string(int64_t(kMaxCoordinate)) +
+                            "]");
+  return {float(x), float(y), float(z)};
+}
+
+glm::vec3 sequence3(const py::sequence& s, const char* what) {
+  if (py::len(s) != 3) throw py::value_error(std::string(what) + ": expected 3 numbers");
+  double v[3];
+  for (size_t k = 0; k < 3; ++k) {
+    try {
+      v[k] = s[k].cast<double>();
+    } catch (const py::cast_error&) {
+      throw py::value_error(std::string(what) + ": expected 3 numbers");
+    }
+  }
+  return coordinates(v[0], v[1], v[2], what);
+}
+
+/// An (N, 3) array of the xyz of `v`.
+template <typename T, typename V>
+py::array_t<T> xyzArray(const std::vector<V>& v, size_t n) {
+  py::array_t<T> a({py::ssize_t(n), py::ssize_t(3)});
+  auto m = a.template mutable_unchecked<2>();
+  for (size_t i = 0; i < n; ++i)
+    for (py::ssize_t k = 0; k < 3; ++k) m(py::ssize_t(i), k) = T(v[i][int(k)]);
+  return a;
+}
+
+class PySimulation {
+public:
+  PySimulation(const std::string& preset, const std::string& backend, std::optional<int> device,
+               const py::kwargs& params) {
+    auto p = presetParams(preset);
+    if (!p) throw py::value_error(unknownPreset(preset));
+    for (auto item : params) applyKey(*p, item.first.cast<std::string>(), item.second);
+    if (backend != "cpu" && backend != "gpu") throw py::value_error("unknown backend '" + backend + "' (cpu or gpu)");
+    if (device && *device < 0) throw py::value_error("device: expected an index >= 0 (see tender.devices())");
+    if (auto err = validate(*p, backend)) throw py::value_error(*err);
+    backend_name_ = backend;
+    device_ = device.value_or(-1);
+    build(*p);
+  }
+
+  void step(int64_t ticks) {
+    if (ticks < 0) throw py::value_error("ticks: expected a count >= 0, got " + std::to_string(ticks));
+    for (int64_t t = 0; t < ticks; ++t) {
+      auto t0 = std::chrono::steady_clock::now();
+      const bool ran = sim_->tick();
+      if (ran) backend_.solver->finish();
+      auto t1 = std::chrono::steady_clock::now();
+      if (ran) ms_.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      if ((t & 15) == 15 && PyErr_CheckSignals() != 0) throw py::error_already_set();
+    }
+    backend_.solver->finish();
+  }
+
+  void grab(int64_t particle) {
+    const uint32_t n = sim_->topology().particleCount();
+    if (particle < 0 || particle >= int64_t(n))
+      throw py::value_error("particle " + std::to_string(particle) + " does not exist (the sheet has " +
+                            std::to_string(n) + ")");
+    sim_->grabParticle(uint32_t(particle));
+  }
+
+  bool grabRay(const py::sequence& origin, const py::sequence& direction) {
+    glm::vec3 o = sequence3(origin, "origin"), d = sequence3(direction, "direction");
+    if (!(glm::dot(d, d) > 0.0f)) throw py::value_error("direction: expected a non-zero vector");
+    return sim_->grabRay(o, d);
+  }
+
+  void move(double x, double y, double z) { sim_->moveGrab(coordinates(x, y, z, "move")); }
+  void release() { sim_->release(); }
+
+  void set(const std::string& key, const py::handle& value) {
+    SimParams p = sim_->params();
+    applyKey(p, key, value);
+    if (auto err = validate(p, backend_name_)) throw py::value_error(*err);
+    if (p.threads != sim_->params().threads || p.simd != sim_->params().simd) {
+      build(p);
+    } else if (needsRebuild(key)) {
+      sim_->rebuild(p);
+    } else {
+      sim_->setLiveParams(p);
+    }
+  }
+
+  void reset(bool animated) {
+    if (animated)
+      sim_->reset();
+    else
+      sim_->rebuild(sim_->params());
+  }
+
+  py::array_t<float> positions() {
+    SimState s = state();
+    return xyzArray<float>(s.pos, s.pos.size());
+  }
+
+  py::array_t<float> velocities() {
+    SimState s = state();
+    const float dt = sim_->params().substepDt();
+    py::array_t<float> a({py::ssize_t(s.pos.size()), py::ssize_t(3)});
+    auto m = a.mutable_unchecked<2>();
+    for (size_t i = 0; i < s.pos.size(); ++i) {
+      const glm::vec3 v = (glm::vec3(s.pos[i]) - glm::vec3(i < s.prev.size() ? s.prev[i] : s.pos[i])) / dt;
+      for (int k = 0; k < 3; ++k) m(py::ssize_t(i), k) = v[k];
+    }
+    return a;
+  }
+
+  py::array_t<int32_t> triangles() {
+    SimState s = state();
+    return xyzArray<int32_t>(s.triangles, std::min<size_t>(s.triangle_count, s.triangles.size()));
+  }
+
+  py::object stats() {
+    SimState s = state();
+    SheetStats st = computeStats(s, sim_->params().substepDt());
+    std::vector<double> ms = ms_;
+    double median = 0.0, slowest = 0.0;
+    if (!ms.empty()) {
+      slowest = *std::max_element(ms.begin(), ms.end());
+      std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
+      median = ms[ms.size() / 2];
+    }
+    Solver& solver = *backend_.solver;
+    nlohmann::json j = statsJson(st);
+    j["preset"] = sim_->params().preset;
+    j["backend"] = solver.name();
+    j["ticks"] = sim_->frameCount();
+    j["physics_ticks"] = sim_->physicsTicks();
+    j["ms_per_tick"] = median;
+    j["ms_slowest_tick"] = slowest;
+    j["dispatches_per_tick"] = solver.dispatchesPerTick();
+    const Arithmetic arith = solver.arithmetic();
+    j["arithmetic"] = {{"rounding", arith.rounding}, {"denormals", arith.denormals}, {"corrected", arith.corrected}};
+    j["inexact_math_emulated"] = arith.inexact_math_emulated;
+    nlohmann::json passes = nlohmann::json::object();
+    for (auto& [name, t] : solver.passTimes().ms) passes[name] = t;
+    if (backend_.gpu) j["gpu_ms_per_pass"] = passes;
+    return py::module_::import("json").attr("loads")(j.dump());
+  }
+
+  std::string stateHash() {
+    char hash[17];
+    std::snprintf(hash, sizeof(hash), "%016llx", static_cast<unsigned long long>(hashPositions(state().pos)));
+    return hash;
+  }
+
+  void save(const std::string& path) {
+    auto format = meshFormatFor(path);
+    if (!format) throw py::value_error("'" + path + "': unknown extension (.ply, .glb or .gltf)");
+    OutputSet outputs;
+    if (auto err = outputs.add(path)) throw py::value_error(*err);
+    backend_.solver->computeNormals();
+    SimState s;
+    backend_.solver->readback(s);
+    std::optional<std::string> err;
+    if (*format == MeshFormat::Ply) {
+      err = outputs.stage(path, [&](std::FILE* f) { return writePly(f, s); });
+    } else {
+      MeshScene scene;
+      scene.uv = sim_->topology().uv;
+      auto png = textures_.find(sim_->params().preset);
+      if (png == textures_.end())
+        png = textures_.emplace(sim_->params().preset, receiptPng(sim_->params().preset)).first;
+      scene.texture_png = png->second;
+      std::string error;
+      auto bytes = encodeGltf(scene, {meshFrame(s, 0.0)}, *format == MeshFormat::Glb, error);
+      if (!bytes) throw std::runtime_error(error);
+      err = outputs.stage(path, *bytes);
+    }
+    if (!err) err = outputs.commit();
+    if (err) throw std::runtime_error(*err);
+  }
+
+  bool wind() const { return sim_->wind(); }
+  void setWind(bool on) { sim_->setWind(on); }
+  bool pins() const { return sim_->pins(); }
+  void setPins(bool on) { sim_->setPins(on); }
+  bool paused() const { return sim_->paused(); }
+  void setPaused(bool on) { sim_->setPaused(on); }
+  std::string backendName() const { return backend_.solver->name(); }
+  uint32_t particleCount() const { return sim_->topology().particleCount(); }
+  int64_t grabbed() const { return sim_->grabbed() == SIM_NONE ? -1 : int64_t(sim_->grabbed()); }
+  py::dict params() const {
+    py::dict d;
+    d["preset"] = sim_->params().preset;
+    for (auto& [key, value] : paramValues(sim_->params())) d[py::str(key)] = value;
+    return d;
+  }
+
+private:
+  /// A new solver and sheet for `p` (checked); on failure the old ones stay.
+  void build(const SimParams& p) {
+    BackendOptions options = backendOptionsFor(backend_name_, p);
+    options.device = device_;
+    Backend backend;
+    if (auto err = createBackend(options, backend)) throw std::runtime_error(*err);
+    auto sim = std::make_unique<Simulation>(p, *backend.solver);
+    sim_.reset();
+    backend_ = std::move(backend); // the solver stays where it is: `sim` keeps pointing at it
+    sim_ = std::move(sim);
+    ms_.clear();
+  }
+
+  SimState state() {
+    SimState s;
+    backend_.solver->readback(s);
+    return s;
+  }
+
+  std::string backend_name_;
+  int device_ = -1;
+  Backend backend_;
+  std::unique_ptr<Simulation> sim_;
+  std::vector<double> ms_;
+  std::map<std::string, std::string> textures_;
+};
+
+py::list devices() {
+  py::list out;
+#ifdef TENDER_HAS_GPU
+  auto list = gpu::listDevices();
+  if (!list) return out;
+  for (const gpu::DeviceInfo& d : *list) {
+    py::dict e;
+    e["index"] = d.index;
+    e["name"] = d.name;
+    e["type"] = d.type;
+    e["driver"] = d.driver;
+    e["memory_bytes"] = d.memory_bytes;
+    e["usable"] = d.usable;
+    out.append(e);
+  }
+#endif
+  return out;
+}
+
+} // namespace
+} // namespace tender
+
+PYBIND11_MODULE(tender, m) {
+  using namespace tender;
+  m.doc() = "Tender: a sheet of receipt paper to grab, crumple, fold, toss and tear.";
+  m.attr("__version__") = TENDER_VERSION;
+  m.def("presets", &presetNames, "The names of the built-in presets.");
+  m.def("devices", &devices,
+        "The Vulkan devices (dicts of index, name, type, driver, memory_bytes, usable), in the order "
+        "`device=` numbers them; empty without Vulkan.");
+  m.def("vulkan_built", &vulkanBuilt, "True when this build has the GPU backend.");
+  m.def("param_keys", [] {
+    std::vector<std::string> keys;
+    for (auto& k : paramKeys()) keys.push_back(k.key);
+    return keys;
+  });
+
+  py::class_<PySimulation>(m, "Simulation",
+                           "A sheet on a backend: Simulation(preset='tender', backend='cpu'|'gpu', device=None, "
+                           "**params), params as `--set` keys with Python values.")
+      .def(py::init<const std::string&, const std::string&, std::optional<int>, const py::kwargs&>(),
+           py::arg("preset") = "tender", py::arg("backend") = "cpu", py::arg("device") = py::none())
+      .def("step", &PySimulation::step, py::arg("ticks") = 1, "Runs `ticks` ticks (as `tender sim --ticks`).")
+      .def("grab", &PySimulation::grab, py::arg("particle"), "Grabs a particle where it is.")
+      .def("grab_ray", &PySimulation::grabRay, py::arg("origin"), py::arg("direction"),
+           "Grabs the nearest particle within grab_radius of the ray; returns whether one was caught.")
+      .def("move", &PySimulation::move, py::arg("x"), py::arg("y"), py::arg("z"), "Moves the grab target.")
+      .def("release", &PySimulation::release, "Lets go (zero or drag velocity, per the `release` key).")
+      .def("set", &PySimulation::set, py::arg("key"), py::arg("value"),
+           "Sets a parameter; keys that change the sheet or the solver rebuild the sheet at rest.")
+      .def("reset", &PySimulation::reset, py::arg("animated") = false,
+           "Puts the sheet back at rest now, or (animated=True) over the next 30 steps.")
+      .def_property_readonly("positions", &PySimulation::positions, "(N, 3) float32, a copy")
+      .def_property_readonly("velocities", &PySimulation::velocities,
+                             "(N, 3) float32, (pos - prev) / substep dt, a copy")
+      .def_property_readonly("triangles", &PySimulation::triangles, "(T, 3) int32, the live triangles, a copy")
+      .def_property("wind", &PySimulation::wind, &PySimulation::setWind, "Wind on or off (as the W key).")
+      .def_property("pins", &PySimulation::pins, &PySimulation::setPins, "Pins on or off (as the P key).")
+      .def_property("paused", &PySimulation::paused, &PySimulation::setPaused, "Paused steps run no physics.")
+      .def_property_readonly("backend", &PySimulation::backendName)
+      .def_property_readonly("particle_count", &PySimulation::particleCount)
+      .def_property_readonly("grabbed", &PySimulation::grabbed, "The grabbed particle, -1 when none.")
+      .def_property_readonly("params", &PySimulation::params, "Every key's value as `--set` spells it.")
+      .def("stats", &PySimulation::stats, "The stats JSON of `tender sim` as a dict.")
+      .def("state_hash", &PySimulation::stateHash, "FNV-1a 64 of the positions, as `tender sim` prints it.")
+      .def("save", &PySimulation::save, py::arg("path"), "Writes PLY, .glb or .gltf (by extension), atomically.");
+}

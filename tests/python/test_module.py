@@ -1,0 +1,194 @@
+"""`import tender`: the Python module against `tender sim` (run by ctest as python.module)."""
+import json
+import os
+import struct
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import tender
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+TENDER = os.environ.get("TENDER")
+
+
+def cli_hash(*args):
+    out = subprocess.run([TENDER, "sim", *args], check=True, capture_output=True, text=True).stdout
+    return out.strip().split("state hash ")[-1]
+
+
+@pytest.mark.skipif(not TENDER, reason="TENDER (the tender program) not set")
+def test_same_hash_as_tender_sim():
+    sim = tender.Simulation(preset="crumple", backend="cpu")
+    sim.step(30)
+    assert sim.state_hash() == cli_hash("--backend", "cpu", "--preset", "crumple", "--ticks", "30")
+    assert sim.stats()["state_hash"] == sim.state_hash()
+
+
+@pytest.mark.skipif(not TENDER, reason="TENDER (the tender program) not set")
+def test_params_spelled_as_set():
+    sim = tender.Simulation(preset="tender-low", backend="cpu", wind=False, gravity=2.5, iterations=3,
+                            pins="corners", damping=0.98)
+    sim.step(12)
+    assert sim.state_hash() == cli_hash("--backend", "cpu", "--preset", "tender-low", "--set", "wind=off",
+                                        "--set", "gravity=2.5", "--set", "iterations=3", "--set",
+                                        "pins=corners", "--set", "damping=0.98", "--ticks", "12")
+
+
+def test_arrays_and_stats():
+    sim = tender.Simulation(preset="crumple-low", backend="cpu")
+    sim.step(5)
+    pos, vel, tri = sim.positions, sim.velocities, sim.triangles
+    n = sim.particle_count
+    assert pos.shape == (n, 3) and pos.dtype == np.float32
+    assert vel.shape == (n, 3) and vel.dtype == np.float32
+    assert tri.shape[1] == 3 and tri.dtype == np.int32 and tri.min() >= 0 and tri.max() < n
+    st = sim.stats()
+    assert st["particles"] == n and st["ticks"] == 5 and st["triangles"] == len(tri)
+    assert st["backend"] == "cpu" and st["preset"] == "crumple-low"
+    assert np.isclose(np.linalg.norm(vel, axis=1).max(), st["max_speed"], rtol=1e-5)
+    assert np.allclose(pos.min(axis=0), st["bbox_min"]) and np.allclose(pos.max(axis=0), st["bbox_max"])
+    pos[:] = 0  # a copy: the sheet does not change
+    assert sim.positions.any()
+
+
+def test_grab_move_release_and_reset():
+    sim = tender.Simulation(preset="crumple-low", backend="cpu")
+    start = sim.positions
+    sim.grab(0)
+    assert sim.grabbed == 0
+    sim.move(1.0, 2.0, 3.0)
+    sim.step(20)
+    assert np.allclose(sim.positions[0], [1.0, 2.0, 3.0], atol=1e-4)
+    sim.release()
+    assert sim.grabbed == -1
+    sim.step(2)
+    assert sim.grab_ray((0.0, 0.0, 10.0), (0.0, 0.0, -1.0)) in (True, False)
+    assert not sim.grab_ray((100.0, 100.0, 100.0), (0.0, 1.0, 0.0))
+    sim.release()
+    sim.reset()
+    assert np.array_equal(sim.positions, start)
+    sim.step(3)
+    sim.reset(animated=True)
+    sim.step(30)  # the 30 frames of the animated reset
+    assert np.allclose(sim.positions, start, atol=1e-4)
+
+
+def test_set_live_and_rebuild():
+    sim = tender.Simulation(preset="tender-low", backend="cpu")
+    sim.step(3)
+    before = sim.positions
+    sim.set("damping", 0.95)  # live: the sheet keeps its state
+    sim.set("wind", False)
+    assert sim.params["damping"] == "0.95" and sim.params["wind"] == "off"
+    assert np.array_equal(sim.positions, before)
+    sim.set("gravity", np.float32(1.5))  # NumPy scalars as their Python values
+    sim.set("iterations", np.int64(3))
+    sim.set("collision", np.bool_(False))
+    assert (sim.params["gravity"], sim.params["iterations"], sim.params["collision"]) == ("1.5", "3", "off")
+    sim.set("cols", 10)  # rebuilds
+    assert sim.positions.shape[0] == 10 * int(sim.params["rows"])
+    sim.step(2)
+
+
+def test_bad_input_raises():
+    with pytest.raises(KeyError, match="unknown parameter 'nope'"):
+        tender.Simulation(backend="cpu", nope=1)
+    with pytest.raises(ValueError, match="unknown preset 'nope'"):
+        tender.Simulation(preset="nope", backend="cpu")
+    with pytest.raises(ValueError, match="unknown backend"):
+        tender.Simulation(backend="metal")
+    with pytest.raises(ValueError, match="^gravity: "):
+        tender.Simulation(backend="cpu", gravity=float("nan"))
+    with pytest.raises(ValueError, match="^gravity: "):
+        tender.Simulation(backend="cpu", gravity=float("inf"))
+    with pytest.raises(ValueError, match="^cols: "):
+        tender.Simulation(backend="cpu", cols=-3)
+    with pytest.raises(ValueError):
+        tender.Simulation(backend="cpu", cols=[1])
+    sim = tender.Simulation(preset="crumple-low", backend="cpu")
+    with pytest.raises(ValueError, match="does not exist"):
+        sim.grab(sim.particle_count)
+    with pytest.raises(ValueError, match="does not exist"):
+        sim.grab(-1)
+    with pytest.raises(ValueError, match="ticks"):
+        sim.step(-1)
+    with pytest.raises(ValueError, match="out of range"):
+        sim.move(float("nan"), 0, 0)
+    with pytest.raises(ValueError, match="out of range"):
+        sim.move(1e7, 0, 0)
+    with pytest.raises(ValueError):
+        sim.grab_ray((0, 0, 0), (0, 0, 0))
+    with pytest.raises(ValueError):
+        sim.grab_ray((0, 0), (0, 0, 1))
+    with pytest.raises(ValueError):
+        sim.grab_ray((0, 0, "x"), (0, 0, 1))
+    with pytest.raises(ValueError, match="out of range"):
+        sim.grab_ray((0, 0, float("inf")), (0, 0, 1))
+    with pytest.raises(KeyError):
+        sim.set("nope", 1)
+    with pytest.raises(ValueError, match="^iterations: "):
+        sim.set("iterations", 0)
+    with pytest.raises(ValueError):
+        sim.save("out.xyz")
+    # The sheet is unchanged and still runs.
+    sim.step(1)
+    assert sim.stats()["nan_count"] == 0
+
+
+def test_save_ply_and_glb(tmp_path):
+    sim = tender.Simulation(preset="crumple-low", backend="cpu")
+    sim.step(3)
+    sim.save(str(tmp_path / "a.ply"))
+    sim.save(str(tmp_path / "a.glb"))
+    sim.save(str(tmp_path / "a.gltf"))
+    ply = (tmp_path / "a.ply").read_bytes()
+    assert ply.startswith(b"ply\n") and b"element vertex %d" % sim.particle_count in ply
+    glb = (tmp_path / "a.glb").read_bytes()
+    magic, version, length = struct.unpack("<4sII", glb[:12])
+    assert magic == b"glTF" and version == 2 and length == len(glb)
+    assert json.loads((tmp_path / "a.gltf").read_text())["asset"]["version"] == "2.0"
+    assert sorted(os.listdir(tmp_path)) == ["a.glb", "a.gltf", "a.ply"]  # no temporary left
+    with pytest.raises(ValueError, match="cannot write"):
+        sim.save(str(tmp_path / "missing" / "a.glb"))
+
+
+def test_presets_and_devices():
+    assert tender.presets()[:2] == ["tender", "crumple"]
+    devices = tender.devices()
+    assert isinstance(devices, list)
+    for d in devices:
+        assert {"name", "type"} <= set(d)
+
+
+def test_gpu_on_lavapipe():
+    if not tender.vulkan_built():
+        with pytest.raises(RuntimeError):
+            tender.Simulation(backend="gpu")
+        return
+    if not any(d["usable"] for d in tender.devices()):
+        pytest.skip("no usable Vulkan device")
+    gpu = tender.Simulation(preset="crumple-low", backend="gpu")
+    cpu = tender.Simulation(preset="crumple-low", backend="cpu")
+    gpu.step(5)
+    cpu.step(5)
+    assert gpu.backend == "gpu" and gpu.state_hash() == cpu.state_hash()
+    assert "gpu_ms_per_pass" in gpu.stats()
+
+
+def test_gpu_bad_device():
+    if not tender.vulkan_built():
+        pytest.skip("no Vulkan in this build")
+    with pytest.raises(RuntimeError):
+        tender.Simulation(backend="gpu", device=99)
+
+
+def test_toss_example(tmp_path):
+    out = tmp_path / "toss.glb"
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "examples", "toss.py"), str(out)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert out.read_bytes()[:4] == b"glTF"
