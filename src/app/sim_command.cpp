@@ -155,26 +155,8 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   solver.readback(state);
   SheetStats st = computeStats(state, common.params.substepDt());
   double median = 0.0, slowest = 0.0;
-  if (!ms.empty()) {
-    slowest = *std::max_element(ms.begin(), ms.end());
-    std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
-    median = ms[ms.size() / 2];
-  }
-
-  nlohmann::json j = statsJson(st);
-  j["preset"] = common.params.preset;
-  j["backend"] = solver.name();
-  j["ticks"] = o.ticks;
-  j["physics_ticks"] = sim.physicsTicks();
-  j["ms_per_tick"] = median;
-  j["ms_slowest_tick"] = slowest;
-  j["dispatches_per_tick"] = solver.dispatchesPerTick();
-  const Arithmetic arith = solver.arithmetic();
-  j["arithmetic"] = {{"rounding", arith.rounding}, {"denormals", arith.denormals}, {"corrected", arith.corrected}};
-  j["inexact_math_emulated"] = arith.inexact_math_emulated;
-  nlohmann::json passes = nlohmann::json::object();
-  for (auto& [name, t] : solver.passTimes().ms) passes[name] = t;
-  if (backend.gpu) j["gpu_ms_per_pass"] = passes;
+  nlohmann::json j = runStatsJson(st, solver, {common.params.preset, o.ticks, sim.physicsTicks(), std::move(ms)},
+                                  backend.gpu != nullptr, &median, &slowest);
 
   std::printf("tender sim: preset %s, backend %s, %ux%u = %u particles, %llu ticks\n", common.params.preset.c_str(),
               solver.name().c_str(), common.params.cols, common.params.rows, st.particles,

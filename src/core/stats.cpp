@@ -1,5 +1,6 @@
 #include "stats.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -60,14 +61,46 @@ nlohmann::json statsJson(const SheetStats& s) {
   j["colors"] = s.colors;
   j["torn"] = s.torn;
   j["triangles"] = s.triangles;
-  char hash[17];
-  snprintf(hash, sizeof(hash), "%016llx", static_cast<unsigned long long>(s.state_hash));
-  j["state_hash"] = hash;
+  j["state_hash"] = hashHex(s.state_hash);
   j["bbox_min"] = {s.bbox_min.x, s.bbox_min.y, s.bbox_min.z};
   j["bbox_max"] = {s.bbox_max.x, s.bbox_max.y, s.bbox_max.z};
   j["max_stretch"] = s.max_stretch;
   j["max_speed"] = s.max_speed;
   j["nan_count"] = s.nan_count;
+  return j;
+}
+
+std::string hashHex(uint64_t h) {
+  char hash[17];
+  std::snprintf(hash, sizeof(hash), "%016llx", static_cast<unsigned long long>(h));
+  return hash;
+}
+
+nlohmann::json runStatsJson(const SheetStats& s, const Solver& solver, RunRecord run, bool gpu, double* median_ms,
+                            double* slowest_ms) {
+  double median = 0.0, slowest = 0.0;
+  std::vector<double>& ms = run.tick_ms;
+  if (!ms.empty()) {
+    slowest = *std::max_element(ms.begin(), ms.end());
+    std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
+    median = ms[ms.size() / 2];
+  }
+  if (median_ms) *median_ms = median;
+  if (slowest_ms) *slowest_ms = slowest;
+  nlohmann::json j = statsJson(s);
+  j["preset"] = run.preset;
+  j["backend"] = solver.name();
+  j["ticks"] = run.ticks;
+  j["physics_ticks"] = run.physics_ticks;
+  j["ms_per_tick"] = median;
+  j["ms_slowest_tick"] = slowest;
+  j["dispatches_per_tick"] = solver.dispatchesPerTick();
+  const Arithmetic arith = solver.arithmetic();
+  j["arithmetic"] = {{"rounding", arith.rounding}, {"denormals", arith.denormals}, {"corrected", arith.corrected}};
+  j["inexact_math_emulated"] = arith.inexact_math_emulated;
+  nlohmann::json passes = nlohmann::json::object();
+  for (auto& [name, t] : solver.passTimes().ms) passes[name] = t;
+  if (gpu) j["gpu_ms_per_pass"] = passes;
   return j;
 }
 

@@ -31,6 +31,20 @@ uint64_t hashPositions(const std::vector<glm::vec4>& pos);
 SheetStats computeStats(const SimState& s, float substep_dt);
 /// The stats as JSON (the caller adds timing fields).
 nlohmann::json statsJson(const SheetStats& s);
+/// A 64-bit hash as the 16 hex digits the stats print.
+std::string hashHex(uint64_t h);
+
+/// What a run adds to the stats: its preset, ticks and the wall time of each physics tick (ms).
+struct RunRecord {
+  std::string preset;
+  uint64_t ticks = 0, physics_ticks = 0;
+  std::vector<double> tick_ms;
+};
+/// The stats JSON of a run (`tender sim --stats`, the Python module's stats()): statsJson plus the
+/// run's preset, backend, ticks, median and slowest tick, dispatches, arithmetic and, on the GPU,
+/// the time of each pass. `median_ms`, when given, receives the median.
+nlohmann::json runStatsJson(const SheetStats& s, const Solver& solver, RunRecord run, bool gpu,
+                            double* median_ms = nullptr, double* slowest_ms = nullptr);
 /// Writes a binary PLY with the positions and the live triangles to an open file; false on an
 /// I/O error (write it through OutputSet or writeFileAtomically).
 bool writePly(std::FILE* f, const SimState& s);

@@ -194,36 +194,13 @@ public:
   py::object stats() {
     SimState s = state();
     SheetStats st = computeStats(s, sim_->params().substepDt());
-    std::vector<double> ms = ms_;
-    double median = 0.0, slowest = 0.0;
-    if (!ms.empty()) {
-      slowest = *std::max_element(ms.begin(), ms.end());
-      std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
-      median = ms[ms.size() / 2];
-    }
-    Solver& solver = *backend_.solver;
-    nlohmann::json j = statsJson(st);
-    j["preset"] = sim_->params().preset;
-    j["backend"] = solver.name();
-    j["ticks"] = sim_->frameCount();
-    j["physics_ticks"] = sim_->physicsTicks();
-    j["ms_per_tick"] = median;
-    j["ms_slowest_tick"] = slowest;
-    j["dispatches_per_tick"] = solver.dispatchesPerTick();
-    const Arithmetic arith = solver.arithmetic();
-    j["arithmetic"] = {{"rounding", arith.rounding}, {"denormals", arith.denormals}, {"corrected", arith.corrected}};
-    j["inexact_math_emulated"] = arith.inexact_math_emulated;
-    nlohmann::json passes = nlohmann::json::object();
-    for (auto& [name, t] : solver.passTimes().ms) passes[name] = t;
-    if (backend_.gpu) j["gpu_ms_per_pass"] = passes;
+    nlohmann::json j =
+        runStatsJson(st, *backend_.solver, {sim_->params().preset, sim_->frameCount(), sim_->physicsTicks(), ms_},
+                     backend_.gpu != nullptr);
     return py::module_::import("json").attr("loads")(j.dump());
   }
 
-  std::string stateHash() {
-    char hash[17];
-    std::snprintf(hash, sizeof(hash), "%016llx", static_cast<unsigned long long>(hashPositions(state().pos)));
-    return hash;
-  }
+  std::string stateHash() { return hashHex(hashPositions(state().pos)); }
 
   void save(const std::string& path) {
     auto format = meshFormatFor(path);
