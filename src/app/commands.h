@@ -11,6 +11,10 @@
 
 namespace tender {
 
+namespace render {
+struct HeadlessOptions;
+} // namespace render
+
 /// Exit status of every bad-input error (with one line on stderr).
 constexpr int kExitBadInput = 2;
 /// Exit status of tender-demo started by `tender` (kLaunchedVariable set) when no window can be
@@ -81,6 +85,10 @@ int runPresets(const std::string& name);
 /// part (where is printed), 2 on bad input.
 int runDiff(const CommonOptions& common, const DiffOptions& o);
 int runRender(const CommonOptions& common, const RenderOptions& o);
+/// The offscreen picture `tender render` (and its --video) asks for: the sheet, backend, device,
+/// size and input script of these options (the ticks are the caller's).
+void headlessOptionsFor(const CommonOptions& common, const RenderOptions& o, const InputScript& script,
+                        render::HeadlessOptions& out);
 /// `tender render --video`: every frame of the run piped to ffmpeg (H.264 MP4).
 int runVideo(const CommonOptions& common, const RenderOptions& o);
 int runDemo(const CommonOptions& common, const DemoOptions& o);

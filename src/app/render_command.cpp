@@ -7,22 +7,27 @@
 
 namespace tender {
 
+void headlessOptionsFor(const CommonOptions& common, const RenderOptions& o, const InputScript& script,
+                        render::HeadlessOptions& out) {
+  out.params = common.params;
+  out.backend = common.backend;
+  out.device = common.device;
+  out.validation = common.validation;
+  out.width = o.width;
+  out.height = o.height;
+  out.script = script;
+}
+
 int runRender(const CommonOptions& common, const RenderOptions& o) {
   if (!o.video.empty()) return runVideo(common, o);
   OutputSet outputs;
   if (auto err = outputs.add(o.out)) return fail(*err);
-  render::HeadlessOptions h;
-  h.params = common.params;
-  h.backend = common.backend;
-  h.device = common.device;
-  h.validation = common.validation;
-  h.ticks = o.ticks;
-  h.width = o.width;
-  h.height = o.height;
   std::string error;
   auto script = scriptFor(common.script, common.params, error);
   if (!script) return fail(error);
-  h.script = *script;
+  render::HeadlessOptions h;
+  headlessOptionsFor(common, o, *script, h);
+  h.ticks = o.ticks;
   render::HeadlessResult r = render::renderHeadless(h);
   if (!r.error.empty()) return fail(r.error);
   if (auto err = outputs.stage(o.out, render::encodePng(r.picture))) return fail(*err);

@@ -235,13 +235,7 @@ int runVideo(const CommonOptions& common, const RenderOptions& o) {
   if (ffmpeg.empty()) return fail("--video needs ffmpeg, which is not on PATH (Debian: apt-get install ffmpeg)");
 
   render::HeadlessOptions h;
-  h.params = common.params;
-  h.backend = common.backend;
-  h.device = common.device;
-  h.validation = common.validation;
-  h.width = o.width;
-  h.height = o.height;
-  h.script = *script;
+  headlessOptionsFor(common, o, *script, h);
 
   // A failed ffmpeg closes its end of the pipe: that is an error to report, not a signal.
   std::signal(SIGPIPE, SIG_IGN);

@@ -2,21 +2,7 @@
 # Command-line contract of `tender`: every bad input exits 2 with exactly one line on stderr;
 # `tender sim` writes stats JSON and a PLY.
 set -u
-T=${TENDER:?set TENDER to the tender binary}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-expect_bad() { # args...: must exit 2 with one stderr line
-  "$T" "$@" >"$tmp/out" 2>"$tmp/err"
-  local rc=$? lines
-  lines=$(wc -l <"$tmp/err")
-  if [ "$rc" -ne 2 ] || [ "$lines" -ne 1 ]; then
-    echo "FAIL: tender $* -> exit $rc, $lines stderr lines:"; cat "$tmp/err"; failures=$((failures + 1))
-  else
-    echo "ok: tender $* -> $(cat "$tmp/err")"
-  fi
-}
+. "$(dirname "$0")/lib.sh"
 
 sim=(sim --backend cpu --ticks 2)
 expect_bad "${sim[@]}" --preset nope

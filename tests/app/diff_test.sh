@@ -3,23 +3,7 @@
 # hash); a one-ULP difference planted after one pass (TENDER_TEST_PLANT_ULP) is found at that tick,
 # substep, pass and particle (exit 1); bad input exits 2 with one line.
 set -u
-T=${TENDER:?set TENDER to the tender binary}
-export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-
-expect_bad() { # args...: must exit 2 with one stderr line
-  "$T" "$@" >"$tmp/out" 2>"$tmp/err"
-  local rc=$? lines
-  lines=$(wc -l <"$tmp/err")
-  if [ "$rc" -ne 2 ] || [ "$lines" -ne 1 ]; then
-    fail "tender $* -> exit $rc, $lines stderr lines: $(cat "$tmp/err")"
-  else
-    echo "ok: tender $* -> $(cat "$tmp/err")"
-  fi
-}
+. "$(dirname "$0")/lib.sh"
 
 # expect_found OUT PATTERN...: every pattern is in the diff's report
 expect_found() {

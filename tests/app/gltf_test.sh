@@ -5,25 +5,10 @@
 # tools/setup installed it (npm), and imported by Blender when it is installed. Bad input exits 2
 # with one line and writes nothing.
 set -u
-T=${TENDER:?set TENDER to the tender binary}
 here=$(cd "$(dirname "$0")" && pwd)
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+. "$here/lib.sh"
 passed=0
-failures=0
 ok() { echo "ok: $*"; passed=$((passed + 1)); }
-bad() { echo "FAIL: $*"; failures=$((failures + 1)); }
-
-expect_bad() { # args...: must exit 2 with one stderr line
-  "$T" "$@" >"$tmp/out" 2>"$tmp/err"
-  local rc=$? lines
-  lines=$(wc -l <"$tmp/err")
-  if [ "$rc" -ne 2 ] || [ "$lines" -ne 1 ]; then
-    bad "tender $* -> exit $rc, $lines stderr lines: $(cat "$tmp/err")"
-  else
-    ok "tender $* -> $(cat "$tmp/err")"
-  fi
-}
 
 # A 16 x 24 sheet yanked by its free corner until it tears.
 sim=(sim --backend cpu --set cols=16 --set rows=24 --set substeps=4 --set iterations=2)
@@ -46,10 +31,10 @@ expect_bad "${run[@]}" --out /nonexistent/dir/x.glb
 expect_bad "${run[@]}" --frames-every 4 --out "$tmp/bad/" --stats /dev/full
 expect_bad "${run[@]}" --frames-every 4 --out "$tmp/bad/" --stats "$tmp/bad/frame_000002.glb"
 expect_bad "${sim[@]}" --ticks 100000 --frames-every 1 --out "$tmp/bad/anim.glb"
-if [ -z "$(ls -A "$tmp/bad")" ]; then ok "failed runs wrote nothing"; else bad "failed runs left $(ls "$tmp/bad")"; fi
+if [ -z "$(ls -A "$tmp/bad")" ]; then ok "failed runs wrote nothing"; else fail "failed runs left $(ls "$tmp/bad")"; fi
 
 # Good runs: the end state, the sequence, the animation (frames at ticks 0, 10, 20 and 24).
-good() { "$T" "$@" >"$tmp/out" 2>"$tmp/err" && ok "tender $*" || bad "tender $* -> $(cat "$tmp/err")"; }
+good() { "$T" "$@" >"$tmp/out" 2>"$tmp/err" && ok "tender $*" || fail "tender $* -> $(cat "$tmp/err")"; }
 good "${run[@]}" --out "$tmp/end.glb" --stats "$tmp/end.json"
 good "${run[@]}" --out "$tmp/end.gltf"
 good "${run[@]}" --frames-every 10 --out "$tmp/seq/"
@@ -60,13 +45,13 @@ files=("$tmp/end.glb" "$tmp/end.gltf" "$tmp/seq/"frame_*.glb "$tmp/anim.glb" "$t
 if [ "$(ls "$tmp/seq")" = "$(printf 'frame_%06d.glb\n' 0 1 2 3)" ]; then
   ok "sequence: $(ls "$tmp/seq" | tr '\n' ' ')"
 else
-  bad "sequence folder holds: $(ls -a "$tmp/seq" | tr '\n' ' ')"
+  fail "sequence folder holds: $(ls -a "$tmp/seq" | tr '\n' ' ')"
 fi
-if ls -a "$tmp" "$tmp/seq" | grep -q '\.tmp\.'; then bad "temporary files left"; else ok "no temporary files left"; fi
+if ls -a "$tmp" "$tmp/seq" | grep -q '\.tmp\.'; then fail "temporary files left"; else ok "no temporary files left"; fi
 
 # Read every file back (a reader independent of tinygltf): the structure, counts, index ranges,
 # accessor bounds, the embedded PNG; the animation's frames; the end state against the stats.
-if python3 - "$tmp" <<'PY'; then ok "every file reads back consistently"; else bad "read-back"; fi
+if python3 - "$tmp" <<'PY'; then ok "every file reads back consistently"; else fail "read-back"; fi
 import base64, json, math, struct, sys, os
 tmp = sys.argv[1]
 
@@ -174,7 +159,7 @@ PY
 if [ -s "$tmp/hash_plain" ] && cmp -s "$tmp/hash_plain" "$tmp/hash_frames"; then
   ok "frames leave the $(cat "$tmp/hash_plain")"
 else
-  bad "frames change the run: $(cat "$tmp/hash_plain") vs $(cat "$tmp/hash_frames")"
+  fail "frames change the run: $(cat "$tmp/hash_plain") vs $(cat "$tmp/hash_frames")"
 fi
 if "$T" devices >/dev/null 2>&1; then
   gpu_run=("${run[@]}")
@@ -183,7 +168,7 @@ if "$T" devices >/dev/null 2>&1; then
     cmp -s "$tmp/anim.glb" "$tmp/anim_gpu.glb"; then
     ok "the GPU backend writes the CPU's animated file"
   else
-    bad "GPU animated file differs from the CPU's: $(cat "$tmp/err")"
+    fail "GPU animated file differs from the CPU's: $(cat "$tmp/err")"
   fi
 else
   echo "skip: no Vulkan device for the GPU comparison"
@@ -199,7 +184,7 @@ if command -v node >/dev/null; then
   case $rc in
     0) ok "gltf-validator: no errors, no warnings in ${#files[@]} files" ;;
     77) echo "skip: gltf-validator not installed (tools/setup installs it with npm)" ;;
-    *) bad "gltf-validator" ;;
+    *) fail "gltf-validator" ;;
   esac
 else
   echo "skip: no node for gltf-validator"
@@ -242,7 +227,7 @@ PY
   elif grep -q "imported .*anim.glb" "$tmp/blender.txt"; then
     ok "blender imports the files: $(grep imported "$tmp/blender.txt" | tr '\n' ' ')"
   else
-    bad "blender import: $(tail -5 "$tmp/blender.txt")"
+    fail "blender import: $(tail -5 "$tmp/blender.txt")"
   fi
 else
   echo "skip: blender not installed"

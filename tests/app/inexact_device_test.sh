@@ -3,12 +3,7 @@
 # divide off by up to 3 ULP) gives the CPU reference's state hash and says so in its stats; with
 # the correction switched off (TENDER_UNCORRECTED_MATH=1) the hash differs.
 set -u
-T=${TENDER:?set TENDER to the tender binary}
-export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+. "$(dirname "$0")/lib.sh"
 hash_of() { sed -n 's/.*"state_hash": "\([0-9a-f]*\)".*/\1/p' "$1"; }
 
 printf '0 grab particle 1535\n1 move 4 -4 6\n40 release\n' >"$tmp/yank.txt"

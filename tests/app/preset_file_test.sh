@@ -3,11 +3,7 @@
 # and `--preset-file` of that JSON runs bitwise the same as `--preset NAME`; a bad file exits 2
 # with one line that names it.
 set -u
-T=${TENDER:?set TENDER to the tender binary}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+. "$(dirname "$0")/lib.sh"
 hash_of() { "$T" sim --backend cpu "$@" | grep -o 'state hash [0-9a-f]*'; }
 
 [ "$("$T" presets | tr '\n' ' ')" = "tender crumple tender-low crumple-low " ] && echo "ok: tender presets" ||

@@ -2,12 +2,7 @@
 # `tender render` and `tender` without a display: a PNG of the requested size, its path printed,
 # exit 0; bad input exits 2 with one line.
 set -u
-T=${TENDER:?set TENDER to the tender binary}
-export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+. "$(dirname "$0")/lib.sh"
 
 # Width and height of a PNG from its IHDR chunk.
 png_size() { od -An -tu1 -j16 -N8 "$1" | awk '{print $1*16777216+$2*65536+$3*256+$4 "x" $5*16777216+$6*65536+$7*256+$8}'; }
@@ -40,11 +35,6 @@ head -1 "$tmp/out3" | grep -q "^tender: cannot open a window (.*); rendering a p
   fail "tender with an unreachable display should say why in one line, then where the PNG is: $(cat "$tmp/out3" "$tmp/err3")"
 [ "$rc" -eq 0 ] && echo "ok: tender (unreachable display) -> $(head -1 "$tmp/out3")"
 
-expect_bad() {
-  "$T" "$@" >"$tmp/o" 2>"$tmp/e"
-  local rc=$?
-  if [ "$rc" -ne 2 ] || [ "$(wc -l <"$tmp/e")" -ne 1 ]; then fail "tender $* -> exit $rc: $(cat "$tmp/e")"; else echo "ok: tender $* -> $(cat "$tmp/e")"; fi
-}
 expect_bad render --width 4 --out "$tmp/x.png"
 expect_bad render --backend cpu --ticks 1 --width 64 --height 64 --out /dev/full
 printf '0 grab particle 99999\n' >"$tmp/range.txt"

@@ -2,13 +2,8 @@
 # `tender render --video`: an H.264 MP4 (yuv420p) of seconds x fps frames of the requested size;
 # bad input, a missing ffmpeg and failed writes exit 2 with one line and leave no file behind.
 set -u
-T=${TENDER:?set TENDER to the tender binary}
-export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
+. "$(dirname "$0")/lib.sh"
 command -v ffmpeg >/dev/null && command -v ffprobe >/dev/null || { echo "SKIP: ffmpeg or ffprobe missing"; exit 77; }
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 small=(render --backend cpu --width 160 --height 120)
 
 # A half-second video at 30 fps: 15 frames, 160x120, H.264 in yuv420p, the index (moov) first.
@@ -45,15 +40,6 @@ fi
   [ "$(ffprobe -v error -count_frames -show_entries stream=nb_read_frames -of csv=p=0 "$tmp/g.mp4")" = 6 ] &&
   echo "ok: the gpu backend -> 6 frames" || fail "--backend gpu: $(cat "$tmp/out")"
 
-expect_bad() { # args...: exit 2, one line on stderr
-  "$T" "$@" >"$tmp/o" 2>"$tmp/e"
-  local rc=$?
-  if [ "$rc" -ne 2 ] || [ "$(wc -l <"$tmp/e")" -ne 1 ] || ! grep -q '^tender: error: ' "$tmp/e"; then
-    fail "tender $* -> exit $rc: $(cat "$tmp/e")"
-  else
-    echo "ok: tender $* -> $(cat "$tmp/e")"
-  fi
-}
 for fps in 0 -5 241 nan abc; do expect_bad "${small[@]}" --seconds 0.5 --fps "$fps" --video "$tmp/x.mp4"; done
 expect_bad "${small[@]}" --seconds 0.001 --video "$tmp/x.mp4"
 expect_bad render --backend cpu --width 161 --height 120 --seconds 0.5 --video "$tmp/x.mp4"
