@@ -9,7 +9,6 @@
 
 #include "cpu/denormal_mode.h"
 #include "gpu/sim_pipeline.h"
-#include "gpu/spirv_rules.h"
 #include "gpu_test_env.h"
 
 using namespace tender;
@@ -18,9 +17,7 @@ namespace {
 
 // True when the simulation's shaders flush denormals on this device (it can only flush them); the
 // CPU's results to compare with are then computed with FTZ and DAZ set.
-bool flushes(gpu::VulkanContext& ctx) {
-  return gpu::floatRulesFor(ctx.floatControls()).denormals == gpu::Denormals::FlushToZero;
-}
+bool flushes(gpu::VulkanContext& ctx) { return test::cpuOptionsLike(ctx).flush_denormals; }
 
 bool same(uint32_t a, uint32_t b) {
   const float fa = std::bit_cast<float>(a), fb = std::bit_cast<float>(b);

@@ -13,13 +13,14 @@
 #include "common/sim_helpers.h"
 #include "cpu/cpu_solver.h"
 #include "gpu/context.h"
+#include "gpu/spirv_rules.h"
 
 namespace tender::test {
 
-/// CPU reference options that treat denormals as the GPU solver's device does: flushed where the
-/// device can only flush them (its shaders then flush too), kept otherwise.
-inline CpuOptions cpuOptionsLike(const Solver& gpu, CpuOptions o = {}) {
-  o.flush_denormals = gpu.arithmetic().denormals == "flush to zero";
+/// CPU reference options that treat denormals as the device does for the simulation's shaders
+/// (GpuSolver::arithmetic): flushed where it can only flush them, kept otherwise.
+inline CpuOptions cpuOptionsLike(gpu::VulkanContext& ctx, CpuOptions o = {}) {
+  o.flush_denormals = gpu::floatRulesFor(ctx.floatControls()).denormals == gpu::Denormals::FlushToZero;
   return o;
 }
 

@@ -26,7 +26,7 @@ protected:
 std::pair<SimState, SimState> runBoth(gpu::VulkanContext& ctx, const SimParams& p, const char* text, int ticks,
                                       bool fused = true, gpu::FusedShape shape = {}) {
   gpu::GpuSolver gpu(ctx, shape);
-  CpuSolver cpu(cpuOptionsLike(gpu));
+  CpuSolver cpu(cpuOptionsLike(ctx));
   gpu.setFusedPath(fused);
   Simulation a(p, cpu), b(p, gpu);
   a.setScript(script(text));
@@ -79,7 +79,7 @@ TEST_F(Parity, HashBucketsMatchTheCpu) {
   SimState after_gpu;
   gpu.readback(after_gpu);
 
-  CpuSolver cpu(cpuOptionsLike(gpu));
+  CpuSolver cpu(cpuOptionsLike(ctx()));
   cpu.upload(sim.topology());
   for (uint32_t i = 0; i < s.pos.size(); ++i) cpu.positions()[i] = s.pos[i];
   cpu.previous() = s.prev;
@@ -106,7 +106,7 @@ TEST_F(Parity, HugeHashTableUsesThreeScanLevelsAndTallGrids) {
   gpu.setCandidateLists(false); // a hash in every substep
   CpuOptions no_lists;
   no_lists.candidate_lists = false;
-  CpuSolver cpu(cpuOptionsLike(gpu, no_lists));
+  CpuSolver cpu(cpuOptionsLike(ctx(), no_lists));
   gpu.upload(topo);
   cpu.upload(topo);
   shaderio::SimUniforms u = sim.makeUniforms();
@@ -239,7 +239,7 @@ TEST_F(Parity, FusedSmallSheetPathMatchesSeparatePasses) {
     return s;
   };
   SimState fused = runGpu(true), separate = runGpu(false);
-  CpuSolver cpu(cpuOptionsLike(gpu::GpuSolver(ctx())));
+  CpuSolver cpu(cpuOptionsLike(ctx()));
   Simulation sim(p, cpu);
   sim.setScript(script(text));
   SimState ref = run(sim, 40);
@@ -282,7 +282,7 @@ TEST_F(Parity, FusedTickInTheShapesOfBothKindsOfDevice) {
       if (fused) {
         EXPECT_EQ(dispatches, gpu_like ? 1u : p.substeps);
       }
-      CpuSolver cpu(cpuOptionsLike(gpu));
+      CpuSolver cpu(cpuOptionsLike(ctx()));
       Simulation cpu_sim(p, cpu);
       cpu_sim.setScript(script(c.script));
       SimState ref = run(cpu_sim, 40);
@@ -383,7 +383,7 @@ void Parity::checkCandidateLists(const SimParams& p, bool fused, bool expect_ent
   Simulation sim(p, gpu);
   ASSERT_EQ(gpu.usesFusedPath(sim.makeUniforms()), fused);
   ASSERT_TRUE(gpu.usesCandidateLists());
-  CpuSolver cpu(cpuOptionsLike(gpu));
+  CpuSolver cpu(cpuOptionsLike(ctx()));
   Simulation ref(p, cpu);
   const SheetTopology& topo = sim.topology();
   const uint32_t n = topo.particleCount();
@@ -451,7 +451,7 @@ TEST_F(Parity, OverflowingCandidateListsFallBackToTheHash) {
     gpu.setFusedPath(fused);
     Simulation sim(p, gpu);
     ASSERT_EQ(gpu.usesFusedPath(sim.makeUniforms()), fused);
-    CpuSolver cpu(cpuOptionsLike(gpu));
+    CpuSolver cpu(cpuOptionsLike(ctx()));
     Simulation ref(p, cpu);
     int waiting = 0;
     const int ticks = 20;

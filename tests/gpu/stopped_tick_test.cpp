@@ -65,7 +65,7 @@ TEST_F(StoppedTick, EveryPassMatchesTheCpuFusedAndPerColour) {
 
   gpu::GpuSolver fused(ctx()), percolor(ctx());
   percolor.setFusedPath(false);
-  CpuSolver cpu(cpuOptionsLike(fused));
+  CpuSolver cpu(cpuOptionsLike(ctx()));
   std::set<uint64_t> distinct;
   bool deltas_compared = false;
   uint32_t torn_before_last = 0, torn_at_end = 0;
