@@ -66,6 +66,13 @@
 #define SIM_BIND_CANDIDATES 26
 #define SIM_BIND_CANDIDATE_BASE 27
 #define SIM_BIND_HASH_ARGS 28
+// The batched fused tick of a fleet (tick_batch.comp) reaches each binding's buffer through its
+// device address instead: the fleet's table (BatchPush.table) holds, per binding (SIM_BIND_*; the
+// uniforms are one SimUniforms per sheet), the address of sheet 0's slice and the bytes from one
+// sheet's slice to the next, then at SIM_BATCH_QUEUE the list of sheets to tick (one per workgroup)
+#define SIM_BATCH_QUEUE 29
+// Entries of the fleet's table
+#define SIM_BATCH_ENTRIES 30
 
 // Adjacency masks (SIM_BIND_ADJ_MASK): bit (dy + 2) * 5 + (dx + 2) is set when particle i is
 // connected to the particle dx columns and dy rows away; SIM_ADJ_FAR when it is connected to a

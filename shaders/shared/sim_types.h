@@ -77,6 +77,15 @@ struct FusedPush {
   uint stop;          // last pass of the tick to run (passesPerSubstep numbering), SIM_NONE: all
 };
 
+/// Push constants of the batched fused tick of a fleet (tick_batch.comp): the fused tick's, and the
+/// device address of the fleet's table (SIM_BATCH_* in sim_config.h).
+struct BatchPush {
+  FusedPush fused;
+  uvec2 table; // address (low, high 32 bits) of SIM_BATCH_ENTRIES uvec4: xy sheet 0's address, zw the stride
+  uint pad0;
+  uint pad1;
+};
+
 /// GPU counters: tear bookkeeping and indirect arguments (one storage buffer).
 struct Counters {
   uint torn_total;     // constraints torn since the last reset

@@ -7,8 +7,8 @@
 
 /// Position and previous position of one particle.
 struct VerletState {
-  vec4 pos;
-  vec4 prev;
+  vec4 position;
+  vec4 previous;
 };
 
 /// Position corrections of the two ends of a constraint.
@@ -50,11 +50,11 @@ SIM_INLINE VerletState verletStep(vec4 pos, vec4 prev, vec3 accel, float damping
   vec3 p = vec3(pos);
   if (w > 0.0f) {
     vec3 v = (p - vec3(prev)) * damping;
-    s.pos = vec4(p + v + accel * dt2, w);
+    s.position = vec4(p + v + accel * dt2, w);
   } else {
-    s.pos = vec4(p, w);
+    s.position = vec4(p, w);
   }
-  s.prev = vec4(p, w);
+  s.previous = vec4(p, w);
   return s;
 }
 
@@ -69,8 +69,8 @@ SIM_INLINE VerletState integrateParticle(vec4 pos, vec4 prev, vec4 rest, float u
   float w = inverseMass(rest, held, flags);
   VerletState s;
   if (placed) {
-    s.pos = vec4(vec3(grab_target), w);
-    s.prev = vec4(vec3(grab_prev), w);
+    s.position = vec4(vec3(grab_target), w);
+    s.previous = vec4(vec3(grab_prev), w);
   } else {
     s = verletStep(pos, prev, externalAccel(gravity, wind, wind_twist, u), damping, dt2, w);
   }
@@ -96,15 +96,15 @@ SIM_INLINE PairDelta solveDistance(vec4 pa, vec4 pb, float rest, float stiffness
 /// Ground contact: clamp to the floor, reflect normal velocity with restitution, apply friction.
 SIM_INLINE VerletState floorContact(vec4 pos, vec4 prev, float floor_y, float restitution, float friction) {
   VerletState s;
-  s.pos = pos;
-  s.prev = prev;
+  s.position = pos;
+  s.previous = prev;
   if (pos.y < floor_y) {
     float vy = min(pos.y - prev.y, 0.0f);
     float keep = 1.0f - friction;
-    s.pos.y = floor_y;
-    s.prev.y = floor_y + vy * restitution;
-    s.prev.x = pos.x - (pos.x - prev.x) * keep;
-    s.prev.z = pos.z - (pos.z - prev.z) * keep;
+    s.position.y = floor_y;
+    s.previous.y = floor_y + vy * restitution;
+    s.previous.x = pos.x - (pos.x - prev.x) * keep;
+    s.previous.z = pos.z - (pos.z - prev.z) * keep;
   }
   return s;
 }

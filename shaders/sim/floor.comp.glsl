@@ -10,6 +10,6 @@ void main() {
   uint i = threadIndex();
   if (i >= p.count) return;
   VerletState st = floorParticle(pos[i], prev[i], vec3(delta[i]), u.flags, u.floor_y, u.restitution, u.friction);
-  pos[i] = st.pos;
-  prev[i] = st.prev;
+  pos[i] = st.position;
+  prev[i] = st.previous;
 }

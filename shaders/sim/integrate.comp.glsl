@@ -18,6 +18,6 @@ void main() {
   VerletState st =
       integrateParticle(pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index, u.grab_target[s], u.grab_prev[s],
                         u.flags, u.gravity, u.wind[s], u.wind_twist[s], u.damping, u.dt * u.dt);
-  pos[i] = st.pos;
-  prev[i] = st.prev;
+  pos[i] = st.position;
+  prev[i] = st.previous;
 }

@@ -21,6 +21,102 @@ layout(local_size_x = SIM_LOCAL_SIZE) in;
 #define SIM_COHERENT
 #endif
 
+#ifdef SIM_BATCH
+// The batched fused tick of a fleet: every array is sheet sheet's slice of its buffer, reached by
+// device address (SIM_BATCH_* in sim_config.h); the names below stand for those slices, so the
+// passes' code reads the same in both builds.
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+// BatchPush's members (`p` as in the fused tick, then the table's address)
+layout(push_constant) uniform PushBlock {
+  FusedPush p;
+  uvec2 batch_table;
+};
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BatchTableRef { uvec4 entry[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer QueueRef { uint sheet[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer UniformsRef { SimUniforms v; };
+layout(buffer_reference, std430, buffer_reference_align = 16) SIM_COHERENT buffer Vec4Ref { vec4 v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) SIM_COHERENT buffer Uvec4Ref { uvec4 v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) SIM_COHERENT buffer Uvec2Ref { uvec2 v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer Vec2Ref { vec2 v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) SIM_COHERENT buffer UintRef { uint v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) SIM_COHERENT buffer ConstraintRef { Constraint v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) SIM_COHERENT buffer CountersRef { Counters v; };
+UniformsRef g_u;
+Vec4Ref g_pos, g_prev, g_rest_pos, g_delta, g_candidate_base, g_reset_from;
+Vec2Ref g_uv;
+ConstraintRef g_constraints;
+Uvec2Ref g_color_range, g_tri_edges;
+UintRef g_adj_offsets, g_adj_list, g_adj_mask, g_cell_count, g_cell_start, g_cell_particles, g_particle_cell, g_torn,
+    g_scratch, g_cell_scatter, g_candidates;
+Uvec4Ref g_triangles, g_compact_tmp, g_cell_pos;
+CountersRef g_counters;
+
+// The sheet workgroup `group` ticks, and the address of its slice of binding `binding`.
+uint batchSheet(uint group) {
+  return QueueRef(uint64_t(packUint2x32(BatchTableRef(packUint2x32(batch_table)).entry[SIM_BATCH_QUEUE].xy)))
+      .sheet[group];
+}
+uint64_t batchSlice(uint binding, uint sheet) {
+  uvec4 e = BatchTableRef(packUint2x32(batch_table)).entry[binding];
+  return packUint2x32(e.xy) + uint64_t(sheet) * packUint2x32(e.zw);
+}
+// Points every array at the slices of `sheet`.
+void bindSheet(uint sheet) {
+  g_u = UniformsRef(batchSlice(SIM_BIND_UNIFORMS, sheet));
+  g_pos = Vec4Ref(batchSlice(SIM_BIND_POS, sheet));
+  g_prev = Vec4Ref(batchSlice(SIM_BIND_PREV, sheet));
+  g_rest_pos = Vec4Ref(batchSlice(SIM_BIND_REST, sheet));
+  g_uv = Vec2Ref(batchSlice(SIM_BIND_UV, sheet));
+  g_delta = Vec4Ref(batchSlice(SIM_BIND_DELTA, sheet));
+  g_reset_from = Vec4Ref(batchSlice(SIM_BIND_RESET_FROM, sheet));
+  g_candidate_base = Vec4Ref(batchSlice(SIM_BIND_CANDIDATE_BASE, sheet));
+  g_constraints = ConstraintRef(batchSlice(SIM_BIND_CONSTRAINTS, sheet));
+  g_color_range = Uvec2Ref(batchSlice(SIM_BIND_COLOR_RANGES, sheet));
+  g_tri_edges = Uvec2Ref(batchSlice(SIM_BIND_TRI_EDGES, sheet));
+  g_adj_offsets = UintRef(batchSlice(SIM_BIND_ADJ_OFFSETS, sheet));
+  g_adj_list = UintRef(batchSlice(SIM_BIND_ADJ_LIST, sheet));
+  g_adj_mask = UintRef(batchSlice(SIM_BIND_ADJ_MASK, sheet));
+  g_cell_count = UintRef(batchSlice(SIM_BIND_CELL_COUNT, sheet));
+  g_cell_start = UintRef(batchSlice(SIM_BIND_CELL_START, sheet));
+  g_cell_particles = UintRef(batchSlice(SIM_BIND_CELL_PARTICLES, sheet));
+  g_particle_cell = UintRef(batchSlice(SIM_BIND_PARTICLE_CELL, sheet));
+  g_torn = UintRef(batchSlice(SIM_BIND_TORN, sheet));
+  g_scratch = UintRef(batchSlice(SIM_BIND_SCRATCH, sheet));
+  g_cell_scatter = UintRef(batchSlice(SIM_BIND_CELL_SCATTER, sheet));
+  g_candidates = UintRef(batchSlice(SIM_BIND_CANDIDATES, sheet));
+  g_triangles = Uvec4Ref(batchSlice(SIM_BIND_TRIANGLES, sheet));
+  g_compact_tmp = Uvec4Ref(batchSlice(SIM_BIND_COMPACT_TMP, sheet));
+  g_cell_pos = Uvec4Ref(batchSlice(SIM_BIND_CELL_POS, sheet));
+  g_counters = CountersRef(batchSlice(SIM_BIND_COUNTERS, sheet));
+}
+#define u g_u.v
+#define pos g_pos.v
+#define prev g_prev.v
+#define rest_pos g_rest_pos.v
+#define uv g_uv.v
+#define delta g_delta.v
+#define reset_from g_reset_from.v
+#define candidate_base g_candidate_base.v
+#define constraints g_constraints.v
+#define color_range g_color_range.v
+#define tri_edges g_tri_edges.v
+#define adj_offsets g_adj_offsets.v
+#define adj_list g_adj_list.v
+#define adj_mask g_adj_mask.v
+#define cell_count g_cell_count.v
+#define cell_start g_cell_start.v
+#define cell_particles g_cell_particles.v
+#define particle_cell g_particle_cell.v
+#define torn g_torn.v
+#define scratch g_scratch.v
+#define cell_scatter g_cell_scatter.v
+#define candidates g_candidates.v
+#define triangles g_triangles.v
+#define compact_tmp g_compact_tmp.v
+#define cell_pos g_cell_pos.v
+#define counters g_counters.v
+#else
 layout(std140, set = 0, binding = SIM_BIND_UNIFORMS) uniform UniformsBlock { SimUniforms u; };
 layout(std430, set = 0, binding = SIM_BIND_POS) SIM_COHERENT buffer PosBuffer { vec4 pos[]; };
 layout(std430, set = 0, binding = SIM_BIND_PREV) SIM_COHERENT buffer PrevBuffer { vec4 prev[]; };
@@ -68,6 +164,8 @@ layout(std430, set = 0, binding = SIM_BIND_CANDIDATE_BASE) SIM_COHERENT buffer C
 };
 // Indirect arguments of the separate hash passes: SIM_HASH_DISPATCHES live, then as many full
 layout(std430, set = 0, binding = SIM_BIND_HASH_ARGS) SIM_COHERENT buffer HashArgsBuffer { uvec4 hash_args[]; };
+
+#endif
 
 // Linear index of this invocation; grids wider than SIM_MAX_GROUPS_X spill into Y.
 uint threadIndex() {

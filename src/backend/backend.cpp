@@ -2,8 +2,10 @@
 
 #include <exception>
 
+#include "cpu/cpu_batch.h"
 #include "cpu/cpu_solver.h"
 #ifdef TENDER_HAS_GPU
+#include "gpu/gpu_fleet.h"
 #include "gpu/gpu_solver.h"
 #endif
 
@@ -60,6 +62,48 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
     out.solver = std::move(solver);
   } catch (const std::exception& e) {
     out = Backend{};
+    return e.what();
+  }
+  return std::nullopt;
+#else
+  return std::string("this build has no Vulkan backend (try --backend cpu)");
+#endif
+}
+
+std::optional<std::string> fleetFits(const std::string& backend, const SimParams& params) {
+  if (backend == "cpu") return std::nullopt;
+#ifdef TENDER_HAS_GPU
+  return gpu::GpuFleet::fits(params);
+#else
+  return std::string("this build has no Vulkan backend (try --backend cpu)");
+#endif
+}
+
+std::optional<std::string> createBatch(const BackendOptions& o, uint32_t sheets, std::unique_ptr<SheetBatch>& out) {
+  out.reset();
+  if (sheets == 0) return std::string("a batch needs at least one sheet");
+  if (o.backend == "cpu") {
+    CpuOptions co;
+    co.simd = o.simd;
+    co.flush_denormals = o.flush_denormals;
+    out = std::make_unique<CpuBatch>(sheets, o.threads, co);
+    return std::nullopt;
+  }
+  if (o.backend != "gpu") return "a fleet runs on cpu or gpu, not '" + o.backend + "'";
+#ifdef TENDER_HAS_GPU
+  try {
+    if (o.context) {
+      out = std::make_unique<gpu::GpuFleet>(*o.context, sheets);
+    } else {
+      gpu::ContextOptions co;
+      co.device = o.device;
+      co.validation = o.validation;
+      auto ctx = gpu::VulkanContext::create(co);
+      if (!ctx) return ctx.error() + " (try --backend cpu)";
+      out = std::make_unique<gpu::GpuFleet>(std::move(ctx.value()), sheets);
+    }
+  } catch (const std::exception& e) {
+    out.reset();
     return e.what();
   }
   return std::nullopt;

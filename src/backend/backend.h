@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/fleet.h"
 #include "core/params.h"
 #include "core/passes.h"
 #include "core/solver.h"
@@ -54,5 +55,14 @@ bool vulkanBuilt();
 /// Builds a backend; on failure returns one line (an unknown name, no Vulkan device, a Vulkan
 /// error) and leaves `out` empty.
 std::optional<std::string> createBackend(const BackendOptions& options, Backend& out);
+
+/// Builds the batch of a fleet of `sheets` sheets ("cpu" or "gpu"; `threads` and `simd` for the
+/// CPU's workers and kernels); on failure returns one line and leaves `out` empty. A GPU batch
+/// runs sheets of at most SIM_FUSED_MAX_PARTICLES particles (fleetFits).
+std::optional<std::string> createBatch(const BackendOptions& options, uint32_t sheets,
+                                       std::unique_ptr<SheetBatch>& out);
+/// Why sheets of these parameters cannot run as one batch on this backend ("gpu": only sheets the
+/// fused tick takes); nullopt when they can (a sweep runs such sheets one at a time instead).
+std::optional<std::string> fleetFits(const std::string& backend, const SimParams& params);
 
 } // namespace tender

@@ -59,6 +59,10 @@ public:
   uint32_t grabbed() const { return grab_index_; }
   glm::vec3 grabTarget() const { return grab_to_; }
 
+  /// Applies the script's events due before the next step (tick() and advance() do this first;
+  /// a fleet does it for every sheet before it ticks them, so a grab's read-back comes before the
+  /// batch runs).
+  void applyDueEvents();
   /// One frame of headless time: the script's events for this tick, then one physics tick (or one
   /// reset frame, or nothing when paused). Returns true when the solver ran physics.
   bool tick();
@@ -83,7 +87,6 @@ private:
   void grabAt(uint32_t i, glm::vec3 position);
   void runPhysicsTick();
   void runResetFrame();
-  void applyDueEvents();
 
   SimParams params_;
   Solver& solver_;

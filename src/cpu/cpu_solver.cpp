@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 
+#include "core/host_queries.h"
 #include "denormal_mode.h"
 #include "simd_kernels.h"
 #include "worker_pool.h"
@@ -83,8 +84,8 @@ void CpuSolver::integrate(const SimUniforms& u, uint32_t s) {
     for (uint32_t i = begin; i < end; ++i) {
       const VerletState st = integrateParticle(pos[i], prev[i], rest[i], uv[i].x, i == u.grab_index, target, grab_prev,
                                                u.flags, u.gravity, wind, twist, u.damping, dt2);
-      pos[i] = st.pos;
-      prev[i] = st.prev;
+      pos[i] = st.position;
+      prev[i] = st.previous;
     }
   });
 }
@@ -129,8 +130,8 @@ void CpuSolver::floorPass(const SimUniforms& u) {
     for (uint32_t i = begin; i < end; ++i) {
       const vec3 d = collide ? collision_.delta(i) : vec3(0.0f);
       const VerletState st = floorParticle(pos[i], prev[i], d, u.flags, u.floor_y, u.restitution, u.friction);
-      pos[i] = st.pos;
-      prev[i] = st.prev;
+      pos[i] = st.position;
+      prev[i] = st.previous;
     }
   });
 }
@@ -302,33 +303,12 @@ void CpuSolver::beginReset() {
 
 void CpuSolver::computeNormals() {
   const DenormalMode mode(options_.flush_denormals);
-  const uint32_t W = topo_->cols, H = topo_->rows;
-  for (uint32_t j = 0; j < H; ++j)
-    for (uint32_t i = 0; i < W; ++i) {
-      const uint32_t l = j * W + (i > 0 ? i - 1 : i), r = j * W + (i + 1 < W ? i + 1 : i);
-      const uint32_t up = (j > 0 ? j - 1 : j) * W + i, dn = (j + 1 < H ? j + 1 : j) * W + i;
-      normal_[j * W + i] = vec4(gridNormal(vec3(pos_[l]), vec3(pos_[r]), vec3(pos_[up]), vec3(pos_[dn])), 0.0f);
-    }
+  gridNormals(pos_, topo_->cols, topo_->rows, normal_);
 }
 
 PickResult CpuSolver::pick(glm::vec3 o, glm::vec3 d, float radius) {
   const DenormalMode mode(options_.flush_denormals);
-  PickResult best{};
-  best.index = SIM_NONE;
-  float best_d2 = radius * radius;
-  for (uint32_t i = 0; i < pos_.size(); ++i) {
-    vec2 r = rayPointDistance2(o, d, vec3(pos_[i]));
-    if (r.x <= best_d2 && (best.index == SIM_NONE || r.x < best_d2)) {
-      best.index = i;
-      best.t = r.y;
-      best_d2 = r.x;
-    }
-  }
-  if (best.index != SIM_NONE) {
-    best.d2 = floatBitsToUint(best_d2);
-    best.pos = pos_[best.index];
-  }
-  return best;
+  return pickNearest(pos_, o, d, radius);
 }
 
 void CpuSolver::readDeltas(std::vector<glm::vec4>& out) {

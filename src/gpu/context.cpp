@@ -333,12 +333,16 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   en12.hostQueryReset = f12.hostQueryReset;
   en12.timelineSemaphore = f12.timelineSemaphore;
   en12.scalarBlockLayout = f12.scalarBlockLayout;
+  // A fleet's batched tick reaches its sheets' slices by device address (64-bit arithmetic)
+  en12.bufferDeviceAddress = f12.bufferDeviceAddress;
   VkPhysicalDeviceFeatures2 en2{};
   en2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
   en2.pNext = &en12;
   en2.features.samplerAnisotropy = f2.features.samplerAnisotropy;
   en2.features.fillModeNonSolid = f2.features.fillModeNonSolid;
   en2.features.depthClamp = f2.features.depthClamp;
+  en2.features.shaderInt64 = f2.features.shaderInt64;
+  ctx->device_addresses_ = f12.bufferDeviceAddress && f2.features.shaderInt64;
 
   float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{};
@@ -411,6 +415,10 @@ Buffer VulkanContext::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, 
   mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
   mai.allocationSize = req.size;
   mai.memoryTypeIndex = type;
+  VkMemoryAllocateFlagsInfo flags_info{};
+  flags_info.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO;
+  flags_info.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+  if (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) mai.pNext = &flags_info;
   VK_CHECK(vkAllocateMemory(device_, &mai, nullptr, &b.memory));
   VK_CHECK(vkBindBufferMemory(device_, b.buffer, b.memory, 0));
   if (map) VK_CHECK(vkMapMemory(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
@@ -423,6 +431,13 @@ Buffer VulkanContext::createDeviceBuffer(VkDeviceSize size, VkBufferUsageFlags u
 
 Buffer VulkanContext::createHostBuffer(VkDeviceSize size, VkBufferUsageFlags usage) {
   return createBuffer(size, usage, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, true);
+}
+
+VkDeviceAddress VulkanContext::address(const Buffer& b) const {
+  VkBufferDeviceAddressInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO;
+  info.buffer = b.buffer;
+  return vkGetBufferDeviceAddress(device_, &info);
 }
 
 void VulkanContext::destroyBuffer(Buffer& b) {

@@ -152,6 +152,11 @@ public:
   Buffer createDeviceBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
   /// Creates a persistently mapped host-visible, host-coherent buffer.
   Buffer createHostBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
+  /// True when buffers can be reached by device address (bufferDeviceAddress and shaderInt64: a
+  /// fleet's batched tick needs both).
+  bool deviceAddresses() const { return device_addresses_; }
+  /// The device address of a buffer created with VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT.
+  VkDeviceAddress address(const Buffer& b) const;
   /// Destroys a buffer and frees its memory (no-op on an empty one).
   void destroyBuffer(Buffer& b);
   /// Copies bytes out of a device buffer through a staging buffer (waits for completion).
@@ -186,6 +191,7 @@ private:
   double timestamp_period_ = 1.0;
   uint32_t timestamp_bits_ = 0;
   bool validation_ = false, quiet_ = false;
+  bool device_addresses_ = false;
   std::atomic<uint32_t> validation_messages_{0};
 };
 

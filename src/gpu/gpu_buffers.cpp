@@ -9,6 +9,7 @@
 
 #include "gpu/barriers.h"
 #include "gpu/gpu_solver.h"
+#include "gpu/sheet_buffers.h"
 
 namespace tender::gpu {
 
@@ -21,100 +22,7 @@ constexpr VkBufferUsageFlags kStorageUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT 
                                              VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
                                              VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
 
-/// The adjacency of each particle as a mask over its 5 x 5 grid stencil (SIM_BIND_ADJ_MASK), so
-/// that the collision gather tests a neighbour with a bit instead of a search.
-std::vector<uint32_t> adjacencyMasks(const SheetTopology& topo) {
-  constexpr int kReach = SIM_ADJ_STENCIL;
-  std::vector<uint32_t> masks(topo.particleCount(), 0u);
-  for (uint32_t i = 0; i < masks.size(); ++i)
-    for (uint32_t k = topo.adj_offsets[i]; k < topo.adj_offsets[i + 1]; ++k) {
-      const uint32_t j = topo.adj_list[k];
-      const int dx = int(j % topo.cols) - int(i % topo.cols), dy = int(j / topo.cols) - int(i / topo.cols);
-      if (std::abs(dx) <= kReach && std::abs(dy) <= kReach)
-        masks[i] |= 1u << uint32_t((dy + kReach) * (2 * kReach + 1) + dx + kReach);
-      else
-        masks[i] |= SIM_ADJ_FAR;
-    }
-  return masks;
-}
-
-template <class T>
-VkDeviceSize bytesOf(const std::vector<T>& v) {
-  return VkDeviceSize(v.size()) * sizeof(T);
-}
-
 } // namespace
-
-uint32_t GpuSolver::scanSumsSize(uint32_t count) {
-  uint32_t groups = (count + SIM_SCAN_BLOCK - 1) / SIM_SCAN_BLOCK;
-  return groups + (groups > 1 ? scanSumsSize(groups) : 0);
-}
-
-std::vector<GpuSolver::BindingSpec> GpuSolver::bindingTable(StartData& d, bool particle_data) const {
-  const SheetTopology& topo = topo_;
-  const uint32_t n = topo.particleCount(), m = topo.constraintCount(), t = topo.triangleCount();
-  const uint32_t cells = topo.hash_size;
-  // The fused tick's scans meet their per-invocation totals in the SIM_WG_FUSED slots after the
-  // compaction slots (the separate passes' block sums, unused on that path).
-  const uint32_t scratch = std::max(hash_sums_ + scanSumsSize(cells), tear_slots_ + SIM_WG_FUSED);
-  const VkDeviceSize list_bytes = candidates_fit_ ? 4ull * SIM_CANDIDATE_STRIDE * n : 16,
-                     list_base = candidates_fit_ ? 16ull * n : 16;
-
-  // Start contents derived from the topology; the per-particle ones only for an upload.
-  if (particle_data) {
-    d.pos.resize(n);
-    for (uint32_t i = 0; i < n; ++i) d.pos[i] = startPosition(topo.rest_pos[i]);
-    d.normal.assign(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
-    d.adj_mask = adjacencyMasks(topo);
-  }
-  d.last_start = n; // cell_start[T] = N, always
-  d.colors.clear();
-  for (const ColorRange& c : topo.colors) d.colors.emplace_back(c.first, c.count);
-  d.counters = Counters{};
-  d.counters.triangle_count = t;
-  d.counters.compact_dispatch = uvec4(0u, 1u, 1u, 0u);
-  d.counters.draw_args = uvec4(3u * t, 1u, 0u, 0u);
-
-  enum : uint8_t { kPlain = 0, kRestored = 1, kReadBack = 2 };
-  auto spec = [](uint32_t binding, VkDeviceSize bytes, const void* data = nullptr, VkDeviceSize data_bytes = 0,
-                 uint8_t flags = kPlain, VkDeviceSize offset = 0) {
-    return BindingSpec{binding, bytes, data, data_bytes, offset, (flags & kRestored) != 0, (flags & kReadBack) != 0};
-  };
-  return {
-      // Particles
-      spec(SIM_BIND_POS, 16ull * n, d.pos.data(), bytesOf(d.pos), kReadBack),
-      spec(SIM_BIND_PREV, 16ull * n, d.pos.data(), bytesOf(d.pos), kReadBack),
-      spec(SIM_BIND_REST, 16ull * n, topo.rest_pos.data(), bytesOf(topo.rest_pos)),
-      spec(SIM_BIND_UV, 8ull * n, topo.uv.data(), bytesOf(topo.uv)),
-      spec(SIM_BIND_NORMAL, 16ull * n, d.normal.data(), bytesOf(d.normal), kReadBack),
-      spec(SIM_BIND_RESET_FROM, 16ull * n, d.pos.data(), bytesOf(d.pos)),
-      spec(SIM_BIND_DELTA, 16ull * n),
-      // Constraints and what tearing changes (a reset restores them)
-      spec(SIM_BIND_CONSTRAINTS, 16ull * m, topo.constraints.data(), bytesOf(topo.constraints), kRestored | kReadBack),
-      spec(SIM_BIND_COLOR_RANGES, 8ull * topo.colorCount(), d.colors.data(), bytesOf(d.colors), kRestored | kReadBack),
-      spec(SIM_BIND_TORN, 4ull * m, nullptr, 0, kRestored | kReadBack),
-      spec(SIM_BIND_TRIANGLES, 16ull * t, topo.triangles.data(), bytesOf(topo.triangles), kRestored | kReadBack),
-      spec(SIM_BIND_COUNTERS, sizeof(Counters), &d.counters, sizeof(Counters), kRestored | kReadBack),
-      spec(SIM_BIND_TRI_EDGES, 8ull * t, topo.tri_edges.data(), bytesOf(topo.tri_edges)),
-      spec(SIM_BIND_COMPACT_TMP, 16ull * (m + t)),
-      spec(SIM_BIND_SCRATCH, 4ull * scratch),
-      // Collision: adjacency, the spatial hash, the candidate lists
-      spec(SIM_BIND_ADJ_OFFSETS, 4ull * topo.adj_offsets.size(), topo.adj_offsets.data(), bytesOf(topo.adj_offsets)),
-      spec(SIM_BIND_ADJ_LIST, 4ull * topo.adj_list.size(), topo.adj_list.data(), bytesOf(topo.adj_list)),
-      spec(SIM_BIND_ADJ_MASK, 4ull * n, d.adj_mask.data(), bytesOf(d.adj_mask)),
-      spec(SIM_BIND_CELL_COUNT, 4ull * cells),
-      spec(SIM_BIND_CELL_START, 4ull * (cells + 1), &d.last_start, 4, kPlain, 4ull * cells),
-      spec(SIM_BIND_CELL_PARTICLES, 4ull * n),
-      spec(SIM_BIND_PARTICLE_CELL, 4ull * n),
-      spec(SIM_BIND_CELL_SCATTER, 4ull * n),
-      spec(SIM_BIND_CELL_POS, 16ull * n),
-      spec(SIM_BIND_CANDIDATES, list_bytes),
-      spec(SIM_BIND_CANDIDATE_BASE, list_base),
-      spec(SIM_BIND_HASH_ARGS, 16ull * 2 * SIM_HASH_DISPATCHES),
-      // Interaction
-      spec(SIM_BIND_PICK, sizeof(PickResult)),
-  };
-}
 
 void GpuSolver::destroySheet() {
   VkDevice dev = ctx_.device();
@@ -144,12 +52,8 @@ void GpuSolver::upload(const SheetTopology& topo) {
   spacing_ = std::numeric_limits<float>::max();
   for (const Constraint& k : topo.constraints)
     if ((k.kind_id & SIM_KIND_MASK) == SIM_KIND_STRUCTURAL) spacing_ = std::min(spacing_, k.rest);
-  tear_slots_ = topo.constraintCount() + topo.triangleCount() + 1;
-  tear_sums_ = tear_slots_;
-  hash_sums_ = tear_sums_ + scanSumsSize(tear_slots_);
   const VkDeviceSize max_range = ctx_.properties().limits.maxStorageBufferRange;
-  // Collision candidate lists, when the largest binding holds them
-  candidates_fit_ = 4ull * SIM_CANDIDATE_STRIDE * topo.particleCount() <= max_range;
+  layout_sizes_ = SheetLayout::of(topo, max_range);
   hash_grids_.clear();
   hash_grids_uploaded_.clear();
 
@@ -158,7 +62,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
   uniform_stride_ = (sizeof(SimUniforms) + align - 1) / align * align;
   buf_[SIM_BIND_UNIFORMS] = ctx_.createHostBuffer(uniform_stride_ * (kSlots + 1), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   StartData start;
-  const std::vector<BindingSpec> table = bindingTable(start, true);
+  const std::vector<BindingSpec> table = sheetBindings(topo_, layout_sizes_, start, true);
   // A sheet whose arrays exceed what the device binds is refused with one line, before allocating.
   for (const BindingSpec& b : table)
     if (b.bytes > max_range)
@@ -238,7 +142,7 @@ void GpuSolver::stageBindings(VkCommandBuffer cmd, const std::vector<BindingSpec
 void GpuSolver::beginReset() {
   finish();
   StartData start;
-  const std::vector<BindingSpec> table = bindingTable(start, false);
+  const std::vector<BindingSpec> table = sheetBindings(topo_, layout_sizes_, start, false);
   std::vector<Buffer> staging;
   ctx_.submitOnce([&](VkCommandBuffer cmd) {
     // The reset animates from where the sheet is now; what tearing changed is restored.
@@ -252,7 +156,7 @@ void GpuSolver::beginReset() {
 void GpuSolver::readback(SimState& out) {
   finish();
   StartData start;
-  const std::vector<BindingSpec> table = bindingTable(start, false);
+  const std::vector<BindingSpec> table = sheetBindings(topo_, layout_sizes_, start, false);
   // Every read-back binding into one staging buffer, one after the other.
   std::array<VkDeviceSize, kBindingCount> offset{};
   VkDeviceSize total = 0;
@@ -269,27 +173,9 @@ void GpuSolver::readback(SimState& out) {
         vkCmdCopyBuffer(cmd, buf_[b.binding].buffer, staging.buffer, 1, &region);
       }
   });
-  auto take = [&]<class T>(uint32_t binding, std::vector<T>& v, size_t count) {
-    v.resize(count);
-    if (count) std::memcpy(v.data(), static_cast<const char*>(staging.mapped) + offset[binding], count * sizeof(T));
-  };
-  const uint32_t n = topo_.particleCount(), m = topo_.constraintCount();
-  take(SIM_BIND_POS, out.pos, n);
-  take(SIM_BIND_PREV, out.prev, n);
-  take(SIM_BIND_NORMAL, out.normal, n);
-  take(SIM_BIND_CONSTRAINTS, out.constraints, m);
-  take(SIM_BIND_TORN, out.torn, m);
-  std::vector<glm::uvec2> colors;
-  take(SIM_BIND_COLOR_RANGES, colors, topo_.colorCount());
-  std::vector<glm::uvec4> triangles;
-  take(SIM_BIND_TRIANGLES, triangles, topo_.triangleCount());
-  Counters counters{};
-  std::memcpy(&counters, static_cast<const char*>(staging.mapped) + offset[SIM_BIND_COUNTERS], sizeof(counters));
+  assembleState(
+      topo_, [&](uint32_t binding) { return static_cast<const char*>(staging.mapped) + offset[binding]; }, out);
   ctx_.destroyBuffer(staging);
-  out.colors.resize(colors.size());
-  for (size_t c = 0; c < colors.size(); ++c) out.colors[c] = {colors[c].x, colors[c].y};
-  out.triangle_count = std::min<uint32_t>(counters.triangle_count, topo_.triangleCount());
-  out.triangles.assign(triangles.begin(), triangles.begin() + out.triangle_count);
 }
 
 void GpuSolver::readDeltas(std::vector<glm::vec4>& out) {

@@ -107,7 +107,7 @@ bool GpuSolver::recordSubstep(Slot& slot, const RecordKey& key, uint32_t s, uint
     hash_slot_ = 0;
     dispatch(cmd, pipes_.hash_count, Grid::Hash, n, all);
     computeToCompute(cmd);
-    recordScan(cmd, SIM_SCAN_HASH, 0, topo_.hash_size, hash_sums_, Grid::Hash);
+    recordScan(cmd, SIM_SCAN_HASH, 0, topo_.hash_size, layout_sizes_.hash_sums, Grid::Hash);
     dispatch(cmd, pipes_.hash_scatter, Grid::Hash, n, all);
     computeToCompute(cmd);
     dispatch(cmd, pipes_.hash_sort, Grid::Hash, n, all);
@@ -134,7 +134,7 @@ bool GpuSolver::recordSubstep(Slot& slot, const RecordKey& key, uint32_t s, uint
     computeToCompute(cmd);
     dispatch(cmd, pipes_.tear_flags, Grid::Compaction, 0, nullptr, 0);
     computeToCompute(cmd);
-    recordScan(cmd, SIM_SCAN_SCRATCH, 0, tear_slots_, tear_sums_, Grid::Compaction);
+    recordScan(cmd, SIM_SCAN_SCRATCH, 0, layout_sizes_.tear_slots, layout_sizes_.tear_sums, Grid::Compaction);
     dispatch(cmd, pipes_.tear_compact, Grid::Compaction, 0, nullptr, 0);
     computeToCompute(cmd);
   }

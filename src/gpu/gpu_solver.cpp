@@ -313,14 +313,7 @@ PassTimes GpuSolver::passTimes() const {
   return t;
 }
 
-Arithmetic GpuSolver::arithmetic() const {
-  Arithmetic a;
-  a.rounding = float_rules_.rounding_rte ? "nearest even" : "device default";
-  a.denormals = denormalsName(float_rules_.denormals);
-  a.inexact_math_emulated = math_.inexact;
-  a.corrected = math_.corrected;
-  return a;
-}
+Arithmetic GpuSolver::arithmetic() const { return arithmeticOf(float_rules_, math_); }
 
 bool GpuSolver::usesFusedPath() const {
   return fused_allowed_ && pipes_.tick_fused.pipeline && topo_.particleCount() <= SIM_FUSED_MAX_PARTICLES &&

@@ -11,6 +11,7 @@
 
 #include "core/solver.h"
 #include "gpu/context.h"
+#include "gpu/sheet_buffers.h"
 #include "gpu/sim_pipeline.h"
 
 namespace tender::gpu {
@@ -101,7 +102,7 @@ public:
   /// their buffer fits the device (one SIM_CANDIDATE_STRIDE record per particle).
   void setCandidateLists(bool keep) { candidates_allowed_ = keep; }
   /// True when ticks keep collision candidate lists.
-  bool usesCandidateLists() const { return candidates_allowed_ && candidates_fit_; }
+  bool usesCandidateLists() const { return candidates_allowed_ && layout_sizes_.candidates_fit; }
   /// True when a tick with these uniforms runs the fused tick: the sheet is small enough and, with
   /// collision on, the hash cell is within the shape's limit.
   bool usesFusedPath(const shaderio::SimUniforms& u) const;
@@ -139,28 +140,6 @@ private:
     uint32_t dispatches = 0;
   };
 
-  /// One storage buffer of the sheet, as the table of bindings describes it (gpu_buffers.cpp).
-  struct BindingSpec {
-    uint32_t binding = 0;
-    VkDeviceSize bytes = 0;       ///< size, from the topology
-    const void* data = nullptr;   ///< start contents (nullptr: zeros)
-    VkDeviceSize data_bytes = 0;  ///< bytes of `data`
-    VkDeviceSize data_offset = 0; ///< where in the buffer `data` goes
-    bool restored = false;        ///< a reset restores it (what tearing changes)
-    bool read_back = false;       ///< readback() copies it
-  };
-  /// Start contents derived from the topology, which the table points into.
-  struct StartData {
-    std::vector<glm::vec4> pos, normal;
-    std::vector<uint32_t> adj_mask;
-    std::vector<glm::uvec2> colors;
-    uint32_t last_start = 0;
-    shaderio::Counters counters{};
-  };
-  /// The table of bindings of the uploaded topology (every storage binding, once). Without
-  /// `particle_data` the per-particle start contents (positions, normals, adjacency masks) are left
-  /// out: what a reset restores and what readback needs are cheap to point at.
-  std::vector<BindingSpec> bindingTable(StartData& start, bool particle_data) const;
   /// Records the start contents of the table's bindings (only those a reset restores).
   void stageBindings(VkCommandBuffer cmd, const std::vector<BindingSpec>& table, bool restored_only,
                      std::vector<Buffer>& staging);
@@ -187,7 +166,6 @@ private:
   void timestamp(VkCommandBuffer cmd, Slot& slot, Category c);
   void waitSlot(Slot& slot) const;
   void collectTimes(const Slot& slot) const;
-  static uint32_t scanSumsSize(uint32_t count);
 
   std::unique_ptr<VulkanContext> owned_ctx_;
   VulkanContext& ctx_;
@@ -205,8 +183,7 @@ private:
   std::array<Buffer, kBindingCount> buf_{};
   Buffer small_readback_; ///< host-visible: pick result and particle positions
   VkDeviceSize uniform_stride_ = 0;
-  uint32_t tear_slots_ = 0;                ///< constraints + triangles + 1: the compaction's scan length
-  uint32_t tear_sums_ = 0, hash_sums_ = 0; ///< scratch offsets of the per-block sums
+  SheetLayout layout_sizes_; ///< sizes the passes and the bindings share
 
   mutable std::array<Slot, kSlots> slots_{};
   uint32_t next_slot_ = 0;
@@ -226,7 +203,6 @@ private:
   float fused_max_cell_spacings_ = -1.0f;       ///< largest hash cell of the fused tick (< 0: any)
   float spacing_ = 0.0f;                        ///< grid spacing: the shortest structural rest length
   bool candidates_allowed_ = true;              ///< setCandidateLists
-  bool candidates_fit_ = false;                 ///< the candidate-list buffer fits the device
   std::vector<glm::uvec4> hash_grids_;          ///< full grids of the hash passes, in recording order
   std::vector<glm::uvec4> hash_grids_uploaded_; ///< what SIM_BIND_HASH_ARGS holds of them
   uint32_t hash_slot_ = 0;                      ///< next live hash-pass argument while recording

@@ -142,4 +142,13 @@ void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitche
   }
 }
 
+Arithmetic arithmeticOf(const FloatRules& rules, MathSwitches math) {
+  Arithmetic a;
+  a.rounding = rules.rounding_rte ? "nearest even" : "device default";
+  a.denormals = denormalsName(rules.denormals);
+  a.inexact_math_emulated = math.inexact;
+  a.corrected = math.corrected;
+  return a;
+}
+
 } // namespace tender::gpu

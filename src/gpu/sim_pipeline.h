@@ -6,7 +6,9 @@
 #include <string_view>
 #include <vector>
 
+#include "core/solver.h"
 #include "gpu/context.h"
+#include "gpu/spirv_rules.h"
 
 namespace tender::gpu {
 
@@ -21,6 +23,9 @@ struct MathSwitches {
   bool flush = false;
   static MathSwitches fromEnvironment();
 };
+
+/// How the simulation's shaders compute under these rules and switches (Solver::arithmetic).
+Arithmetic arithmeticOf(const FloatRules& rules, MathSwitches math);
 
 /// A compute pipeline of shaders/sim/<key>.glsl on `layout`; `spec0` sets specialization constant 0
 /// where the shader has one. The module goes to `module` (destroy it with the pipeline). Throws

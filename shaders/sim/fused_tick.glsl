@@ -1,0 +1,230 @@
+// The fused tick of small sheets (tick_fused.comp: one sheet; tick_batch.comp: one sheet of a
+// fleet per workgroup, SIM_BATCH). Small sheets: substeps p.first_substep .. + p.substeps of a tick (on a GPU the whole
+// tick, on a CPU device one substep) in one dispatch of one workgroup. Positions stay in shared memory from the first
+// substep to the last; a workgroup barrier replaces each dispatch and pipeline barrier of the separate passes. Every
+// substep runs the same per-particle and per-constraint maths, in the same order, as integrate, project, hash_*,
+// collide, floor and tear_*; the hash is built in the same buffers. Each invocation owns the particles lid, lid +
+// kInvocations, ... (integration, collision and floor of a particle run on one invocation, so the collision delta stays
+// in a register). Workgroup size: at most SIM_WG_FUSED, specialised per device (sim_common.glsl declares it)
+#define SIM_LOCAL_SIZE SIM_WG_FUSED
+#define SIM_LOCAL_SIZE_SPECIALIZED
+// Invocations exchange data through buffers between barriers
+#define SIM_COHERENT coherent
+#include "sim_common.glsl"
+shared vec4 s_pos[SIM_FUSED_MAX_PARTICLES];
+#define SIM_POSITION(j) s_pos[j]
+#include "sim_elements.glsl"
+#ifndef SIM_BATCH
+layout(push_constant) uniform PushBlock { FusedPush p; };
+#endif
+
+// Invocations of the workgroup (specialised)
+const uint kInvocations = gl_WorkGroupSize.x;
+
+// Everything written before it, to shared memory and to buffers, is seen by the whole workgroup.
+void sync() {
+  memoryBarrierBuffer();
+  memoryBarrierShared();
+  barrier();
+}
+
+// Diagnosis (`tender diff`): the tick stops after pass p.stop of the tick (passesPerSubstep's
+// numbering; SIM_NONE: it runs whole). Every invocation takes the same branch, after a barrier.
+bool stopsAfter(uint pass) { return pass == p.stop; }
+
+// The positions go back to their buffer (at the end of the dispatch, or where the tick stops).
+void storePositions(uint n) {
+  for (uint i = gl_LocalInvocationID.x; i < n; i += kInvocations) pos[i] = s_pos[i];
+}
+
+// Exclusive scan by the whole workgroup of cell_count into cell_start (SIM_SCAN_HASH) or of
+// scratch[0, count) in place (SIM_SCAN_SCRATCH). Each invocation scans a contiguous chunk after
+// adding up the totals of the chunks before its own, which meet in scratch[sums + invocation].
+void scanWorkgroup(uint mode, uint count, uint sums) {
+  uint lid = gl_LocalInvocationID.x;
+  uint chunk = (count + kInvocations - 1u) / kInvocations;
+  uint first = min(lid * chunk, count), last = min(first + chunk, count);
+  uint total = 0u;
+  for (uint k = first; k < last; ++k) total += mode == SIM_SCAN_HASH ? cell_count[k] : scratch[k];
+  scratch[sums + lid] = total;
+  sync();
+  uint run = 0u;
+  for (uint g = 0u; g < lid; ++g) run += scratch[sums + g];
+  for (uint k = first; k < last; ++k) {
+    if (mode == SIM_SCAN_HASH) {
+      cell_start[k] = run;
+      run += cell_count[k];
+    } else {
+      uint v = scratch[k];
+      scratch[k] = run;
+      run += v;
+    }
+  }
+  sync();
+}
+
+#ifdef SIM_BATCH
+// One frame of the animated reset (as reset.comp), in the first dispatch of the sheet's tick.
+void resetFrame(uint n) {
+  if (p.first_substep != 0u) return;
+  for (uint i = gl_LocalInvocationID.x; i < n; i += kInvocations) {
+    float w = inverseMass(rest_pos[i], false, u.flags);
+    vec4 q = vec4(blend3(vec3(reset_from[i]), vec3(rest_pos[i]), u.reset_alpha), w);
+    pos[i] = q;
+    prev[i] = q;
+  }
+}
+#endif
+
+void main() {
+  uint lid = gl_LocalInvocationID.x;
+#ifdef SIM_BATCH
+  bindSheet(batchSheet(groupIndex()));
+  if (u.reset_active != 0u) {
+    resetFrame(p.count);
+    return;
+  }
+#endif
+  uint n = p.count, m = u.constraint_count;
+  bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
+  bool tearing = tearingOn(u.tear_factor) && m > 0u;
+  float dt2 = u.dt * u.dt;
+  for (uint i = lid; i < n; i += kInvocations) s_pos[i] = pos[i];
+  uint end = min(p.first_substep + p.substeps, substepCount(u.substeps));
+  uint per_substep = passesPerSubstep(u.iterations, u.color_count, collision);
+  uint projects = u.iterations * u.color_count;
+  for (uint s = p.first_substep; s < end; ++s) {
+    uint first_pass = s * per_substep;
+    // 1. Verlet integration (as integrate.comp)
+    for (uint i = lid; i < n; i += kInvocations) {
+      VerletState st =
+          integrateParticle(s_pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index, u.grab_target[s],
+                            u.grab_prev[s], u.flags, u.gravity, u.wind[s], u.wind_twist[s], u.damping, dt2);
+      s_pos[i] = st.position;
+      prev[i] = st.previous;
+    }
+    sync();
+    if (stopsAfter(first_pass)) {
+      storePositions(n);
+      return;
+    }
+    // A new substep: no constraint torn in it yet (every invocation read the count of the last
+    // substep before the barrier above).
+    if (lid == 0u) counters.torn_new = 0u;
+    // 2. Gauss-Seidel over colours (as project.comp), a barrier after each colour
+    for (uint it = 0u; it < u.iterations; ++it)
+      for (uint c = 0u; c < u.color_count; ++c) {
+        uvec2 range = color_range[c];
+        for (uint t = lid; t < range.y; t += kInvocations) {
+          Constraint k = constraints[range.x + t];
+          vec4 pa = s_pos[k.a], pb = s_pos[k.b];
+          PairDelta d = solveDistance(pa, pb, k.rest, u.stiffness[k.kind_id & SIM_KIND_MASK]);
+          s_pos[k.a] = pa + vec4(d.da, 0.0f);
+          s_pos[k.b] = pb + vec4(d.db, 0.0f);
+        }
+        sync();
+        if (stopsAfter(first_pass + 1u + it * u.color_count + c)) {
+          storePositions(n);
+          return;
+        }
+      }
+    // 3. Collision (as candidates_check, hash_*, collide and candidates_finish). From the candidate lists
+    // while they hold every pair that can touch (no particle has travelled SIM_CANDIDATE_TRAVEL x skin
+    // since they were built); otherwise from the spatial hash (count, scan, scatter, order within
+    // bucket) and a search of the 27 cells around each particle, which rebuilds the lists as it
+    // goes unless they were outgrown too fast of late (SIM_CANDIDATE_MIN_AGE, SIM_CANDIDATE_WAIT).
+    uvec4 state = counters.candidate_state;
+    uint mode = SIM_COLLIDE_HASH;
+    if (collision) {
+      if (lid == 0u) counters.candidate_flags = uvec4(0u);
+      sync();
+      if (candidatesCurrentNow(state)) {
+        float skin = candidateSkinNow();
+        bool far = false;
+        for (uint i = lid; i < n; i += kInvocations)
+          far = far || travelledTooFar(vec3(s_pos[i]), vec3(candidate_base[i]), skin);
+        if (far) atomicOr(counters.candidate_flags.x, 1u);
+        sync();
+      }
+      mode = collideModeOf(state, counters.candidate_flags.x != 0u);
+      if (mode != SIM_COLLIDE_CANDIDATES) {
+        for (uint i = lid; i < n; i += kInvocations) hashCount(i, vec3(s_pos[i]));
+        sync();
+        scanWorkgroup(SIM_SCAN_HASH, u.hash_mask + 1u, compactSlots());
+        for (uint i = lid; i < n; i += kInvocations) hashScatter(i);
+        sync();
+        for (uint i = lid; i < n; i += kInvocations) hashSort(i, vec3(s_pos[i]));
+        sync();
+      } else {
+        // The lists read the positions of other particles: all of them before any moves
+        for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(candidateRepulsion(i, vec3(s_pos[i])), 0.0f);
+        sync();
+      }
+    }
+    // 4. Each particle takes its repulsion (from the lists, or gathered here from the hash's
+    // bucket-ordered copy of the positions) and meets the floor (as floor.comp). A tick that
+    // stops after the collision keeps the repulsion in delta (as collide.comp) instead.
+    uint collide_pass = first_pass + 1u + projects;
+    bool stop_collide = collision && stopsAfter(collide_pass);
+    for (uint i = lid; i < n; i += kInvocations) {
+      vec4 q = s_pos[i];
+      vec3 repel = vec3(0.0f);
+      bool fits = true;
+      if (collision) repel = mode == SIM_COLLIDE_CANDIDATES ? vec3(delta[i]) : gatherParticle(i, vec3(q), mode, fits);
+      if (!fits) atomicOr(counters.candidate_flags.y, 1u);
+      if (stop_collide) {
+        delta[i] = vec4(repel, 0.0f);
+        continue;
+      }
+      VerletState st = floorParticle(q, prev[i], repel, u.flags, u.floor_y, u.restitution, u.friction);
+      s_pos[i] = st.position;
+      prev[i] = st.previous;
+    }
+    sync();
+    uint floor_pass = collide_pass + (collision ? 1u : 0u);
+    if (stop_collide || stopsAfter(floor_pass)) {
+      storePositions(n);
+      return;
+    }
+    if (collision && lid == 0u)
+      counters.candidate_state = candidatesNextStateOf(state, mode, counters.candidate_flags.y != 0u);
+    // 5. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
+    // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
+    // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
+    // substep it tore in removed it), and kinds that cannot tear skip the position loads.
+    if (!tearing) {
+      if (stopsAfter(floor_pass + 1u)) {
+        storePositions(n);
+        return;
+      }
+      continue;
+    }
+    for (uint c = 0u; c < u.color_count; ++c) {
+      uvec2 range = color_range[c];
+      for (uint t = lid; t < range.y; t += kInvocations) {
+        Constraint k = constraints[range.x + t];
+        if ((u.tear_kinds & (1u << (k.kind_id & SIM_KIND_MASK))) != 0u) markTear(k, s_pos[k.a], s_pos[k.b]);
+      }
+    }
+    sync();
+    if (counters.torn_new != 0u) {
+      // What stood on the triangles lost goes too (as tear_unsupported), then the compaction
+      for (uint c = 0u; c < u.color_count; ++c) {
+        uvec2 range = color_range[c];
+        for (uint t = lid; t < range.y; t += kInvocations) markUnsupported(constraints[range.x + t]);
+      }
+      sync();
+      uint slots = compactSlots();
+      for (uint k = lid; k < slots; k += kInvocations) tearFlags(k);
+      sync();
+      scanWorkgroup(SIM_SCAN_SCRATCH, slots, slots);
+      for (uint k = lid; k < slots; k += kInvocations) tearCompact(k);
+      sync();
+    }
+    if (stopsAfter(floor_pass + 1u)) {
+      storePositions(n);
+      return;
+    }
+  }
+  storePositions(n);
+}

@@ -1,0 +1,328 @@
+#include "gpu_fleet.h"
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "core/host_queries.h"
+#include "gpu/barriers.h"
+
+namespace tender::gpu {
+
+using namespace shaderio;
+
+namespace {
+
+/// Slices start at this alignment (every binding's slice of every sheet).
+constexpr VkDeviceSize kSliceAlign = 256;
+constexpr VkBufferUsageFlags kSliceUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                           VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+
+VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
+
+} // namespace
+
+/// Sheet i of the fleet as a Solver: uploads, resets and read-backs of its slices. Its ticks never
+/// come here: the fleet's QueuedSolver queues them and the fleet runs them all in one dispatch.
+class GpuFleet::Sheet final : public Solver {
+public:
+  Sheet(GpuFleet& fleet, uint32_t index) : fleet_(fleet), index_(index) {}
+  std::string name() const override { return "gpu"; }
+  void upload(const SheetTopology& topo) override { fleet_.uploadSheet(index_, topo); }
+  void tick(const SimUniforms&) override { throw std::logic_error("a fleet's sheet ticks through its batch"); }
+  void beginReset() override { fleet_.resetSheet(index_); }
+  /// The normals are computed from the positions when the state is read back.
+  void computeNormals() override {}
+  PickResult pick(glm::vec3 o, glm::vec3 d, float radius) override {
+    SimState s;
+    fleet_.readSheet(index_, s);
+    return pickNearest(s.pos, o, d, radius);
+  }
+  glm::vec3 particlePosition(uint32_t index) override { return glm::vec3(fleet_.readParticle(index_, index)); }
+  void readback(SimState& out) override { fleet_.readSheet(index_, out); }
+  void finish() override { fleet_.finish(); }
+  uint32_t dispatchesPerTick() const override { return fleet_.last_dispatches_; }
+  uint64_t memoryBytes() const override { return fleet_.memoryBytes() / std::max<uint32_t>(fleet_.size(), 1); }
+  Arithmetic arithmetic() const override { return arithmeticOf(fleet_.float_rules_, fleet_.math_); }
+  void stopNextTickAfter(uint32_t last_pass) override {
+    if (last_pass != SIM_NONE) throw std::runtime_error("a fleet runs whole ticks (tender diff runs one sheet)");
+  }
+  void readDeltas(std::vector<glm::vec4>& out) override { fleet_.readSheetDeltas(index_, out); }
+
+private:
+  GpuFleet& fleet_;
+  uint32_t index_;
+};
+
+GpuFleet::GpuFleet(VulkanContext& ctx, uint32_t sheets) : ctx_(ctx) { create(sheets); }
+
+GpuFleet::GpuFleet(std::unique_ptr<VulkanContext> ctx, uint32_t sheets)
+    : owned_ctx_(std::move(ctx)), ctx_(*owned_ctx_) {
+  create(sheets);
+}
+
+std::optional<std::string> GpuFleet::fits(const SimParams& p) {
+  const SheetCounts c = sheetCounts(p);
+  if (c.particles > SIM_FUSED_MAX_PARTICLES || c.hash_buckets > SIM_FUSED_MAX_BUCKETS)
+    return "a " + std::to_string(p.cols) + "x" + std::to_string(p.rows) + " sheet is larger than a fleet's sheets (" +
+           std::to_string(SIM_FUSED_MAX_PARTICLES) + " particles at most)";
+  if (p.collision && p.cell_size > SIM_FUSED_CPU_MAX_CELL_SPACINGS * p.spacing)
+    return "a hash cell of " + std::to_string(p.cell_size / p.spacing) + " spacings is larger than a fleet's (" +
+           std::to_string(int(SIM_FUSED_CPU_MAX_CELL_SPACINGS)) + " at most)";
+  return std::nullopt;
+}
+
+void GpuFleet::create(uint32_t sheets) {
+  if (sheets == 0 || sheets > ctx_.properties().limits.maxComputeWorkGroupCount[0])
+    throw std::runtime_error("a GPU fleet runs 1 to " +
+                             std::to_string(ctx_.properties().limits.maxComputeWorkGroupCount[0]) +
+                             " sheets per batch, not " + std::to_string(sheets));
+  if (!ctx_.deviceAddresses())
+    throw std::runtime_error("Vulkan device " + ctx_.info().name +
+                             " cannot run a fleet: it lacks bufferDeviceAddress or shaderInt64 (try --backend cpu)");
+  if (ctx_.properties().limits.maxComputeSharedMemorySize < 16u * SIM_FUSED_MAX_PARTICLES)
+    throw std::runtime_error("Vulkan device " + ctx_.info().name +
+                             " cannot run a fleet: it has under 32 KiB of shared memory (try --backend cpu)");
+  VkDevice dev = ctx_.device();
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, uint32_t(sizeof(BatchPush))};
+  VkPipelineLayoutCreateInfo pli{};
+  pli.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  pli.pushConstantRangeCount = 1;
+  pli.pPushConstantRanges = &range;
+  VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &layout_));
+  // The fused tick's shape on this kind of device (see FusedShape in gpu_solver.h)
+  const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  const uint32_t workgroup = cpu_device ? SIM_WG_FUSED_CPU : SIM_WG_FUSED;
+  substeps_per_dispatch_ = cpu_device ? SIM_FUSED_SUBSTEPS_CPU : SIM_MAX_SUBSTEPS;
+  float_rules_ = floatRulesFor(ctx_.floatControls());
+  math_ = MathSwitches::fromEnvironment();
+  pipeline_ = createSimPipeline(ctx_, "tick_batch.comp", layout_, float_rules_, math_, workgroup, module_);
+
+  VkFenceCreateInfo fci{};
+  fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  VK_CHECK(vkCreateFence(dev, &fci, nullptr, &fence_));
+  VkCommandBufferAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  ai.commandPool = ctx_.commandPool();
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VK_CHECK(vkAllocateCommandBuffers(dev, &ai, &cmd_));
+
+  sheets_.reserve(sheets);
+  queued_.reserve(sheets);
+  for (uint32_t i = 0; i < sheets; ++i) {
+    sheets_.push_back(std::make_unique<Sheet>(*this, i));
+    queued_.push_back(std::make_unique<QueuedSolver>(*this, *sheets_.back()));
+  }
+}
+
+GpuFleet::~GpuFleet() {
+  VkDevice dev = ctx_.device();
+  vkDeviceWaitIdle(dev);
+  for (Buffer& b : buf_) ctx_.destroyBuffer(b);
+  ctx_.destroyBuffer(table_);
+  ctx_.destroyBuffer(inputs_);
+  if (cmd_) vkFreeCommandBuffers(dev, ctx_.commandPool(), 1, &cmd_);
+  if (fence_) vkDestroyFence(dev, fence_, nullptr);
+  if (pipeline_) vkDestroyPipeline(dev, pipeline_, nullptr);
+  if (module_) vkDestroyShaderModule(dev, module_, nullptr);
+  if (layout_) vkDestroyPipelineLayout(dev, layout_, nullptr);
+}
+
+void GpuFleet::allocate(const SheetTopology& topo) {
+  topo_ = topo;
+  sizes_ = SheetLayout::of(topo, ctx_.properties().limits.maxStorageBufferRange);
+  const uint32_t sheets = size();
+  StartData start;
+  const std::vector<BindingSpec> table = sheetBindings(topo_, sizes_, start, false);
+  // A slice per sheet in each binding's buffer; the uniforms as one binding more.
+  stride_[SIM_BIND_UNIFORMS] = alignUp(sizeof(SimUniforms), kSliceAlign);
+  for (const BindingSpec& b : table) stride_[b.binding] = alignUp(std::max<VkDeviceSize>(b.bytes, 16), kSliceAlign);
+  stride_[SIM_BATCH_QUEUE] = 0;
+  std::array<glm::uvec4, SIM_BATCH_ENTRIES> entries{};
+  try {
+    for (uint32_t b = 0; b < SIM_BATCH_ENTRIES; ++b) {
+      const VkDeviceSize bytes = b == SIM_BATCH_QUEUE ? 4ull * sheets : stride_[b] * sheets;
+      if (bytes == 0) continue;
+      buf_[b] = ctx_.createDeviceBuffer(bytes, kSliceUsage);
+      const VkDeviceAddress a = ctx_.address(buf_[b]);
+      entries[b] = glm::uvec4(uint32_t(a), uint32_t(a >> 32), uint32_t(stride_[b]), uint32_t(stride_[b] >> 32));
+    }
+    table_ = ctx_.createDeviceBuffer(sizeof(entries), kSliceUsage);
+    inputs_ = ctx_.createHostBuffer(alignUp(4ull * sheets, kSliceAlign) + stride_[SIM_BIND_UNIFORMS] * sheets,
+                                    VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  } catch (const VulkanError&) {
+    for (Buffer& b : buf_) ctx_.destroyBuffer(b);
+    ctx_.destroyBuffer(table_);
+    throw std::runtime_error("a batch of " + std::to_string(sheets) + " " + std::to_string(topo.cols) + "x" +
+                             std::to_string(topo.rows) + " sheets does not fit the memory of Vulkan device " +
+                             ctx_.info().name + " (try a smaller --batch)");
+  }
+  ctx_.submitOnce([&](VkCommandBuffer cmd) { vkCmdUpdateBuffer(cmd, table_.buffer, 0, sizeof(entries), &entries); });
+  allocated_ = true;
+}
+
+void GpuFleet::stage(VkCommandBuffer cmd, uint32_t i, const std::vector<BindingSpec>& table, bool restored_only,
+                     Buffer& staging) {
+  // Zeros first, then the start contents over them, from one staging buffer.
+  VkDeviceSize total = 0;
+  for (const BindingSpec& b : table)
+    if ((!restored_only || b.restored) && b.data && b.data_bytes) total += alignUp(b.data_bytes, 16);
+  staging = ctx_.createHostBuffer(std::max<VkDeviceSize>(total, 16), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  for (const BindingSpec& b : table)
+    if (!restored_only || b.restored)
+      vkCmdFillBuffer(cmd, buf_[b.binding].buffer, sliceOffset(b.binding, i), stride_[b.binding], 0);
+  memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  VkDeviceSize at = 0;
+  for (const BindingSpec& b : table) {
+    if ((restored_only && !b.restored) || !b.data || b.data_bytes == 0) continue;
+    std::memcpy(static_cast<char*>(staging.mapped) + at, b.data, size_t(b.data_bytes));
+    VkBufferCopy region{at, sliceOffset(b.binding, i) + b.data_offset, b.data_bytes};
+    vkCmdCopyBuffer(cmd, staging.buffer, buf_[b.binding].buffer, 1, &region);
+    at += alignUp(b.data_bytes, 16);
+  }
+}
+
+void GpuFleet::uploadSheet(uint32_t i, const SheetTopology& topo) {
+  finish();
+  if (!allocated_) allocate(topo);
+  // Every sheet shares the topology: the restored bindings of a reset come from topo_.
+  if (topo.cols != topo_.cols || topo.rows != topo_.rows || topo.constraints.size() != topo_.constraints.size() ||
+      topo.triangles.size() != topo_.triangles.size() || topo.colors.size() != topo_.colors.size() ||
+      std::memcmp(topo.constraints.data(), topo_.constraints.data(), topo.constraints.size() * sizeof(Constraint)) != 0)
+    throw std::invalid_argument("the sheets of a fleet share their topology (grid, spacing and constraint families)");
+  StartData start;
+  const std::vector<BindingSpec> table = sheetBindings(topo, sizes_, start, true);
+  Buffer staging;
+  ctx_.submitOnce([&](VkCommandBuffer cmd) { stage(cmd, i, table, false, staging); });
+  ctx_.destroyBuffer(staging);
+}
+
+void GpuFleet::resetSheet(uint32_t i) {
+  finish();
+  StartData start;
+  const std::vector<BindingSpec> table = sheetBindings(topo_, sizes_, start, false);
+  Buffer staging;
+  ctx_.submitOnce([&](VkCommandBuffer cmd) {
+    // The reset animates from where the sheet is now; what tearing changed is restored.
+    VkBufferCopy region{sliceOffset(SIM_BIND_POS, i), sliceOffset(SIM_BIND_RESET_FROM, i),
+                        16ull * topo_.particleCount()};
+    if (region.size) vkCmdCopyBuffer(cmd, buf_[SIM_BIND_POS].buffer, buf_[SIM_BIND_RESET_FROM].buffer, 1, &region);
+    stage(cmd, i, table, true, staging);
+  });
+  ctx_.destroyBuffer(staging);
+}
+
+Buffer GpuFleet::download(const std::vector<std::pair<uint32_t, VkDeviceSize>>& slices, uint32_t sheet,
+                          std::vector<VkDeviceSize>& offsets) {
+  finish();
+  offsets.assign(SIM_BATCH_ENTRIES, 0);
+  VkDeviceSize total = 0;
+  for (auto [binding, bytes] : slices) {
+    offsets[binding] = total;
+    total += alignUp(bytes, 16);
+  }
+  Buffer staging = ctx_.createHostBuffer(std::max<VkDeviceSize>(total, 16), VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  ctx_.submitOnce([&](VkCommandBuffer cmd) {
+    for (auto [binding, bytes] : slices)
+      if (bytes) {
+        VkBufferCopy region{sliceOffset(binding, sheet), offsets[binding], bytes};
+        vkCmdCopyBuffer(cmd, buf_[binding].buffer, staging.buffer, 1, &region);
+      }
+  });
+  return staging;
+}
+
+void GpuFleet::readSheet(uint32_t i, SimState& out) {
+  StartData start;
+  std::vector<std::pair<uint32_t, VkDeviceSize>> slices;
+  for (const BindingSpec& b : sheetBindings(topo_, sizes_, start, false))
+    if (b.read_back) slices.emplace_back(b.binding, b.bytes);
+  std::vector<VkDeviceSize> offsets;
+  Buffer staging = download(slices, i, offsets);
+  assembleState(
+      topo_, [&](uint32_t binding) { return static_cast<const char*>(staging.mapped) + offsets[binding]; }, out);
+  ctx_.destroyBuffer(staging);
+  gridNormals(out.pos, topo_.cols, topo_.rows, out.normal);
+}
+
+glm::vec4 GpuFleet::readParticle(uint32_t i, uint32_t particle) {
+  finish();
+  glm::vec4 p;
+  ctx_.download(buf_[SIM_BIND_POS], &p, sizeof(p), sliceOffset(SIM_BIND_POS, i) + 16ull * particle);
+  return p;
+}
+
+void GpuFleet::readSheetDeltas(uint32_t i, std::vector<glm::vec4>& out) {
+  finish();
+  out.resize(topo_.particleCount());
+  ctx_.download(buf_[SIM_BIND_DELTA], out.data(), 16ull * out.size(), sliceOffset(SIM_BIND_DELTA, i));
+}
+
+void GpuFleet::finish() {
+  if (!pending_) return;
+  VK_CHECK(vkWaitForFences(ctx_.device(), 1, &fence_, VK_TRUE, UINT64_MAX));
+  pending_ = false;
+}
+
+void GpuFleet::flush() {
+  // The queued sheets, their uniforms into the host buffer (the last flush has finished reading it)
+  finish();
+  std::vector<uint32_t> queue;
+  uint32_t substeps = 0;
+  const VkDeviceSize uniforms_at = alignUp(4ull * size(), kSliceAlign);
+  char* inputs = static_cast<char*>(inputs_.mapped);
+  for (uint32_t i = 0; i < size(); ++i) {
+    auto& q = queued_[i]->queued();
+    if (!q) continue;
+    SimUniforms u = *q;
+    q.reset();
+    if (sizes_.candidates_fit) u.flags |= SIM_FLAG_CANDIDATES; // as the solver keeps them
+    std::memcpy(inputs + uniforms_at + stride_[SIM_BIND_UNIFORMS] * i, &u, sizeof(u));
+    substeps = std::max(substeps, u.reset_active ? 1u : substepCount(u.substeps));
+    queue.push_back(i);
+  }
+  last_dispatches_ = 0;
+  if (queue.empty()) return;
+  std::memcpy(inputs, queue.data(), 4 * queue.size());
+
+  VkCommandBufferBeginInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_CHECK(vkBeginCommandBuffer(cmd_, &bi));
+  // Work submitted before (uploads, resets, the last flush) is done before the copies.
+  allToAll(cmd_);
+  std::vector<VkBufferCopy> regions;
+  for (uint32_t i : queue)
+    regions.push_back(
+        {uniforms_at + stride_[SIM_BIND_UNIFORMS] * i, sliceOffset(SIM_BIND_UNIFORMS, i), sizeof(SimUniforms)});
+  vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BIND_UNIFORMS].buffer, uint32_t(regions.size()), regions.data());
+  VkBufferCopy queue_region{0, 0, 4ull * queue.size()};
+  vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_QUEUE].buffer, 1, &queue_region);
+  transferToCompute(cmd_);
+  vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+  const VkDeviceAddress table = ctx_.address(table_);
+  for (uint32_t first = 0; first < substeps; first += substeps_per_dispatch_) {
+    if (first > 0) computeToCompute(cmd_);
+    BatchPush push{};
+    push.fused = {topo_.particleCount(), first, substeps_per_dispatch_, SIM_NONE};
+    push.table = glm::uvec2(uint32_t(table), uint32_t(table >> 32));
+    vkCmdPushConstants(cmd_, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+    vkCmdDispatch(cmd_, uint32_t(queue.size()), 1, 1);
+    ++last_dispatches_;
+  }
+  allToAllAndHost(cmd_);
+  VK_CHECK(vkEndCommandBuffer(cmd_));
+  ctx_.submit(cmd_, fence_);
+  pending_ = true;
+}
+
+uint64_t GpuFleet::memoryBytes() const {
+  uint64_t total = table_.size + inputs_.size;
+  for (const Buffer& b : buf_) total += b.size;
+  return total;
+}
+
+} // namespace tender::gpu

@@ -1,0 +1,144 @@
+// The table of a sheet's storage bindings: sizes, start contents, what a reset restores and
+// what a read-back copies; and the state assembled from the read-back copies.
+#include "gpu/sheet_buffers.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+
+namespace tender::gpu {
+
+using namespace shaderio;
+
+namespace {
+
+/// The adjacency of each particle as a mask over its 5 x 5 grid stencil (SIM_BIND_ADJ_MASK), so
+/// that the collision gather tests a neighbour with a bit instead of a search.
+std::vector<uint32_t> adjacencyMasks(const SheetTopology& topo) {
+  constexpr int kReach = SIM_ADJ_STENCIL;
+  std::vector<uint32_t> masks(topo.particleCount(), 0u);
+  for (uint32_t i = 0; i < masks.size(); ++i)
+    for (uint32_t k = topo.adj_offsets[i]; k < topo.adj_offsets[i + 1]; ++k) {
+      const uint32_t j = topo.adj_list[k];
+      const int dx = int(j % topo.cols) - int(i % topo.cols), dy = int(j / topo.cols) - int(i / topo.cols);
+      if (std::abs(dx) <= kReach && std::abs(dy) <= kReach)
+        masks[i] |= 1u << uint32_t((dy + kReach) * (2 * kReach + 1) + dx + kReach);
+      else
+        masks[i] |= SIM_ADJ_FAR;
+    }
+  return masks;
+}
+
+template <class T>
+VkDeviceSize bytesOf(const std::vector<T>& v) {
+  return VkDeviceSize(v.size()) * sizeof(T);
+}
+
+} // namespace
+
+uint32_t scanSumsSize(uint32_t count) {
+  uint32_t groups = (count + SIM_SCAN_BLOCK - 1) / SIM_SCAN_BLOCK;
+  return groups + (groups > 1 ? scanSumsSize(groups) : 0);
+}
+
+SheetLayout SheetLayout::of(const SheetTopology& topo, VkDeviceSize max_range) {
+  SheetLayout l;
+  l.tear_slots = topo.constraintCount() + topo.triangleCount() + 1;
+  l.tear_sums = l.tear_slots;
+  l.hash_sums = l.tear_sums + scanSumsSize(l.tear_slots);
+  // Collision candidate lists, when the largest binding holds them
+  l.candidates_fit = 4ull * SIM_CANDIDATE_STRIDE * topo.particleCount() <= max_range;
+  return l;
+}
+
+std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLayout& layout, StartData& d,
+                                       bool particle_data) {
+  const uint32_t n = topo.particleCount(), m = topo.constraintCount(), t = topo.triangleCount();
+  const uint32_t cells = topo.hash_size;
+  // The fused tick's scans meet their per-invocation totals in the SIM_WG_FUSED slots after the
+  // compaction slots (the separate passes' block sums, unused on that path).
+  const uint32_t scratch = std::max(layout.hash_sums + scanSumsSize(cells), layout.tear_slots + SIM_WG_FUSED);
+  const VkDeviceSize list_bytes = layout.candidates_fit ? 4ull * SIM_CANDIDATE_STRIDE * n : 16,
+                     list_base = layout.candidates_fit ? 16ull * n : 16;
+
+  // Start contents derived from the topology; the per-particle ones only for an upload.
+  if (particle_data) {
+    d.pos.resize(n);
+    for (uint32_t i = 0; i < n; ++i) d.pos[i] = startPosition(topo.rest_pos[i]);
+    d.normal.assign(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
+    d.adj_mask = adjacencyMasks(topo);
+  }
+  d.last_start = n; // cell_start[T] = N, always
+  d.colors.clear();
+  for (const ColorRange& c : topo.colors) d.colors.emplace_back(c.first, c.count);
+  d.counters = Counters{};
+  d.counters.triangle_count = t;
+  d.counters.compact_dispatch = uvec4(0u, 1u, 1u, 0u);
+  d.counters.draw_args = uvec4(3u * t, 1u, 0u, 0u);
+
+  enum : uint8_t { kPlain = 0, kRestored = 1, kReadBack = 2 };
+  auto spec = [](uint32_t binding, VkDeviceSize bytes, const void* data = nullptr, VkDeviceSize data_bytes = 0,
+                 uint8_t flags = kPlain, VkDeviceSize offset = 0) {
+    return BindingSpec{binding, bytes, data, data_bytes, offset, (flags & kRestored) != 0, (flags & kReadBack) != 0};
+  };
+  return {
+      // Particles
+      spec(SIM_BIND_POS, 16ull * n, d.pos.data(), bytesOf(d.pos), kReadBack),
+      spec(SIM_BIND_PREV, 16ull * n, d.pos.data(), bytesOf(d.pos), kReadBack),
+      spec(SIM_BIND_REST, 16ull * n, topo.rest_pos.data(), bytesOf(topo.rest_pos)),
+      spec(SIM_BIND_UV, 8ull * n, topo.uv.data(), bytesOf(topo.uv)),
+      spec(SIM_BIND_NORMAL, 16ull * n, d.normal.data(), bytesOf(d.normal), kReadBack),
+      spec(SIM_BIND_RESET_FROM, 16ull * n, d.pos.data(), bytesOf(d.pos)),
+      spec(SIM_BIND_DELTA, 16ull * n),
+      // Constraints and what tearing changes (a reset restores them)
+      spec(SIM_BIND_CONSTRAINTS, 16ull * m, topo.constraints.data(), bytesOf(topo.constraints), kRestored | kReadBack),
+      spec(SIM_BIND_COLOR_RANGES, 8ull * topo.colorCount(), d.colors.data(), bytesOf(d.colors), kRestored | kReadBack),
+      spec(SIM_BIND_TORN, 4ull * m, nullptr, 0, kRestored | kReadBack),
+      spec(SIM_BIND_TRIANGLES, 16ull * t, topo.triangles.data(), bytesOf(topo.triangles), kRestored | kReadBack),
+      spec(SIM_BIND_COUNTERS, sizeof(Counters), &d.counters, sizeof(Counters), kRestored | kReadBack),
+      spec(SIM_BIND_TRI_EDGES, 8ull * t, topo.tri_edges.data(), bytesOf(topo.tri_edges)),
+      spec(SIM_BIND_COMPACT_TMP, 16ull * (m + t)),
+      spec(SIM_BIND_SCRATCH, 4ull * scratch),
+      // Collision: adjacency, the spatial hash, the candidate lists
+      spec(SIM_BIND_ADJ_OFFSETS, 4ull * topo.adj_offsets.size(), topo.adj_offsets.data(), bytesOf(topo.adj_offsets)),
+      spec(SIM_BIND_ADJ_LIST, 4ull * topo.adj_list.size(), topo.adj_list.data(), bytesOf(topo.adj_list)),
+      spec(SIM_BIND_ADJ_MASK, 4ull * n, d.adj_mask.data(), bytesOf(d.adj_mask)),
+      spec(SIM_BIND_CELL_COUNT, 4ull * cells),
+      spec(SIM_BIND_CELL_START, 4ull * (cells + 1), &d.last_start, 4, kPlain, 4ull * cells),
+      spec(SIM_BIND_CELL_PARTICLES, 4ull * n),
+      spec(SIM_BIND_PARTICLE_CELL, 4ull * n),
+      spec(SIM_BIND_CELL_SCATTER, 4ull * n),
+      spec(SIM_BIND_CELL_POS, 16ull * n),
+      spec(SIM_BIND_CANDIDATES, list_bytes),
+      spec(SIM_BIND_CANDIDATE_BASE, list_base),
+      spec(SIM_BIND_HASH_ARGS, 16ull * 2 * SIM_HASH_DISPATCHES),
+      // Interaction
+      spec(SIM_BIND_PICK, sizeof(PickResult)),
+  };
+}
+
+void assembleState(const SheetTopology& topo, const std::function<const void*(uint32_t binding)>& bytes,
+                   SimState& out) {
+  auto take = [&]<class T>(uint32_t binding, std::vector<T>& v, size_t count) {
+    v.resize(count);
+    if (count) std::memcpy(v.data(), bytes(binding), count * sizeof(T));
+  };
+  const uint32_t n = topo.particleCount(), m = topo.constraintCount();
+  take(SIM_BIND_POS, out.pos, n);
+  take(SIM_BIND_PREV, out.prev, n);
+  take(SIM_BIND_NORMAL, out.normal, n);
+  take(SIM_BIND_CONSTRAINTS, out.constraints, m);
+  take(SIM_BIND_TORN, out.torn, m);
+  std::vector<glm::uvec2> colors;
+  take(SIM_BIND_COLOR_RANGES, colors, topo.colorCount());
+  std::vector<glm::uvec4> triangles;
+  take(SIM_BIND_TRIANGLES, triangles, topo.triangleCount());
+  Counters counters{};
+  std::memcpy(&counters, bytes(SIM_BIND_COUNTERS), sizeof(counters));
+  out.colors.resize(colors.size());
+  for (size_t c = 0; c < colors.size(); ++c) out.colors[c] = {colors[c].x, colors[c].y};
+  out.triangle_count = std::min<uint32_t>(counters.triangle_count, topo.triangleCount());
+  out.triangles.assign(triangles.begin(), triangles.begin() + out.triangle_count);
+}
+
+} // namespace tender::gpu

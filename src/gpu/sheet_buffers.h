@@ -1,0 +1,57 @@
+#pragma once
+/// The storage buffers of one sheet, described by one table of bindings: the size of each from
+/// the topology, its start contents, whether a reset restores it and whether a read-back copies it.
+/// The solver (one sheet) and the fleet (a slice of each buffer per sheet) both work from it.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "core/sheet.h"
+#include "core/solver.h"
+
+namespace tender::gpu {
+
+/// Sizes derived from the topology that the passes and the table share.
+struct SheetLayout {
+  uint32_t tear_slots = 0;               ///< constraints + triangles + 1: the compaction's scan length
+  uint32_t tear_sums = 0, hash_sums = 0; ///< scratch offsets of the per-block sums
+  bool candidates_fit = false;           ///< the candidate-list buffer fits a binding of the device
+  /// The layout of a topology on a device that binds at most `max_range` bytes.
+  static SheetLayout of(const SheetTopology& topo, VkDeviceSize max_range);
+};
+
+/// One storage buffer of the sheet.
+struct BindingSpec {
+  uint32_t binding = 0;
+  VkDeviceSize bytes = 0;       ///< size, from the topology
+  const void* data = nullptr;   ///< start contents (nullptr: zeros)
+  VkDeviceSize data_bytes = 0;  ///< bytes of `data`
+  VkDeviceSize data_offset = 0; ///< where in the buffer `data` goes
+  bool restored = false;        ///< a reset restores it (what tearing changes)
+  bool read_back = false;       ///< a read-back copies it
+};
+
+/// Start contents derived from the topology, which the table points into.
+struct StartData {
+  std::vector<glm::vec4> pos, normal;
+  std::vector<uint32_t> adj_mask;
+  std::vector<glm::uvec2> colors;
+  uint32_t last_start = 0;
+  shaderio::Counters counters{};
+};
+
+/// Elements of the per-block sums of a scan of `count` elements (every level).
+uint32_t scanSumsSize(uint32_t count);
+
+/// The table of bindings of a topology (every storage binding, once). Without `particle_data`
+/// the per-particle start contents (positions, normals, adjacency masks) are left out: what a
+/// reset restores and what a read-back needs are cheap to point at.
+std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLayout& layout, StartData& start,
+                                       bool particle_data);
+
+/// The state of a sheet from its read-back bindings: `bytes(binding)` points at the copy of each.
+void assembleState(const SheetTopology& topo, const std::function<const void*(uint32_t binding)>& bytes, SimState& out);
+
+} // namespace tender::gpu

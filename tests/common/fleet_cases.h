@@ -1,0 +1,87 @@
+#pragma once
+/// The fleet cases every backend runs: a batch of sheets with mixed parameters and scripts, each
+/// compared bitwise with the same sheet run alone on that backend.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "common/sim_helpers.h"
+#include "core/fleet.h"
+
+namespace tender::test {
+
+/// Sheets of a 12 x 16 grid; sheet i takes its parameters and its script from i, so a batch of
+/// 37 holds every combination below several times: tearing yanks and sheets left hanging, a reset,
+/// a pause, a ray grab, three pin modes, both winds, and different stiffness, damping, gravity,
+/// tear factor, restitution, floor, substeps, iterations, release and collision.
+inline std::vector<FleetSheet> mixedFleet(uint32_t count) {
+  static const char* kScripts[] = {
+      "",
+      // A hard yank: tears unless the tear factor is high
+      "0 grab particle 186\n1 move 4 -4 6\n30 release\n",
+      // A grab, a reset while the sheet swings, then a pause
+      "0 grab particle 100\n2 move 1 0 1\n10 release\n15 reset\n50 pause on\n54 pause off\n",
+      // A ray grab from in front of the sheet, dragged sideways
+      "3 grab ray 0 1 5 0 0 -1\n4 move 2 1 2\n20 release\n",
+  };
+  static const char* kPins[] = {"top3", "corners", "none"};
+  std::vector<FleetSheet> sheets;
+  for (uint32_t i = 0; i < count; ++i) {
+    std::vector<std::string> sets = {
+        "cols=12",
+        "rows=16",
+        "spacing=0.16",
+        std::string("pins=") + kPins[i % 3],
+        std::string("wind_kind=") + (i % 2 ? "noise" : "sinusoid"),
+        "wind_strength=" + std::to_string(0.5 + 0.25 * (i % 5)),
+        "damping=" + std::to_string(0.97 + 0.005 * (i % 4)),
+        "gravity=" + std::to_string(8.0 + 0.5 * (i % 6)),
+        "stiffness=" + std::to_string(0.7 + 0.1 * (i % 4)),
+        "tear_factor=" + std::string(i % 7 == 3   ? "0"
+                                     : i % 5 == 2 ? "6"
+                                                  : "2.5"),
+        "restitution=" + std::to_string(0.1 * (i % 3)),
+        "floor_y=" + std::to_string(-2.0 - 0.5 * (i % 3)),
+        "substeps=" + std::to_string(6 + i % 3),
+        "iterations=" + std::to_string(3 + i % 2),
+        std::string("release=") + (i % 4 == 1 ? "drag" : "zero"),
+        std::string("collision=") + (i % 9 == 4 ? "off" : "on"),
+    };
+    FleetSheet s;
+    s.params = preset("tender", sets);
+    s.script = script(kScripts[i % 4]);
+    sheets.push_back(std::move(s));
+  }
+  return sheets;
+}
+
+/// Runs a fleet of `sheets` on `batch` for `ticks` steps and each sheet alone on `alone`, and
+/// expects every sheet's state to be bitwise the same both ways (normals aside: a fleet on the GPU
+/// computes them on the host). Returns the number of sheets that tore.
+inline uint32_t expectFleetMatchesAlone(SheetBatch& batch, Solver& alone, const std::vector<FleetSheet>& sheets,
+                                        int ticks) {
+  Fleet fleet(batch, sheets);
+  for (int t = 0; t < ticks; ++t) fleet.tick();
+  uint32_t tore = 0;
+  for (uint32_t i = 0; i < sheets.size(); ++i) {
+    SimState a, b;
+    fleet.sim(i).solver().readback(a);
+    Simulation sim(sheets[i].params, alone);
+    sim.setScript(sheets[i].script);
+    b = run(sim, ticks);
+    EXPECT_EQ(fleet.sim(i).grabCount(), sim.grabCount()) << "sheet " << i;
+    EXPECT_TRUE(sameBytes(a.pos, b.pos)) << "sheet " << i;
+    EXPECT_TRUE(sameBytes(a.prev, b.prev)) << "sheet " << i;
+    EXPECT_TRUE(sameBytes(a.constraints, b.constraints)) << "sheet " << i;
+    EXPECT_TRUE(sameBytes(a.colors, b.colors)) << "sheet " << i;
+    EXPECT_TRUE(sameBytes(a.torn, b.torn)) << "sheet " << i;
+    EXPECT_TRUE(sameBytes(a.triangles, b.triangles)) << "sheet " << i;
+    uint32_t torn = 0;
+    for (uint32_t k : a.torn) torn += k;
+    tore += torn > 0 ? 1u : 0u;
+  }
+  return tore;
+}
+
+} // namespace tender::test
