@@ -24,9 +24,11 @@
 #include <nlohmann/json.hpp>
 
 #include "backend/backend.h"
+#include "core/fleet.h"
 #include "core/output.h"
 #include "core/simulation.h"
 #include "core/stats.h"
+#include "cpu/cpu_batch.h"
 #include "cpu/cpu_solver.h"
 #include "traffic.h"
 
@@ -52,7 +54,8 @@ struct BenchOptions {
   std::string json, csv;
   uint64_t max_cpu_particles = 400000;
   double max_seconds = 30.0;
-  bool no_peak = false; ///< skip the copy-bandwidth measurement of the host and the device
+  bool no_peak = false;          ///< skip the copy-bandwidth measurement of the host and the device
+  std::vector<uint32_t> batches; ///< --batch: fleets of these many sheets per size and backend
 };
 
 /// Measured copy bandwidths that results are compared with (absent: not measured).
@@ -297,6 +300,88 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   return r;
 }
 
+/// Runs a fleet of `sheets` sheets of one size on one backend (each sheet the full physics of the
+/// preset) and returns its JSON record: ms per batched tick, sheet-ticks and particle-substeps per
+/// second, and the speed-up over single-sheet runs of the same size (`single_ms`, per tick).
+nlohmann::json runBatchCase(const BenchOptions& o, const Size& size, const std::string& backend, uint32_t sheets,
+                            double single_ms, const std::string& label, Progress& progress) {
+  nlohmann::json r;
+  r["size"] = size.text();
+  r["cols"] = size.cols;
+  r["rows"] = size.rows;
+  r["particles"] = uint64_t(size.cols) * size.rows;
+  r["backend"] = backend;
+  r["batch"] = sheets;
+  auto skip = [&](const std::string& why) {
+    r["status"] = "skipped";
+    r["reason"] = why;
+    progress.update(label + ": skipped (" + why + ")", true);
+    return r;
+  };
+  SimParams p;
+  if (auto err = benchParams(o, size, p)) return skip(*err);
+  if (auto err = validate(p, backend)) return skip(*err);
+  if (auto err = fleetFits(backend, p)) return skip(*err);
+  if (estimateSheetBytes(p, backend) * sheets > availableMemoryBytes())
+    return skip("a batch of " + std::to_string(sheets) + " sheets needs more memory than this machine has");
+  BackendOptions bo = backendOptionsFor(backend, p);
+  bo.device = o.device;
+  std::unique_ptr<SheetBatch> batch;
+  std::optional<Fleet> fleet;
+  try {
+    if (auto err = createBatch(bo, sheets, batch)) return skip(*err);
+    fleet.emplace(*batch, std::vector<FleetSheet>(sheets, FleetSheet{p, {}}));
+  } catch (const std::exception& e) { // e.g. the device cannot hold the batch
+    return skip(e.what());
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  for (uint32_t t = 0; t < o.warmup && elapsed() < o.max_seconds / 2; ++t) {
+    fleet->tick();
+    batch->finish();
+  }
+  std::vector<double> ms;
+  const auto timed_start = Clock::now();
+  for (uint32_t t = 0; t < o.ticks; ++t) {
+    const auto t0 = Clock::now();
+    fleet->tick();
+    batch->finish();
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    if (progress.live()) progress.update(label + ": tick " + std::to_string(t + 1), false);
+    if (t + 1 >= 3 && std::chrono::duration<double>(Clock::now() - timed_start).count() > o.max_seconds) break;
+  }
+  SimState state;
+  fleet->sim(0).solver().readback(state);
+  const SheetStats st = computeStats(state, p.substepDt());
+  const double median = percentile(ms, 0.5);
+  const double sheet_ticks = median > 0.0 ? 1000.0 * sheets / median : 0.0;
+  r["status"] = "ok";
+  r["ticks_measured"] = ms.size();
+  r["ms_median"] = median;
+  r["ms_p95"] = percentile(ms, 0.95);
+  r["sheet_ticks_per_s"] = sheet_ticks;
+  r["particle_substeps_per_s"] = sheet_ticks * double(p.particleCount()) * p.substeps;
+  r["dispatches_per_tick"] = batch->dispatchesPerFlush();
+  r["memory_bytes"] = batch->memoryBytes();
+  if (single_ms > 0.0) {
+    r["single_ms_median"] = single_ms;
+    r["speedup_vs_single"] = sheet_ticks / (1000.0 / single_ms);
+  }
+  if (backend == "cpu") r["threads"] = static_cast<CpuBatch&>(*batch).threads();
+  r["torn"] = st.torn;
+  r["nan_count"] = st.nan_count;
+  r["state_hash"] = hex64(st.state_hash);
+  char buf[300];
+  std::snprintf(
+      buf, sizeof(buf), "%s: %.3f ms per batched tick, %.0f sheet-ticks/s%s", label.c_str(), median, sheet_ticks,
+      single_ms > 0.0
+          ? (", " + std::to_string(sheet_ticks / (1000.0 / single_ms)).substr(0, 5) + "x single-sheet runs").c_str()
+          : "");
+  progress.update(buf, true);
+  return r;
+}
+
 std::string humanBytes(uint64_t b) {
   char buf[32];
   if (b >= (1ull << 30))
@@ -334,6 +419,26 @@ void printTable(const nlohmann::json& results) {
       }
       std::printf("\n");
     }
+  }
+}
+
+void printBatchTable(const nlohmann::json& batches) {
+  std::printf("\n%-11s %-8s %6s %14s %14s %16s %10s %11s %10s\n", "size", "backend", "batch", "ms/batch tick",
+              "sheet-ticks/s", "part-substep/s", "x single", "dispatches", "memory");
+  for (const auto& r : batches) {
+    if (r["status"] != "ok") {
+      std::printf("%-11s %-8s %6u  skipped: %s\n", r["size"].get<std::string>().c_str(),
+                  r["backend"].get<std::string>().c_str(), r["batch"].get<uint32_t>(),
+                  r["reason"].get<std::string>().c_str());
+      continue;
+    }
+    const std::string speedup = r.contains("speedup_vs_single")
+                                    ? std::to_string(r["speedup_vs_single"].get<double>()).substr(0, 5)
+                                    : std::string("-");
+    std::printf("%-11s %-8s %6u %14.3f %14.0f %16.3g %10s %11u %10s\n", r["size"].get<std::string>().c_str(),
+                r["backend"].get<std::string>().c_str(), r["batch"].get<uint32_t>(), r["ms_median"].get<double>(),
+                r["sheet_ticks_per_s"].get<double>(), r["particle_substeps_per_s"].get<double>(), speedup.c_str(),
+                r["dispatches_per_tick"].get<uint32_t>(), humanBytes(r["memory_bytes"].get<uint64_t>()).c_str());
   }
 }
 
@@ -389,6 +494,10 @@ int main(int argc, char** argv) {
   app.add_option("--max-seconds", o.max_seconds, "time budget of one case's timed ticks (at least 3 run)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
+  std::string batches;
+  app.add_option("--batch", batches,
+                 "fleets of these many sheets per size and backend (comma-separated, e.g. 1,16,256,4096): "
+                 "sheet-ticks per second against single-sheet runs");
   app.add_flag("--no-peak", o.no_peak, "skip the copy-bandwidth measurement (no percent of peak in the results)");
   try {
     app.parse(argc, argv);
@@ -405,6 +514,11 @@ int main(int argc, char** argv) {
   OutputSet outputs;
   for (const std::string& path : {o.json, o.csv})
     if (auto err = outputs.add(path)) return fail(*err);
+  for (const std::string& item : batches.empty() ? std::vector<std::string>{} : split(batches, ',')) {
+    uint64_t b = 0;
+    if (auto err = parseWhole(item, 1, 65535, b)) return fail("--batch '" + item + "': " + *err);
+    o.batches.push_back(uint32_t(b));
+  }
   uint32_t cpu_threads = 0;
   std::vector<Size> sizes;
   if (auto err = parseSizes(o.sizes, sizes)) return fail(*err);
@@ -504,18 +618,29 @@ int main(int argc, char** argv) {
   }
 #endif
 
-  const size_t total = sizes.size() * backends.size();
+  const size_t total = sizes.size() * backends.size() * (1 + o.batches.size());
   size_t index = 0;
+  out["batches"] = nlohmann::json::array();
   for (const Size& size : sizes)
     for (const std::string& backend : backends) {
-      const std::string label =
-          "[" + std::to_string(++index) + "/" + std::to_string(total) + "] " + size.text() + " " + backend;
-      nlohmann::json r = runCase(o, peaks, size, backend, label, progress);
+      auto label = [&](const std::string& what) {
+        return "[" + std::to_string(++index) + "/" + std::to_string(total) + "] " + size.text() + " " + backend + what;
+      };
+      nlohmann::json r = runCase(o, peaks, size, backend, label(""), progress);
       if (r.contains("device")) out["machine"]["gpu"] = r["device"];
+      const double single_ms = r["status"] == "ok" ? r["ms_median"].get<double>() : 0.0;
       out["results"].push_back(r);
+      // Fleets run on cpu and gpu (the fused tick); gpu-percolor has none.
+      for (uint32_t b : o.batches)
+        if (backend == "gpu-percolor")
+          ++index;
+        else
+          out["batches"].push_back(
+              runBatchCase(o, size, backend, b, single_ms, label(" batch " + std::to_string(b)), progress));
     }
 
   printTable(out["results"]);
+  if (!o.batches.empty()) printBatchTable(out["batches"]);
   if (!o.json.empty())
     if (auto err = outputs.stage(o.json, out.dump(2) + "\n")) return fail(*err);
   if (!o.csv.empty())

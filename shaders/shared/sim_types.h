@@ -82,8 +82,8 @@ struct FusedPush {
 struct BatchPush {
   FusedPush fused;
   uvec2 table; // address (low, high 32 bits) of SIM_BATCH_ENTRIES uvec4: xy sheet 0's address, zw the stride
+  uint first;  // workgroup g ticks the sheet at first + g in the queue
   uint pad0;
-  uint pad1;
 };
 
 /// GPU counters: tear bookkeeping and indirect arguments (one storage buffer).

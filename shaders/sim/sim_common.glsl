@@ -31,6 +31,7 @@ layout(local_size_x = SIM_LOCAL_SIZE) in;
 layout(push_constant) uniform PushBlock {
   FusedPush p;
   uvec2 batch_table;
+  uint batch_first;
 };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BatchTableRef { uvec4 entry[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer QueueRef { uint sheet[]; };
@@ -55,7 +56,7 @@ CountersRef g_counters;
 // The sheet workgroup `group` ticks, and the address of its slice of binding `binding`.
 uint batchSheet(uint group) {
   return QueueRef(uint64_t(packUint2x32(BatchTableRef(packUint2x32(batch_table)).entry[SIM_BATCH_QUEUE].xy)))
-      .sheet[group];
+      .sheet[batch_first + group];
 }
 uint64_t batchSlice(uint binding, uint sheet) {
   uvec4 e = BatchTableRef(packUint2x32(batch_table)).entry[binding];

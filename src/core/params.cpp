@@ -360,10 +360,7 @@ uint64_t estimateSheetBytes(const SimParams& p, const std::string& backend) {
   return topology + std::max(building, state) + solver;
 }
 
-namespace {
-
-// Host memory this process may still use: MemAvailable, or half the physical memory.
-uint64_t availableBytes() {
+uint64_t availableMemoryBytes() {
   if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
     char line[256];
     unsigned long long kb = 0;
@@ -376,14 +373,12 @@ uint64_t availableBytes() {
   return pages > 0 && page > 0 ? uint64_t(pages) * uint64_t(page) / 2 : ~uint64_t(0);
 }
 
-} // namespace
-
 std::optional<std::string> validate(const SimParams& p, const std::string& backend) {
   uint64_t n = uint64_t(p.cols) * p.rows;
   if (n == 0) return "the grid has no particles";
   if (n > (1u << 24)) return "a grid of " + std::to_string(n) + " particles is too large (at most 16777216)";
   // Refused up front, with room to spare (a tenth of the memory for everything else).
-  const uint64_t need = estimateSheetBytes(p, backend), have = availableBytes();
+  const uint64_t need = estimateSheetBytes(p, backend), have = availableMemoryBytes();
   if (need > have / 10 * 9)
     return "a " + std::to_string(p.cols) + "x" + std::to_string(p.rows) + " sheet needs about " +
            std::to_string(need >> 20) + " MiB on the " + (backend == "cpu" ? "cpu" : "gpu") + " backend; " +

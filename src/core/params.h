@@ -115,5 +115,7 @@ SheetCounts sheetCounts(const SimParams& p);
 /// Peak host bytes of a run on a backend ("cpu" or a GPU backend, whose buffers count as host
 /// memory): the topology, the solver's arrays, staging and the read-back state.
 uint64_t estimateSheetBytes(const SimParams& p, const std::string& backend);
+/// Host memory this process may still use: MemAvailable, or half the physical memory.
+uint64_t availableMemoryBytes();
 
 } // namespace tender

@@ -20,8 +20,8 @@ void CpuBatch::flush() {
   jobs_.clear();
   for (uint32_t i = 0; i < queued_.size(); ++i)
     if (queued_[i]->queued()) jobs_.push_back(i);
-  last_jobs_ = uint32_t(jobs_.size());
   if (jobs_.empty()) return;
+  last_jobs_ = uint32_t(jobs_.size());
   // Each worker takes the next sheet until none is left: a sheet's tick is whole on one thread
   // (the same arithmetic, in the same order, as the sheet run alone).
   std::atomic<uint32_t> next{0};

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "core/host_queries.h"
 #include "gpu/barriers.h"
@@ -95,6 +96,7 @@ void GpuFleet::create(uint32_t sheets) {
   const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   const uint32_t workgroup = cpu_device ? SIM_WG_FUSED_CPU : SIM_WG_FUSED;
   substeps_per_dispatch_ = cpu_device ? SIM_FUSED_SUBSTEPS_CPU : SIM_MAX_SUBSTEPS;
+  sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
   float_rules_ = floatRulesFor(ctx_.floatControls());
   math_ = MathSwitches::fromEnvironment();
   pipeline_ = createSimPipeline(ctx_, "tick_batch.comp", layout_, float_rules_, math_, workgroup, module_);
@@ -284,8 +286,8 @@ void GpuFleet::flush() {
     substeps = std::max(substeps, u.reset_active ? 1u : substepCount(u.substeps));
     queue.push_back(i);
   }
-  last_dispatches_ = 0;
   if (queue.empty()) return;
+  last_dispatches_ = 0;
   std::memcpy(inputs, queue.data(), 4 * queue.size());
 
   VkCommandBufferBeginInfo bi{};
@@ -303,16 +305,22 @@ void GpuFleet::flush() {
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_QUEUE].buffer, 1, &queue_region);
   transferToCompute(cmd_);
   vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+  // On a GPU one dispatch runs every sheet's whole tick. A CPU device runs a substep per dispatch
+  // (SIM_FUSED_SUBSTEPS_CPU): it takes the sheets a few at a time, each few through every substep,
+  // so that their arrays stay in the cache from one substep to the next.
   const VkDeviceAddress table = ctx_.address(table_);
-  for (uint32_t first = 0; first < substeps; first += substeps_per_dispatch_) {
-    if (first > 0) computeToCompute(cmd_);
-    BatchPush push{};
-    push.fused = {topo_.particleCount(), first, substeps_per_dispatch_, SIM_NONE};
-    push.table = glm::uvec2(uint32_t(table), uint32_t(table >> 32));
-    vkCmdPushConstants(cmd_, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
-    vkCmdDispatch(cmd_, uint32_t(queue.size()), 1, 1);
-    ++last_dispatches_;
-  }
+  const uint32_t per_group = substeps_per_dispatch_ >= substeps ? uint32_t(queue.size()) : sheets_per_group_;
+  for (uint32_t first_sheet = 0; first_sheet < queue.size(); first_sheet += per_group)
+    for (uint32_t first = 0; first < substeps; first += substeps_per_dispatch_) {
+      if (last_dispatches_ > 0) computeToCompute(cmd_);
+      BatchPush push{};
+      push.fused = {topo_.particleCount(), first, substeps_per_dispatch_, SIM_NONE};
+      push.table = glm::uvec2(uint32_t(table), uint32_t(table >> 32));
+      push.first = first_sheet;
+      vkCmdPushConstants(cmd_, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+      vkCmdDispatch(cmd_, std::min<uint32_t>(per_group, uint32_t(queue.size()) - first_sheet), 1, 1);
+      ++last_dispatches_;
+    }
   allToAllAndHost(cmd_);
   VK_CHECK(vkEndCommandBuffer(cmd_));
   ctx_.submit(cmd_, fence_);

@@ -74,6 +74,7 @@ private:
   FloatRules float_rules_;
   MathSwitches math_;
   uint32_t substeps_per_dispatch_ = 1;
+  uint32_t sheets_per_group_ = 1; ///< sheets a dispatch of a CPU device takes (a substep each)
 
   SheetTopology topo_; ///< the topology every sheet shares
   SheetLayout sizes_;
