@@ -16,6 +16,7 @@
 #include <pybind11/stl.h>
 
 #include "backend/backend.h"
+#include "core/fleet.h"
 #include "core/output.h"
 #include "core/params.h"
 #include "core/script.h"
@@ -273,6 +274,142 @@ private:
   std::map<std::string, std::string> textures_;
 };
 
+/// A fleet: B sheets of one grid ticking as one batch (core/fleet.h), each with its own parameters
+/// and optional script. Sheet i gives the same state as tender.Simulation of its parameters.
+class PyFleet {
+public:
+  PyFleet(const py::object& sheets, const std::string& preset, const std::string& backend, std::optional<int> device,
+          const std::optional<std::vector<std::string>>& scripts, const py::kwargs& params) {
+    auto base = presetParams(preset);
+    if (!base) throw py::value_error(unknownPreset(preset));
+    for (auto item : params) applyKey(*base, item.first.cast<std::string>(), item.second);
+    if (backend != "cpu" && backend != "gpu") throw py::value_error("unknown backend '" + backend + "' (cpu or gpu)");
+    if (device && *device < 0) throw py::value_error("device: expected an index >= 0 (see tender.devices())");
+    // sheets: a count of sheets of the common parameters, or one dict of keys per sheet over them
+    std::vector<FleetSheet> list;
+    if (py::isinstance<py::int_>(sheets)) {
+      const int64_t n = sheets.cast<int64_t>();
+      if (n < 1 || n > 65535) throw py::value_error("sheets: expected 1 to 65535, got " + std::to_string(n));
+      list.assign(size_t(n), FleetSheet{*base, {}});
+    } else {
+      for (const py::handle& item : py::iter(sheets)) {
+        if (!py::isinstance<py::dict>(item)) throw py::value_error("sheets: expected a count or a list of dicts");
+        FleetSheet s{*base, {}};
+        for (auto kv : item.cast<py::dict>()) applyKey(s.params, kv.first.cast<std::string>(), kv.second);
+        list.push_back(std::move(s));
+      }
+      if (list.empty() || list.size() > 65535) throw py::value_error("sheets: expected 1 to 65535 sheets");
+    }
+    if (scripts) {
+      if (scripts->size() != list.size())
+        throw py::value_error("scripts: expected one per sheet (" + std::to_string(list.size()) + "), got " +
+                              std::to_string(scripts->size()));
+      for (size_t i = 0; i < list.size(); ++i) {
+        std::string error;
+        auto script = parseScript(scripts->at(i), error);
+        if (!script) throw py::value_error("scripts[" + std::to_string(i) + "]: " + error);
+        if (auto err = checkScript(*script, list[i].params.particleCount()))
+          throw py::value_error("scripts[" + std::to_string(i) + "]: " + *err);
+        list[i].script = std::move(*script);
+      }
+    }
+    for (size_t i = 0; i < list.size(); ++i) {
+      if (auto err = validate(list[i].params, backend))
+        throw py::value_error("sheet " + std::to_string(i) + ": " + *err);
+      if (auto err = batchMismatch(list[0].params, list[i].params))
+        throw py::value_error("sheet " + std::to_string(i) + ": " + *err);
+    }
+    if (auto err = fleetFits(backend, list[0].params)) throw py::value_error(*err);
+    BackendOptions options = backendOptionsFor(backend, list[0].params);
+    options.device = device.value_or(-1);
+    if (auto err = createBatch(options, uint32_t(list.size()), batch_)) throw std::runtime_error(*err);
+    fleet_ = std::make_unique<Fleet>(*batch_, list);
+  }
+
+  void step(int64_t ticks) {
+    if (ticks < 0) throw py::value_error("ticks: expected a count >= 0, got " + std::to_string(ticks));
+    for (int64_t t = 0; t < ticks; ++t) {
+      auto t0 = std::chrono::steady_clock::now();
+      fleet_->tick();
+      batch_->finish();
+      ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      if ((t & 15) == 15 && PyErr_CheckSignals() != 0) throw py::error_already_set();
+    }
+  }
+
+  /// (B, N, 3) float32 of every sheet's positions, or of (pos - prev) / substep dt.
+  py::array_t<float> positions(bool velocities) {
+    const size_t b = fleet_->size(), n = fleet_->sim(0).topology().particleCount();
+    py::array_t<float> a({py::ssize_t(b), py::ssize_t(n), py::ssize_t(3)});
+    auto m = a.mutable_unchecked<3>();
+    for (size_t i = 0; i < b; ++i) {
+      SimState s = state(i);
+      const float dt = fleet_->sim(uint32_t(i)).params().substepDt();
+      for (size_t j = 0; j < n; ++j) {
+        const glm::vec3 v = velocities ? (glm::vec3(s.pos[j]) - glm::vec3(s.prev[j])) / dt : glm::vec3(s.pos[j]);
+        for (int k = 0; k < 3; ++k) m(py::ssize_t(i), py::ssize_t(j), k) = v[k];
+      }
+    }
+    return a;
+  }
+
+  py::object stats(std::optional<int64_t> sheet) {
+    if (!sheet) {
+      py::list out;
+      for (uint32_t i = 0; i < fleet_->size(); ++i) out.append(stats(i));
+      return out;
+    }
+    Simulation& sim = at(*sheet);
+    SimState s = state(uint32_t(*sheet));
+    SheetStats st = computeStats(s, sim.params().substepDt());
+    nlohmann::json j = runStatsJson(st, sim.solver(), {sim.params().preset, sim.frameCount(), sim.physicsTicks(), ms_},
+                                    batch_->name() == "gpu");
+    return py::module_::import("json").attr("loads")(j.dump());
+  }
+
+  std::vector<std::string> stateHashes() {
+    std::vector<std::string> out;
+    for (uint32_t i = 0; i < fleet_->size(); ++i) out.push_back(hashHex(hashPositions(state(i).pos)));
+    return out;
+  }
+
+  void grab(int64_t sheet, int64_t particle) {
+    Simulation& sim = at(sheet);
+    const uint32_t n = sim.topology().particleCount();
+    if (particle < 0 || particle >= int64_t(n))
+      throw py::value_error("particle " + std::to_string(particle) + " does not exist (the sheet has " +
+                            std::to_string(n) + ")");
+    sim.grabParticle(uint32_t(particle));
+  }
+  void move(int64_t sheet, double x, double y, double z) { at(sheet).moveGrab(coordinates(x, y, z, "move")); }
+  void release(int64_t sheet) { at(sheet).release(); }
+  uint32_t size() const { return fleet_->size(); }
+  std::string backendName() const { return batch_->name(); }
+  py::dict params(int64_t sheet) {
+    py::dict d;
+    d["preset"] = at(sheet).params().preset;
+    for (auto& [key, value] : paramValues(at(sheet).params())) d[py::str(key)] = value;
+    return d;
+  }
+
+private:
+  Simulation& at(int64_t sheet) const {
+    if (sheet < 0 || sheet >= int64_t(fleet_->size()))
+      throw py::index_error("sheet " + std::to_string(sheet) + " does not exist (the fleet has " +
+                            std::to_string(fleet_->size()) + ")");
+    return fleet_->sim(uint32_t(sheet));
+  }
+  SimState state(uint32_t i) {
+    SimState s;
+    fleet_->sim(i).solver().readback(s);
+    return s;
+  }
+
+  std::unique_ptr<SheetBatch> batch_;
+  std::unique_ptr<Fleet> fleet_;
+  std::vector<double> ms_;
+};
+
 py::list devices() {
   py::list out;
 #ifdef TENDER_HAS_GPU
@@ -339,4 +476,29 @@ PYBIND11_MODULE(tender, m) {
       .def("stats", &PySimulation::stats, "The stats JSON of `tender sim` as a dict.")
       .def("state_hash", &PySimulation::stateHash, "FNV-1a 64 of the positions, as `tender sim` prints it.")
       .def("save", &PySimulation::save, py::arg("path"), "Writes PLY, .glb or .gltf (by extension), atomically.");
+
+  py::class_<PyFleet>(m, "Fleet",
+                      "Sheets of one grid that tick as one batch: Fleet(sheets=N or [dict per sheet], "
+                      "preset='tender', backend='cpu'|'gpu', device=None, scripts=None, **params). Each dict "
+                      "overrides the common params for its sheet (any key but the grid's); scripts: one input "
+                      "script text per sheet. Sheet i ends where tender.Simulation of its params ends.")
+      .def(py::init<const py::object&, const std::string&, const std::string&, std::optional<int>,
+                    const std::optional<std::vector<std::string>>&, const py::kwargs&>(),
+           py::arg("sheets"), py::arg("preset") = "tender", py::arg("backend") = "cpu", py::arg("device") = py::none(),
+           py::arg("scripts") = py::none())
+      .def("step", &PyFleet::step, py::arg("ticks") = 1, "Runs `ticks` steps of every sheet, each as one batch.")
+      .def_property_readonly(
+          "positions", [](PyFleet& f) { return f.positions(false); }, "(B, N, 3) float32, a copy")
+      .def_property_readonly(
+          "velocities", [](PyFleet& f) { return f.positions(true); }, "(B, N, 3) float32, (pos - prev) / substep dt")
+      .def("stats", &PyFleet::stats, py::arg("sheet") = py::none(),
+           "The stats JSON of `tender sim` of one sheet as a dict, or a list of every sheet's.")
+      .def("state_hashes", &PyFleet::stateHashes, "Every sheet's state hash, as `tender sim` prints it.")
+      .def("grab", &PyFleet::grab, py::arg("sheet"), py::arg("particle"), "Grabs a particle of a sheet where it is.")
+      .def("move", &PyFleet::move, py::arg("sheet"), py::arg("x"), py::arg("y"), py::arg("z"),
+           "Moves a sheet's grab target.")
+      .def("release", &PyFleet::release, py::arg("sheet"), "Lets go of a sheet's particle.")
+      .def("params", &PyFleet::params, py::arg("sheet"), "Every key's value of a sheet as `--set` spells it.")
+      .def("__len__", &PyFleet::size)
+      .def_property_readonly("backend", &PyFleet::backendName);
 }
