@@ -58,13 +58,15 @@ if [ "$rc" -ne 0 ]; then
 fi
 if [ -f "$report" ]; then
   for check in environment devices gpu-tests render-tests diff-tender-hanging diff-tender-yank diff-crumple-hanging \
-    diff-crumple-yank bench; do
+    diff-crumple-yank bench fleet; do
     grep -q "^| $check | .* | pass | " "$report" || fail "report.md: check $check did not pass or is missing"
   done
   grep -q '^\*\*PASS\*\*' "$report" || fail "report.md does not say PASS"
   grep -q '^| dispatch cost | [0-9.]* us per empty dispatch' "$report" || fail "report.md has no dispatch cost"
   grep -q '^| 128x192 | 24576 | gpu-percolor | [0-9]' "$report" || fail "report.md has no benchmark table"
   [ -s "$tmp/report/bench.json" ] && [ -s "$tmp/report/bench.csv" ] || fail "no bench.json or bench.csv"
+  grep -q '^32x48 *gpu *64 *[0-9.]' "$report" || fail "report.md has no fleet table with a batch of 64"
+  [ -s "$tmp/report/fleet.json" ] || fail "no fleet.json"
   for f in "$tmp"/report/*.tmp "$tmp"/report/.*.tmp "$tmp"/report/logs/*.tmp; do
     [ -e "$f" ] && fail "a temporary file is left: $f"
   done
