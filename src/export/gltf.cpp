@@ -298,7 +298,8 @@ bool haveReceiptTexture() {
 
 std::string receiptPng(const std::string& preset) {
 #ifdef TENDER_HAS_RECEIPT
-  const render::ReceiptImage img = render::rasterizeReceipt(render::receiptText(preset));
+  // The layout's own size: a small file that reads well in a viewer (the renderer prints larger)
+  const render::ReceiptImage img = render::rasterizeReceipt(render::receiptText(preset), render::kReceiptLayoutWidth);
   std::string bytes;
   stbi_write_png_to_func(
       [](void* context, void* data, int size) {

@@ -1,7 +1,9 @@
 #pragma once
 /// The orbit camera of the scene: spherical coordinates around a target, perspective projection
-/// for Vulkan (y down in clip space, depth 0..1), picking rays and the grab plane.
+/// for Vulkan (y down in clip space, depth 0..1), picking rays, the grab plane, and the follow
+/// that keeps a tossed sheet in view.
 #include <optional>
+#include <span>
 
 #include <glm/glm.hpp>
 
@@ -25,6 +27,9 @@ public:
   static constexpr float kMaxRadius = 30.0f;
   /// Vertical field of view in degrees.
   static constexpr float kFovDegrees = 50.0f;
+  /// Near and far clip planes.
+  static constexpr float kNear = 0.1f;
+  static constexpr float kFar = 200.0f;
 
   /// The spec's start view: eye at (6, 4, 10) looking at (0, 1, 0).
   OrbitCamera();
@@ -37,6 +42,8 @@ public:
   void zoom(float wheel_steps);
   /// Pans the target by a cursor movement in pixels in a viewport of this height (middle-drag).
   void pan(float dx_pixels, float dy_pixels, float viewport_height);
+  /// Moves the target, the eye keeping its place relative to it.
+  void setTarget(glm::vec3 target) { target_ = target; }
 
   /// Eye position, target, spherical coordinates and distance.
   glm::vec3 eye() const;
@@ -53,11 +60,49 @@ public:
   glm::mat4 projection(float aspect) const;
   /// Ray through pixel (x, y) of a width x height viewport (origin top-left, pixel centres at +0.5).
   Ray ray(float x, float y, float width, float height) const;
+  /// Where a point lands in the view: x right and y down in [-1, 1] inside the view; nullopt
+  /// behind the near plane.
+  std::optional<glm::vec2> viewPoint(glm::vec3 p, float aspect) const;
 
 private:
   glm::vec3 target_{0.0f, 1.0f, 0.0f};
   float radius_ = 1.0f, theta_ = 0.0f, phi_ = 1.0f;
 };
+
+/// Eases an orbit camera after a sheet that leaves the view (a toss): once the centre of the
+/// watched points leaves the middle of the view, the target follows it with a critically damped
+/// spring until the centre is back near the middle. The spring is solved exactly over each step,
+/// so the motion does not depend on the frame rate.
+class CameraFollow {
+public:
+  /// The spring's smoothing time in seconds (its rate is 2 / kSmoothTime).
+  static constexpr float kSmoothTime = 0.5f;
+  /// The centre leaving this part of the view ([-1, 1] across) starts the follow...
+  static constexpr float kLeaveExtent = 0.8f;
+  /// ...and the centre back inside this part ends it.
+  static constexpr float kCentredExtent = 0.25f;
+
+  /// Looks at where the sheet is now (points in world space, sampled as often as the caller
+  /// likes): starts or ends following, and aims the spring at their centre while following.
+  /// A centre that is out of view while not armed (the user looked elsewhere) is not followed.
+  void watch(std::span<const glm::vec3> points, const OrbitCamera& camera, float aspect);
+  /// Moves the camera's target by dt seconds of the spring.
+  void update(OrbitCamera& camera, float dt);
+  /// Stops and forgets the spring's velocity; not armed again until the centre is in view (the
+  /// user moved the camera).
+  void stop();
+  /// Follows from the next watch() on even a centre that is out of view now (the follow turned on).
+  void arm() { armed_ = true; }
+  /// True from the centre leaving the middle of the view until it is back near the middle.
+  bool following() const { return following_; }
+
+private:
+  bool armed_ = false, following_ = false, moving_ = false;
+  glm::vec3 goal_{0.0f}, velocity_{0.0f};
+};
+
+/// Centre (mean) of a set of points; the origin for none.
+glm::vec3 centreOf(std::span<const glm::vec3> points);
 
 /// Intersection of a ray with the plane through `point` with normal `normal`; nullopt when the
 /// ray is parallel to the plane or the plane is behind the origin.

@@ -1,6 +1,7 @@
 #include "receipt.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -14,7 +15,7 @@ namespace {
 // Paper and ink colours (sRGB).
 constexpr uint8_t kPaper[3] = {0xf8, 0xf7, 0xf2};
 constexpr uint8_t kInk[3] = {0x2a, 0x2a, 0x2a};
-// Left and right margin in pixels.
+// Left and right margin (layout units: 1/512 of the width).
 constexpr int kMargin = 36;
 
 // Owns a FreeType library and one face.
@@ -63,9 +64,15 @@ size_t codepointCount(const std::string& s) {
   return n;
 }
 
+// Prints on the image at a layout written for kReceiptLayoutWidth: every position, size and
+// thickness the methods take is in layout units and scaled to the image's pixels.
 class Printer {
 public:
-  Printer(ReceiptImage& img, Font& font) : img_(img), font_(font) {}
+  Printer(ReceiptImage& img, Font& font)
+      : img_(img), font_(font), scale_(double(img.width) / double(kReceiptLayoutWidth)) {}
+
+  // Layout units to pixels.
+  int px(double units) const { return int(std::lround(units * scale_)); }
 
   // Blends ink over the paper at (x, y) with coverage a (0..255).
   void ink(int x, int y, uint32_t a) {
@@ -74,47 +81,30 @@ public:
     for (int c = 0; c < 3; ++c) p[c] = uint8_t((p[c] * (255 - a) + kInk[c] * a + 127) / 255);
   }
 
-  // Prints text with its baseline at y; x < 0 centres it. Returns the printed line.
-  PrintedLine text(const std::string& s, int px, int x, int baseline, bool bold = false) {
-    font_.setSize(px);
-    int adv = font_.advance();
-    int w = int(codepointCount(s)) * adv;
-    if (x < 0) x = (int(img_.width) - w) / 2;
-    FT_Face f = font_.face();
-    int pen = x;
-    for (size_t i = 0; i < s.size();) {
-      uint32_t cp = nextCodepoint(s, i);
-      if (FT_Load_Char(f, cp, FT_LOAD_RENDER)) continue;
-      const FT_Bitmap& bm = f->glyph->bitmap;
-      for (int pass = 0; pass < (bold ? 2 : 1); ++pass) // bold: print twice, one pixel apart
-        for (unsigned r = 0; r < bm.rows; ++r)
-          for (unsigned c = 0; c < bm.width; ++c)
-            ink(pen + f->glyph->bitmap_left + int(c) + pass, baseline - f->glyph->bitmap_top + int(r),
-                bm.buffer[r * unsigned(bm.pitch) + c]);
-      pen += int(f->glyph->advance.x >> 6);
-    }
-    PrintedLine l{s, x, baseline - px * 3 / 4, x + w, baseline + px / 4};
-    img_.lines.push_back(l);
-    return l;
+  // Prints text of font size `size` with its baseline at y; x < 0 centres it.
+  void text(const std::string& s, int size, int x, int y, bool bold = false) {
+    printAt(s, px(size), x < 0 ? -1 : px(x), px(y), bold);
   }
 
   // Prints `left` at the left margin and `right` flush with the right margin.
-  void columns(const std::string& left, const std::string& right, int px, int baseline, bool bold = false) {
-    text(left, px, kMargin, baseline, bold);
-    font_.setSize(px);
-    int w = int(codepointCount(right)) * font_.advance();
-    text(right, px, int(img_.width) - kMargin - w, baseline, bold);
+  void columns(const std::string& left, const std::string& right, int size, int y, bool bold = false) {
+    text(left, size, kMargin, y, bold);
+    const int right_edge = int(img_.width) - px(kMargin);
+    printAt(right, px(size), right_edge - textWidth(right, px(size)), px(y), bold);
   }
 
+  // A dashed rule two units thick with its top at y.
   void dashes(int y) {
-    for (int x = kMargin; x < int(img_.width) - kMargin; ++x)
-      if ((x - kMargin) % 12 < 7)
-        for (int t = 0; t < 2; ++t) ink(x, y + t, 255);
-    img_.lines.push_back({"----", kMargin, y, int(img_.width) - kMargin, y + 2});
+    const int x0 = px(kMargin), x1 = int(img_.width) - x0, top = px(y), bottom = px(y + 2);
+    for (int x = x0; x < x1; ++x)
+      if (std::fmod(double(x - x0) / scale_, 12.0) < 7.0) // 7 units of dash, 5 of gap
+        for (int yy = top; yy < bottom; ++yy) ink(x, yy, 255);
+    img_.lines.push_back({"----", x0, top, x1, bottom});
   }
 
-  // A faux barcode: bar widths from the digits, framed by guard bars.
-  void barcode(const std::string& digits, int y0, int y1) {
+  // A faux barcode between y0 and y1: bar widths from the digits, framed by guard bars.
+  void barcode(const std::string& digits, int y0_units, int y1_units) {
+    const int y0 = px(y0_units), y1 = px(y1_units);
     std::vector<int> widths = {1, 1, 1, 1}; // start guard: bar, space, bar, space
     for (char ch : digits) {
       int d = ch - '0';
@@ -124,21 +114,52 @@ public:
     widths.insert(widths.end(), {1, 1, 1});
     int total = 0;
     for (int w : widths) total += w;
-    const int module = std::max(1, (int(img_.width) - 2 * kMargin - 40) / total);
-    int x = (int(img_.width) - total * module) / 2;
-    const int x_start = x;
+    // Whole layout units per module, then every bar edge scaled to pixels
+    const int module = std::max(1, (int(kReceiptLayoutWidth) - 2 * kMargin - 40) / total);
+    const int x_start = (int(img_.width) - px(total * module)) / 2;
+    int units = 0;
     for (size_t k = 0; k < widths.size(); ++k) {
+      const int x0 = x_start + px(units), x1 = x_start + px(units + widths[k] * module);
       if (k % 2 == 0)
-        for (int xx = x; xx < x + widths[k] * module; ++xx)
-          for (int y = y0; y < y1; ++y) ink(xx, y, 255);
-      x += widths[k] * module;
+        for (int x = x0; x < x1; ++x)
+          for (int y = y0; y < y1; ++y) ink(x, y, 255);
+      units += widths[k] * module;
     }
-    img_.lines.push_back({"|||", x_start, y0, x, y1});
+    img_.lines.push_back({"|||", x_start, y0, x_start + px(units), y1});
   }
 
 private:
+  // Width of a line of text at this pixel size (monospace).
+  int textWidth(const std::string& s, int size) {
+    font_.setSize(size);
+    return int(codepointCount(s)) * font_.advance();
+  }
+
+  // Prints text at pixel size `size` with its baseline at pixel row `baseline`; x < 0 centres it.
+  void printAt(const std::string& s, int size, int x, int baseline, bool bold) {
+    const int w = textWidth(s, size);
+    if (x < 0) x = (int(img_.width) - w) / 2;
+    FT_Face f = font_.face();
+    // Bold: printed again shifted right by up to one layout unit
+    const int shifts = bold ? std::max(1, px(1)) : 0;
+    int pen = x;
+    for (size_t i = 0; i < s.size();) {
+      uint32_t cp = nextCodepoint(s, i);
+      if (FT_Load_Char(f, cp, FT_LOAD_RENDER)) continue;
+      const FT_Bitmap& bm = f->glyph->bitmap;
+      for (int shift = 0; shift <= shifts; ++shift)
+        for (unsigned r = 0; r < bm.rows; ++r)
+          for (unsigned c = 0; c < bm.width; ++c)
+            ink(pen + f->glyph->bitmap_left + int(c) + shift, baseline - f->glyph->bitmap_top + int(r),
+                bm.buffer[r * unsigned(bm.pitch) + c]);
+      pen += int(f->glyph->advance.x >> 6);
+    }
+    img_.lines.push_back({s, x, baseline - size * 3 / 4, x + w, baseline + size / 4});
+  }
+
   ReceiptImage& img_;
   Font& font_;
+  double scale_; // pixels per layout unit
 };
 
 } // namespace
@@ -183,9 +204,11 @@ std::string receiptFontPath() {
   return font && *font ? font : kReceiptFont;
 }
 
-ReceiptImage rasterizeReceipt(const ReceiptText& text, const std::string& font_path) {
+ReceiptImage rasterizeReceipt(const ReceiptText& text, uint32_t width, const std::string& font_path) {
   Font font(font_path);
   ReceiptImage img;
+  img.width = std::max(width, 64u);
+  img.height = img.width * 3 / 2;
   img.rgba.resize(size_t(img.width) * img.height * 4);
   for (size_t i = 0; i < size_t(img.width) * img.height; ++i) {
     img.rgba[i * 4 + 0] = kPaper[0];
@@ -220,7 +243,7 @@ ReceiptImage rasterizeReceipt(const ReceiptText& text, const std::string& font_p
     y += 26;
   }
   y += 10;
-  const int bar_bottom = int(img.height) - 44;
+  const int bar_bottom = int(kReceiptLayoutWidth * 3 / 2) - 44;
   p.barcode(text.barcode, y, bar_bottom);
   std::string spaced;
   for (char c : text.barcode) spaced += c, spaced += ' ';

@@ -1,15 +1,20 @@
 #pragma once
 /// The receipt printed on the paper: its text per preset, and its rasterisation with FreeType
-/// into a 512 x 768 RGBA image (dark ink on off-white).
+/// into an RGBA image of any width, 2:3 (dark ink on off-white), laid out the same at every size.
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace tender::render {
 
-/// Size of the receipt texture in pixels.
-constexpr uint32_t kReceiptWidth = 512;
-constexpr uint32_t kReceiptHeight = 768;
+/// Size of the renderer's receipt texture in pixels: at the closest zoom (radius 3, 50 degrees of
+/// view over 720 pixels: 257 pixels per unit) a texel of a 5.6 to 5.9 units wide sheet covers at
+/// most one pixel (1536 / 5.85 = 263 texels per unit).
+constexpr uint32_t kReceiptWidth = 1536;
+constexpr uint32_t kReceiptHeight = kReceiptWidth * 3 / 2;
+/// The width the receipt's layout is written for: positions and font sizes are in 1/512 of the
+/// image's width, so at this width they are pixels.
+constexpr uint32_t kReceiptLayoutWidth = 512;
 /// The monospace font the receipt is printed with (Debian's fonts-dejavu-core).
 constexpr const char* kReceiptFont = "/usr/share/fonts/truetype/dejavu/DejaVuSansMono.ttf";
 /// The receipt font: $TENDER_FONT when set (a self-contained bundle ships its own), else kReceiptFont.
@@ -46,12 +51,14 @@ struct PrintedLine {
 
 /// An RGBA8 image of the receipt, rows top to bottom.
 struct ReceiptImage {
-  uint32_t width = kReceiptWidth, height = kReceiptHeight;
+  uint32_t width = 0, height = 0;
   std::vector<uint8_t> rgba;
   std::vector<PrintedLine> lines; ///< every text line, divider and the barcode
 };
 
-/// Rasterises a receipt; throws std::runtime_error with one clear line when the font is missing.
-ReceiptImage rasterizeReceipt(const ReceiptText& text, const std::string& font_path = receiptFontPath());
+/// Rasterises a receipt `width` pixels wide and 1.5 times as high (width at least 64); throws
+/// std::runtime_error with one clear line when the font is missing.
+ReceiptImage rasterizeReceipt(const ReceiptText& text, uint32_t width = kReceiptWidth,
+                              const std::string& font_path = receiptFontPath());
 
 } // namespace tender::render

@@ -4,30 +4,7 @@
 # the sheet and move it, and the validation layers must stay silent. Exits 77 (skipped) without
 # Xvfb or xdotool.
 set -u
-DEMO=${TENDER_DEMO:?set TENDER_DEMO to the tender-demo binary}
-for tool in Xvfb xdotool xwd convert; do
-  if ! command -v "$tool" >/dev/null; then
-    echo "SKIP: $tool is not installed (apt-get install xvfb xdotool x11-apps imagemagick)"
-    exit 77
-  fi
-done
-export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
-tmp=$(mktemp -d)
-display=":$((90 + RANDOM % 400))"
-Xvfb "$display" -screen 0 1024x768x24 -nolisten tcp >"$tmp/xvfb.log" 2>&1 &
-xvfb=$!
-demo=
-cleanup() {
-  [ -n "$demo" ] && kill "$demo" 2>/dev/null
-  kill "$xvfb" 2>/dev/null
-  wait 2>/dev/null
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-export DISPLAY=$display
-for _ in $(seq 50); do xdpyinfo >/dev/null 2>&1 && break; sleep 0.1; done
-
-fail() { echo "FAIL: $*"; echo "--- demo output"; cat "$tmp/demo.log"; exit 1; }
+source "$(dirname "$0")/demo_lib.sh"
 
 # No usable display: one line `tender: error: ...` naming the cause, exit 2.
 DISPLAY=:9999 "$DEMO" --backend cpu >"$tmp/nodisplay.out" 2>"$tmp/nodisplay.err"
@@ -39,18 +16,7 @@ echo "ok: no usable display -> $(cat "$tmp/nodisplay.err")"
 "$DEMO" --backend cpu --record /nonexistent/dir/input.txt >/dev/null 2>"$tmp/record.err"
 rc=$?
 [ "$rc" -eq 2 ] && [ "$(wc -l <"$tmp/record.err")" -eq 1 ] || { cat "$tmp/record.err"; fail "unwritable --record -> exit $rc"; }
-alive() { kill -0 "$demo" 2>/dev/null || fail "tender-demo exited during: $1"; }
-shot() { xwd -root -silent | convert xwd:- "$tmp/$1.png"; }
-
-"$DEMO" --backend cpu --validation --record "$tmp/input.txt" --width 800 --height 600 >"$tmp/demo.log" 2>&1 &
-demo=$!
-wid=
-for _ in $(seq 100); do
-  wid=$(xdotool search --name "Tender" 2>/dev/null | head -1)
-  [ -n "$wid" ] && break
-  sleep 0.1
-done
-[ -n "$wid" ] || fail "no window appeared"
+start_demo --backend cpu --validation --record "$tmp/input.txt" --width 800 --height 600
 echo "window $wid: $(xdotool getwindowname "$wid")"
 sleep 3 # pipelines build, the sheet settles
 alive "start-up"
@@ -82,21 +48,16 @@ xdotool windowmap --sync "$wid"
 xdotool windowsize --sync "$wid" 900 650 || true
 sleep 0.5
 alive "restore"
-# Every key: reset, wind, FPS, pins, pause and resume.
-for key in r w i p space space i; do
+# Every key: reset, wind, FPS, pins, pause and resume, follow on and off.
+for key in r w i p space space i f f; do
   xdotool key --window "$wid" "$key"
   sleep 0.3
   alive "key $key"
 done
 xdotool getwindowname "$wid" >/dev/null || fail "the window does not answer"
 shot after
-xdotool key --window "$wid" Escape
-for _ in $(seq 100); do kill -0 "$demo" 2>/dev/null || break; sleep 0.1; done
-wait "$demo"
-rc=$?
-demo=
+stop_demo
 cat "$tmp/demo.log"
-[ "$rc" -eq 0 ] || fail "tender-demo exited with status $rc"
 grep -q "validation" "$tmp/demo.log" && fail "validation messages"
 grep -Eq "[1-9][0-9]* grabs" "$tmp/demo.log" || fail "the drag did not grab the sheet"
 for ev in "grab ray" "move" "release" "reset" "wind" "pins" "pause"; do

@@ -1,5 +1,9 @@
-// The orbit camera: the spec's start view, clamps, rays and the grab plane.
+// The orbit camera: the spec's start view, clamps, rays, the grab plane and the follow of a tossed sheet.
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <span>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -97,4 +101,84 @@ TEST(Camera, GrabPlaneFacesTheCamera) {
   EXPECT_FALSE(tender::render::intersectPlane(r, c.eye() - c.forward() * 5.0f, c.forward()).has_value());
   glm::vec3 side = glm::normalize(glm::cross(r.dir, glm::vec3(0.0f, 1.0f, 0.0f)));
   EXPECT_FALSE(tender::render::intersectPlane(r, r.origin + side, side).has_value());
+}
+
+TEST(Camera, ViewPointOfTheTargetIsTheMiddle) {
+  OrbitCamera c;
+  auto v = c.viewPoint(c.target(), 16.0f / 9.0f);
+  ASSERT_TRUE(v);
+  EXPECT_NEAR(v->x, 0.0f, 1e-5f);
+  EXPECT_NEAR(v->y, 0.0f, 1e-5f);
+  // y points down, as in Vulkan's clip space; a point behind the eye lands nowhere
+  EXPECT_GT(c.viewPoint(c.target() + glm::vec3(0.0f, -1.0f, 0.0f), 1.0f)->y, 0.0f);
+  EXPECT_FALSE(c.viewPoint(c.eye() - c.forward(), 1.0f));
+}
+
+namespace {
+
+using tender::render::CameraFollow;
+
+// A sheet (one point) tossed from the target to x = -30 over 1.5 s, then resting; the follow
+// watches it every 0.1 s and steps at `hz`. Returns the camera's target at each whole second.
+std::vector<glm::vec3> followToss(float hz, bool follow) {
+  OrbitCamera c;
+  CameraFollow f;
+  std::vector<glm::vec3> at_seconds;
+  const int steps = int(hz * 6.0f), per_watch = int(hz / 10.0f);
+  for (int i = 0; i <= steps; ++i) {
+    const float t = float(i) / hz;
+    const glm::vec3 sheet(-30.0f * std::min(t / 1.5f, 1.0f), 1.0f, 0.0f);
+    if (follow && i > 0) f.update(c, 1.0f / hz); // the spring up to time t
+    if (follow && i % per_watch == 0) f.watch(std::span(&sheet, 1), c, 16.0f / 9.0f);
+    if (i % int(hz) == 0) at_seconds.push_back(c.target());
+  }
+  return at_seconds;
+}
+
+} // namespace
+
+TEST(CameraFollow, KeepsATossedSheetInView) {
+  const std::vector<glm::vec3> on = followToss(60.0f, true);
+  // Two seconds after the sheet came to rest the camera looks at it
+  expectNear(on.back(), {-30.0f, 1.0f, 0.0f}, 0.5f);
+  // Off, the camera stays
+  for (glm::vec3 t : followToss(60.0f, false)) expectNear(t, {0.0f, 1.0f, 0.0f});
+}
+
+TEST(CameraFollow, DoesNotDependOnTheFrameRate) {
+  const std::vector<glm::vec3> a = followToss(60.0f, true), b = followToss(30.0f, true), c = followToss(120.0f, true);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.size(), c.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    expectNear(a[i], b[i], 1e-2f);
+    expectNear(a[i], c[i], 1e-2f);
+  }
+}
+
+TEST(CameraFollow, LeavesASheetInViewAndOneTheUserLookedAwayFrom) {
+  OrbitCamera c;
+  CameraFollow f;
+  const glm::vec3 near_target = c.target() + glm::vec3(0.3f, 0.2f, 0.0f);
+  for (int i = 0; i < 100; ++i) {
+    f.watch(std::span(&near_target, 1), c, 1.5f);
+    f.update(c, 0.1f);
+  }
+  expectNear(c.target(), {0.0f, 1.0f, 0.0f});
+  // The user pans far away (the demo stops the follow): the sheet is out of view, not followed
+  c.pan(5000.0f, 0.0f, 720.0f);
+  f.stop();
+  const glm::vec3 panned = c.target();
+  for (int i = 0; i < 100; ++i) {
+    f.watch(std::span(&near_target, 1), c, 1.5f);
+    f.update(c, 0.1f);
+  }
+  EXPECT_FALSE(f.following());
+  expectNear(c.target(), panned);
+  // Armed (the follow turned on), it goes and finds the sheet
+  f.arm();
+  for (int i = 0; i < 100; ++i) {
+    f.watch(std::span(&near_target, 1), c, 1.5f);
+    f.update(c, 0.1f);
+  }
+  expectNear(c.target(), near_target, 0.5f);
 }

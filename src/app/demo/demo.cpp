@@ -156,7 +156,8 @@ void DemoApp::createSolver() {
     return;
   }
   sim_ = std::make_unique<Simulation>(common_.params, *backend_.solver);
-  camera_ = startView(common_.params);
+  resetView();
+  setFollow(followsByDefault(common_.params));
   panel_params_ = common_.params;
   attachPaper();
 }
@@ -313,18 +314,17 @@ int DemoApp::run() {
       fps_frames = 0;
     }
 
+    ImGui_ImplVulkan_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    resolveMouse();
     demo::HudState hs;
     hs.init_progress = renderer_->ready() ? 1.0f : renderer_->buildNext();
     if (renderer_->ready()) {
       if (!sim_start) sim_start = now;
-      if (input_.pending_move) {
-        ScriptEvent m;
-        m.kind = EventKind::Move;
-        m.a = *input_.pending_move;
-        apply(m);
-        input_.pending_move.reset();
-      }
+      applyPendingMove();
       sim_->advance(dt);
+      updateFollow(dt);
       backend_.solver->computeNormals();
     }
     hs.seconds = sim_start ? std::chrono::duration<double>(now - *sim_start).count() : 0.0;
@@ -338,20 +338,15 @@ int DemoApp::run() {
     hs.device = device;
     PassTimes times = backend_.solver->passTimes();
     hs.times = &times;
+    hs.follow = follow_on_;
     if (input_.grabbing && sim_->grabbed() != SIM_NONE) {
-      // The grab target on the screen (Vulkan clip space: y down, depth in [0, 1])
+      // The grab target on the screen, in window pixels
       int ww = 0, wh = 0;
       glfwGetWindowSize(window_, &ww, &wh);
-      const glm::vec4 clip = camera_.projection(float(std::max(ww, 1)) / float(std::max(wh, 1))) * camera_.view() *
-                             glm::vec4(sim_->grabTarget(), 1.0f);
-      if (clip.w > 0.0f)
-        hs.grab_point =
-            glm::vec2((clip.x / clip.w * 0.5f + 0.5f) * float(ww), (clip.y / clip.w * 0.5f + 0.5f) * float(wh));
+      if (auto v = camera_.viewPoint(sim_->grabTarget(), aspect()))
+        hs.grab_point = (*v * 0.5f + 0.5f) * glm::vec2(float(ww), float(wh));
     }
 
-    ImGui_ImplVulkan_NewFrame();
-    ImGui_ImplGlfw_NewFrame();
-    ImGui::NewFrame();
     demo::HudActions actions = hud_->draw(hs, panel_params_);
     render::SceneView view = render::defaultSceneView(sim_->params());
     view.camera = camera_;
@@ -366,6 +361,7 @@ int DemoApp::run() {
   std::printf("tender-demo: %llu frames in %.1f s (%.1f FPS), %llu physics ticks, %u grabs\n",
               static_cast<unsigned long long>(frames), seconds, seconds > 0 ? double(frames) / seconds : 0.0,
               static_cast<unsigned long long>(sim_->physicsTicks()), sim_->grabCount());
+  printCamera();
   // The script clock's steps: `tender sim --script <the recording> --ticks <steps>` ends in this state
   std::printf("tender-demo: %llu steps, state hash %016llx\n", static_cast<unsigned long long>(sim_->frameCount()),
               static_cast<unsigned long long>(hashPositions(state.pos)));
@@ -382,6 +378,15 @@ int DemoApp::run() {
   if (common_.validation && ctx_->validationMessages() > 0)
     return fail(std::to_string(ctx_->validationMessages()) + " validation messages");
   return 0;
+}
+
+void DemoApp::printCamera() const {
+  const glm::vec3 t = camera_.target();
+  char centre[64] = "behind the camera";
+  if (auto v = camera_.viewPoint(render::centreOf(sheetSamples()), aspect()))
+    std::snprintf(centre, sizeof centre, "at %.2f %.2f in the view", double(v->x), double(v->y));
+  std::printf("tender-demo: camera follow %s, target %.2f %.2f %.2f, the sheet's centre %s\n",
+              follow_on_ ? "on" : "off", double(t.x), double(t.y), double(t.z), centre);
 }
 
 int runDemo(const CommonOptions& common, const DemoOptions& options) {

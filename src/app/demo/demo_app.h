@@ -36,10 +36,19 @@ struct FrameSync {
   VkFence done = VK_NULL_HANDLE;
 };
 
+/// A mouse press waiting for ImGui's next frame to say whether it landed on the HUD.
+struct MousePress {
+  bool pending = false;
+  bool released = false;   ///< the button came up again before the press was resolved
+  double x = 0.0, y = 0.0; ///< where the cursor was at the press
+};
+
 /// Mouse and keyboard state, filled by the GLFW callbacks.
 struct Input {
   bool grabbing = false, orbiting = false, panning = false;
   double x = 0.0, y = 0.0;
+  MousePress presses[3]; ///< left, right, middle
+  double scroll = 0.0;   ///< wheel steps waiting, as the presses do, for ImGui's next frame
   glm::vec3 plane_point{0.0f}, plane_normal{0.0f};
   std::optional<glm::vec3> pending_move;
   bool resized = false;
@@ -59,13 +68,38 @@ private:
   void recreateSwapchain();
   void drawFrame(const render::SceneView& view);
   void apply(ScriptEvent e);
+  /// Moves the grab target to where the cursor last dragged it.
+  void applyPendingMove();
   void handleActions(const demo::HudActions& a);
   void switchParams(const SimParams& p, bool new_receipt);
   /// The camera's start view for a preset: the spec's (6, 4, 10) towards (0, 1, 0), or for a
   /// crumple sheet, which falls to the floor at y = -10, a view from further back that shows the
   /// floor and the shadow on it.
   static render::OrbitCamera startView(const SimParams& p);
-  render::Ray cursorRay() const;
+  /// Whether the camera follows a tossed sheet at the start of a preset: on for crumple.
+  static bool followsByDefault(const SimParams& p);
+  /// The camera back at the start view (C, the View button, a preset switch).
+  void resetView();
+  /// Turns the camera follow on or off (F, the HUD's Follow box).
+  void setFollow(bool on);
+  /// A few particles spread over the sheet (a 3 x 3 grid of the topology), read from the solver.
+  std::vector<glm::vec3> sheetSamples() const;
+  /// The camera follow's step: watches the sheet now and then, moves the camera every frame.
+  void updateFollow(float dt);
+  /// Prints the camera's follow switch and target, and where the sheet's centre is in the view
+  /// ([-1, 1] across, y down) at exit.
+  void printCamera() const;
+  /// Width over height of the window.
+  float aspect() const;
+  render::Ray rayAt(double x, double y) const;
+  /// Starts what a press of this mouse button on the scene does (grab, orbit, pan) at (x, y).
+  void beginDrag(int button, double x, double y);
+  /// Ends it when the button comes up.
+  void endDrag(int button);
+  /// Decides the presses and wheel steps of this frame once ImGui's NewFrame has seen them: one
+  /// on a HUD window belongs to the HUD alone (the flag of the previous frame can be stale: the
+  /// cursor may have reached the button in the same event batch as the click).
+  void resolveMouse();
 
   static void onMouseButton(GLFWwindow* w, int button, int action, int mods);
   static void onCursor(GLFWwindow* w, double x, double y);
@@ -92,6 +126,9 @@ private:
   bool imgui_ready_ = false;
   uint32_t slot_ = 0;
   render::OrbitCamera camera_;
+  render::CameraFollow follow_;
+  bool follow_on_ = false;
+  float follow_clock_ = 0.0f; ///< seconds since the follow last looked at the sheet
   Input input_;
   bool show_fps_ = false;
   OutputSet record_;        // --record: written when the session ends

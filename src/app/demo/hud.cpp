@@ -127,12 +127,16 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
   if (ImGui::Button(s.pins ? "Pins: on" : "Pins: off")) a.toggle_pins = true;
   ImGui::SameLine();
   if (ImGui::Button(s.paused ? "Resume" : "Pause")) a.toggle_pause = true;
+  ImGui::SameLine();
+  bool follow = s.follow;
+  if (ImGui::Checkbox("Follow", &follow)) a.toggle_follow = true;
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("the camera keeps a tossed sheet in view (F)");
   const ImVec2 buttons = ImGui::GetWindowPos();
   ImGui::End();
 
   // Controls hint, bottom-left; above the buttons' row when the window is too narrow for both.
   const char* hint = "R to Reset \xc2\xb7 W to toggle Wind \xc2\xb7 I to toggle FPS \xc2\xb7 P to toggle Pins "
-                     "\xc2\xb7 Space to Pause";
+                     "\xc2\xb7 Space to Pause \xc2\xb7 F to toggle Follow";
   const float hint_size = body * 0.9f;
   const ImVec2 hint_extent = body_->CalcTextSizeA(hint_size, FLT_MAX, 0.0f, hint);
   float hint_y = size.y - m - hint_size;

@@ -19,7 +19,8 @@ struct HudState {
   double seconds = 0.0;       ///< since the simulation started
   float fps = 0.0f;
   bool show_fps = false, paused = false, wind = true, pins = true;
-  std::string device; ///< renderer device name
+  bool follow = false; ///< the camera follows a tossed sheet
+  std::string device;  ///< renderer device name
   const PassTimes* times = nullptr;
   uint32_t triangles = 0; ///< live triangles (0 when unknown)
   /// Where the grab holds the paper, in window pixels, while grabbing: the hand sprite's place
@@ -30,6 +31,7 @@ struct HudState {
 struct HudActions {
   bool toggle_wind = false, reset = false, toggle_pins = false, toggle_pause = false;
   bool reset_view = false;           ///< the camera back to the start view
+  bool toggle_follow = false;        ///< the camera follow on or off
   bool live_changed = false;         ///< `params` changed in ways that need no rebuild
   bool rebuild = false;              ///< `params` needs a rebuild (grid size)
   std::optional<std::string> preset; ///< switch to this preset

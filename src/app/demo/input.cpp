@@ -7,10 +7,10 @@
 
 namespace tender {
 
-render::Ray DemoApp::cursorRay() const {
+render::Ray DemoApp::rayAt(double x, double y) const {
   int w = 0, h = 0;
   glfwGetWindowSize(window_, &w, &h);
-  return camera_.ray(float(input_.x), float(input_.y), float(std::max(w, 1)), float(std::max(h, 1)));
+  return camera_.ray(float(x), float(y), float(std::max(w, 1)), float(std::max(h, 1)));
 }
 
 void DemoApp::apply(ScriptEvent e) {
@@ -19,44 +19,80 @@ void DemoApp::apply(ScriptEvent e) {
   if (!options_.record.empty()) record_text_ += formatEvent(e) + "\n";
 }
 
+void DemoApp::applyPendingMove() {
+  if (!input_.pending_move) return;
+  ScriptEvent m;
+  m.kind = EventKind::Move;
+  m.a = *input_.pending_move;
+  apply(m);
+  input_.pending_move.reset();
+}
+
 void DemoApp::onMouseButton(GLFWwindow* w, int button, int action, int) {
   DemoApp& app = *appOf(w);
-  Input& in = app.input_;
-  glfwGetCursorPos(w, &in.x, &in.y);
-  const bool press = action == GLFW_PRESS;
-  if (press && ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse) return;
-  if (!app.renderer_->ready()) return;
+  if (button < 0 || button >= int(std::size(app.input_.presses))) return;
+  MousePress& p = app.input_.presses[button];
+  if (action == GLFW_PRESS) {
+    // Decided in resolveMouse(), after ImGui has seen the press
+    p = {true, false, 0.0, 0.0};
+    glfwGetCursorPos(w, &p.x, &p.y);
+  } else if (p.pending) {
+    p.released = true;
+  } else {
+    app.endDrag(button);
+  }
+}
+
+void DemoApp::resolveMouse() {
+  const bool on_hud = ImGui::GetIO().WantCaptureMouse;
+  if (!on_hud && input_.scroll != 0.0) {
+    camera_.zoom(float(input_.scroll));
+    follow_.stop();
+  }
+  input_.scroll = 0.0;
+  for (int b = 0; b < int(std::size(input_.presses)); ++b) {
+    const MousePress p = input_.presses[b];
+    input_.presses[b] = {};
+    if (!p.pending || on_hud || !renderer_->ready()) continue;
+    beginDrag(b, p.x, p.y);
+    if (p.released) endDrag(b);
+  }
+}
+
+void DemoApp::beginDrag(int button, double x, double y) {
+  Input& in = input_;
   if (button == GLFW_MOUSE_BUTTON_LEFT) {
-    if (press) {
-      // Grab the nearest particle within the pick radius of the cursor's ray.
-      render::Ray r = app.cursorRay();
-      ScriptEvent e;
-      e.kind = EventKind::GrabRay;
-      e.a = r.origin;
-      e.b = r.dir;
-      app.apply(e);
-      if (app.sim_->grabbed() != SIM_NONE) {
-        in.grabbing = true;
-        in.plane_point = app.sim_->grabTarget();
-        in.plane_normal = app.camera_.forward();
-      }
-    } else if (in.grabbing) {
-      if (in.pending_move) {
-        ScriptEvent m;
-        m.kind = EventKind::Move;
-        m.a = *in.pending_move;
-        app.apply(m);
-        in.pending_move.reset();
-      }
-      ScriptEvent e;
-      e.kind = EventKind::Release;
-      app.apply(e);
-      in.grabbing = false;
+    // Grab the nearest particle within the pick radius of the cursor's ray.
+    render::Ray r = rayAt(x, y);
+    ScriptEvent e;
+    e.kind = EventKind::GrabRay;
+    e.a = r.origin;
+    e.b = r.dir;
+    apply(e);
+    if (sim_->grabbed() != SIM_NONE) {
+      in.grabbing = true;
+      in.plane_point = sim_->grabTarget();
+      in.plane_normal = camera_.forward();
     }
   } else if (button == GLFW_MOUSE_BUTTON_RIGHT) {
-    in.orbiting = press;
+    in.orbiting = true;
   } else if (button == GLFW_MOUSE_BUTTON_MIDDLE) {
-    in.panning = press;
+    in.panning = true;
+  }
+}
+
+void DemoApp::endDrag(int button) {
+  Input& in = input_;
+  if (button == GLFW_MOUSE_BUTTON_LEFT && in.grabbing) {
+    applyPendingMove();
+    ScriptEvent e;
+    e.kind = EventKind::Release;
+    apply(e);
+    in.grabbing = false;
+  } else if (button == GLFW_MOUSE_BUTTON_RIGHT) {
+    in.orbiting = false;
+  } else if (button == GLFW_MOUSE_BUTTON_MIDDLE) {
+    in.panning = false;
   }
 }
 
@@ -68,8 +104,9 @@ void DemoApp::onCursor(GLFWwindow* w, double x, double y) {
   in.y = y;
   if (in.grabbing) {
     // The grabbed particle follows the cursor on the camera-facing plane through the grab point.
-    if (auto p = render::intersectPlane(app.cursorRay(), in.plane_point, in.plane_normal)) in.pending_move = *p;
+    if (auto p = render::intersectPlane(app.rayAt(x, y), in.plane_point, in.plane_normal)) in.pending_move = *p;
   }
+  if (in.orbiting || in.panning) app.follow_.stop();
   if (in.orbiting) app.camera_.orbit(dx, dy);
   if (in.panning) {
     int ww = 0, wh = 0;
@@ -78,10 +115,7 @@ void DemoApp::onCursor(GLFWwindow* w, double x, double y) {
   }
 }
 
-void DemoApp::onScroll(GLFWwindow* w, double, double dy) {
-  if (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse) return;
-  appOf(w)->camera_.zoom(float(dy));
-}
+void DemoApp::onScroll(GLFWwindow* w, double, double dy) { appOf(w)->input_.scroll += dy; }
 
 void DemoApp::onKey(GLFWwindow* w, int key, int, int action, int) {
   if (action != GLFW_PRESS) return;
@@ -107,7 +141,10 @@ void DemoApp::onKey(GLFWwindow* w, int key, int, int action, int) {
     app.show_fps_ = !app.show_fps_;
     return;
   case GLFW_KEY_C:
-    app.camera_ = startView(app.sim_->params());
+    app.resetView();
+    return;
+  case GLFW_KEY_F:
+    app.setFollow(!app.follow_on_);
     return;
   case GLFW_KEY_ESCAPE:
     glfwSetWindowShouldClose(w, GLFW_TRUE);
@@ -121,21 +158,71 @@ void DemoApp::onKey(GLFWwindow* w, int key, int, int action, int) {
 
 void DemoApp::onResize(GLFWwindow* w, int, int) { appOf(w)->input_.resized = true; }
 
+namespace {
+
+// How often the camera follow reads the sheet's sample points (a few small read-backs each).
+constexpr float kFollowSampleSeconds = 0.1f;
+
+bool isCrumple(const SimParams& p) { return p.preset.rfind("crumple", 0) == 0; }
+
+} // namespace
+
 render::OrbitCamera DemoApp::startView(const SimParams& p) {
   render::OrbitCamera c;
-  if (p.preset.rfind("crumple", 0) == 0) c.lookAt({7.0f, 3.0f, 19.0f}, {0.0f, -1.8f, 0.0f});
+  if (isCrumple(p)) c.lookAt({7.0f, 3.0f, 19.0f}, {0.0f, -1.8f, 0.0f});
   return c;
+}
+
+bool DemoApp::followsByDefault(const SimParams& p) { return isCrumple(p); }
+
+void DemoApp::resetView() {
+  camera_ = startView(sim_->params());
+  follow_.stop();
+}
+
+void DemoApp::setFollow(bool on) {
+  follow_on_ = on;
+  follow_.stop();
+  if (on) follow_.arm();                // turned on: go and find the sheet wherever it is
+  follow_clock_ = kFollowSampleSeconds; // look at the sheet on the next frame
+}
+
+std::vector<glm::vec3> DemoApp::sheetSamples() const {
+  const SheetTopology& t = sim_->topology();
+  std::vector<glm::vec3> points;
+  for (uint32_t r = 0; r < 3; ++r)
+    for (uint32_t c = 0; c < 3; ++c)
+      points.push_back(backend_.solver->particlePosition((t.rows - 1) * r / 2 * t.cols + (t.cols - 1) * c / 2));
+  return points;
+}
+
+void DemoApp::updateFollow(float dt) {
+  // The user's hand is on the sheet or the camera: they decide what is in view
+  if (!follow_on_ || input_.grabbing || input_.orbiting || input_.panning) return;
+  follow_clock_ += dt;
+  if (follow_clock_ >= kFollowSampleSeconds) {
+    follow_clock_ = 0.0f;
+    follow_.watch(sheetSamples(), camera_, aspect());
+  }
+  follow_.update(camera_, dt);
+}
+
+float DemoApp::aspect() const {
+  int w = 0, h = 0;
+  glfwGetWindowSize(window_, &w, &h);
+  return float(std::max(w, 1)) / float(std::max(h, 1));
 }
 
 void DemoApp::switchParams(const SimParams& p, bool new_receipt) {
   ctx_->waitIdle();
   input_.grabbing = false;
   input_.pending_move.reset();
+  sim_->rebuild(p);
   if (new_receipt) {
     renderer_->setReceipt(render::rasterizeReceipt(render::receiptText(p.preset)));
-    camera_ = startView(p);
+    resetView();
+    setFollow(followsByDefault(p));
   }
-  sim_->rebuild(p);
   panel_params_ = p;
   attachPaper();
 }
@@ -147,7 +234,8 @@ void DemoApp::handleActions(const demo::HudActions& a) {
   if (a.toggle_pins) e.kind = EventKind::Pins, apply(e);
   if (a.toggle_pause) e.kind = EventKind::Pause, apply(e);
   if (a.reset) e.kind = EventKind::Reset, apply(e);
-  if (a.reset_view) camera_ = startView(sim_->params());
+  if (a.reset_view) resetView();
+  if (a.toggle_follow) setFollow(!follow_on_);
   if (a.preset) {
     if (auto p = presetParams(*a.preset)) switchParams(*p, true);
   } else if (a.rebuild) {
