@@ -48,6 +48,8 @@ struct SimUniforms {
   float reset_alpha; // reset interpolation factor of this frame, 0..1
   uint iterations;   // constraint iterations per substep
 
+  vec4 air; // SIM_FLAG_AIR: x pressure, y friction factor (SimParams::airPressureFactor), z 1 / (3 dt)
+
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
   vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet
   vec4 grab_target[SIM_MAX_SUBSTEPS]; // grabbed particle position per substep; w: 0 free, 1 held, 2 tossed
@@ -59,6 +61,8 @@ struct SimUniforms {
 #define SIM_FLAG_PINS 2u
 // Set by the GPU solver when it keeps collision candidate lists (SIM_CANDIDATE_* in sim_config.h)
 #define SIM_FLAG_CANDIDATES 4u
+// Air on every triangle (airOnTriangle in xpbd.h): a pass before integration sums it per particle
+#define SIM_FLAG_AIR 8u
 
 /// Push constants of every simulation dispatch.
 struct SimPush {

@@ -149,6 +149,56 @@ SIM_INLINE bool unsupported(uint kind, bool gone0, bool gone1) {
   return kind == SIM_KIND_TRIBEND && (gone0 || gone1);
 }
 
+/// The particles of triangle t (original id: two per quad, row by row, as buildSheet makes them:
+/// top-left, bottom-left, bottom-right, then top-left, bottom-right, top-right) of a cols-wide grid.
+SIM_INLINE uvec3 gridTriangle(uint t, uint cols) {
+  uint quad = t / 2u, quads = cols - 1u;
+  uint tl = (quad / quads) * cols + quad % quads, bl = tl + cols;
+  return (t & 1u) == 0u ? uvec3(tl, bl, bl + 1u) : uvec3(tl, bl + 1u, tl + 1u);
+}
+
+/// The k-th (k < 6) triangle (original id) with particle i of a cols x rows grid as a corner, or
+/// SIM_NONE: both halves of the quad below-right, one of the quads left and above, both of the
+/// quad above-left.
+SIM_INLINE uint particleTriangle(uint i, uint k, uint cols, uint rows) {
+  uint x = i % cols, y = i / cols, quads = cols - 1u;
+  bool right = x + 1u < cols, below = y + 1u < rows, left = x > 0u, above = y > 0u;
+  if (k < 2u) return right && below ? 2u * (y * quads + x) + k : SIM_NONE;
+  if (k == 2u) return left && below ? 2u * (y * quads + x - 1u) + 1u : SIM_NONE;
+  if (k == 3u) return right && above ? 2u * ((y - 1u) * quads + x) : SIM_NONE;
+  return left && above ? 2u * ((y - 1u) * quads + x - 1u) + (k - 4u) : SIM_NONE;
+}
+
+/// The air on a triangle now at pa, pb, pc and a substep ago at qa, qb, qc, per unit mass of its
+/// paper: the pressure of quadratic drag along its normal (which lifts a tilted sheet as it
+/// slows it) and skin friction along its plane, both growing with its area. air: x the pressure,
+/// y the friction factor (SimParams::airPressureFactor), z 1 / (3 dt).
+SIM_INLINE vec3 airOnTriangle(vec3 pa, vec3 pb, vec3 pc, vec3 qa, vec3 qb, vec3 qc, vec4 air) {
+  vec3 v = ((pa - qa) + (pb - qb) + (pc - qc)) * air.z;
+  vec3 n = cross3(pb - pa, pc - pa);
+  float n2 = dot3(n, n), v2 = dot3(v, v);
+  if (!(n2 > 1e-30f) || !(v2 > 0.0f)) return vec3(0.0f);
+  // |n| is twice the area; vn the velocity along the normal, vt the rest
+  float k = simSqrt(v2) * simSqrt(n2);
+  vec3 vn = n * simDiv(dot3(v, n), n2);
+  vec3 vt = v - vn;
+  return vn * (-air.x * k) + vt * (-air.y * k);
+}
+
+/// The air on a particle: the mean over the live triangles around it (sum of airOnTriangle over
+/// `count` of them), each triangle's paper sharing its mass equally among its corners.
+SIM_INLINE vec3 meanAir(vec3 sum, uint count) {
+  if (count == 0u) return vec3(0.0f);
+  float c = float(count);
+  return vec3(simDiv(sum.x, c), simDiv(sum.y, c), simDiv(sum.z, c));
+}
+
+/// The wind a particle integrates with: the substep's, plus the air on it (from the air pass) when
+/// SIM_FLAG_AIR is set.
+SIM_INLINE vec4 windWithAir(vec4 wind, vec4 air_on_particle, uint flags) {
+  return (flags & SIM_FLAG_AIR) != 0u ? wind + air_on_particle : wind;
+}
+
 /// Smooth normal of grid particle (i, j) from central differences of its neighbours.
 SIM_INLINE vec3 gridNormal(vec3 left, vec3 right, vec3 up, vec3 down) {
   vec3 n = cross3(right - left, up - down);

@@ -95,11 +95,16 @@ void main() {
   uint projects = u.iterations * u.color_count;
   for (uint s = p.first_substep; s < end; ++s) {
     uint first_pass = s * per_substep;
-    // 1. Verlet integration (as integrate.comp)
+    // 1. The air (as air.comp), then Verlet integration (as integrate.comp)
+    if ((u.flags & SIM_FLAG_AIR) != 0u) {
+      sync(); // the air reads the positions of other invocations' particles (loaded or moved)
+      for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(airOnParticle(i), 0.0f);
+      sync();
+    }
     for (uint i = lid; i < n; i += kInvocations) {
-      VerletState st =
-          integrateParticle(s_pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index, u.grab_target[s],
-                            u.grab_prev[s], u.flags, u.gravity, u.wind[s], u.wind_twist[s], u.damping, dt2);
+      VerletState st = integrateParticle(s_pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index, u.grab_target[s],
+                                         u.grab_prev[s], u.flags, u.gravity, windWithAir(u.wind[s], delta[i], u.flags),
+                                         u.wind_twist[s], u.damping, dt2);
       s_pos[i] = st.position;
       prev[i] = st.previous;
     }

@@ -1,7 +1,7 @@
 #version 460
-// Verlet integration with gravity, wind and damping; pins and the grab hold their particles, a
-// toss places the released particle with its drag velocity.
-// Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
+// Verlet integration with gravity, wind (and the air of the air pass) and damping; pins and the grab hold their
+// particles, a toss places the released particle with its drag velocity. Workgroup size (sim_common.glsl declares it
+// and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
 #include "sim_common.glsl"
 layout(push_constant) uniform PushBlock { SimPush p; };
@@ -15,9 +15,9 @@ void main() {
   }
   if (i >= p.count) return;
   uint s = p.substep;
-  VerletState st =
-      integrateParticle(pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index, u.grab_target[s], u.grab_prev[s],
-                        u.flags, u.gravity, u.wind[s], u.wind_twist[s], u.damping, u.dt * u.dt);
+  VerletState st = integrateParticle(pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index, u.grab_target[s],
+                                     u.grab_prev[s], u.flags, u.gravity, windWithAir(u.wind[s], delta[i], u.flags),
+                                     u.wind_twist[s], u.damping, u.dt * u.dt);
   pos[i] = st.position;
   prev[i] = st.previous;
 }

@@ -213,6 +213,22 @@ bool triangleGone(uint t) {
   return torn[e.x] != 0u || torn[e.y] != 0u;
 }
 
+// The air on particle i (SIM_FLAG_AIR): meanAir of airOnTriangle over its live triangles, each
+// at the positions (SIM_POSITION) and previous positions of the start of the substep.
+vec3 airOnParticle(uint i) {
+  vec3 sum = vec3(0.0f);
+  uint count = 0u;
+  for (uint k = 0u; k < 6u; ++k) {
+    uint t = particleTriangle(i, k, u.cols, u.rows);
+    if (t == SIM_NONE || triangleGone(t)) continue;
+    uvec3 c = gridTriangle(t, u.cols);
+    sum += airOnTriangle(vec3(SIM_POSITION(c.x)), vec3(SIM_POSITION(c.y)), vec3(SIM_POSITION(c.z)), vec3(prev[c.x]),
+                         vec3(prev[c.y]), vec3(prev[c.z]), u.air);
+    ++count;
+  }
+  return meanAir(sum, count);
+}
+
 // After the tear marks of a substep (and only when something tore): marks a shear or tri-bend
 // constraint that has lost its triangles (unsupported in xpbd.h). It reads the flags of structural
 // constraints only, which no longer change in this substep.

@@ -24,6 +24,7 @@ struct SimParams {
   float spacing = 0.18f; ///< rest distance between neighbours
   PinMode pins = PinMode::Top3;
   float top_y = 0.0f;    ///< y of the top edge; 0: centred on y = 1, above the floor
+  float tilt = 0.0f;     ///< degrees the sheet leans back from hanging (about its top edge): 90 lies flat
   bool shear = true;     ///< diagonal constraints
   bool bend = true;      ///< skip-one bend constraints (rest 2 x spacing)
   bool tri_bend = false; ///< bending across each pair of adjacent triangles
@@ -39,6 +40,13 @@ struct SimParams {
   WindKind wind_kind = WindKind::Sinusoid;
   float wind_strength = 1.0f; ///< multiplier of the wind
   float wind_scale = 1.2f;    ///< wind acceleration at strength 1 (units/s^2)
+  // Air (SI units): quadratic pressure drag along each triangle's normal, which also gives lift to a
+  // tilted sheet, and skin friction along its plane, per unit mass of the paper
+  bool air = false;
+  float air_density = 1.2f;      ///< kg/m^3
+  float paper_weight = 55.0f;    ///< g/m^2 (thermal receipt paper: 48 to 60)
+  float drag_coefficient = 1.5f; ///< of the pressure along the normal
+  float skin_friction = 0.02f;   ///< coefficient of the friction along the plane
   // Constraints
   float stiffness = 1.0f;      ///< structural and shear projection stiffness
   float bend_stiffness = 1.0f; ///< bend and tri-bend projection stiffness
@@ -66,6 +74,10 @@ struct SimParams {
   float tickDt() const { return 1.0f / tick_hz; }
   float substepDt() const { return 1.0f / (tick_hz * float(substeps)); }
   float collisionRadius() const { return collision_factor * spacing; }
+  /// Factors of the air on a triangle of the rest area spacing^2 / 2 (SimUniforms::air): pressure
+  /// and friction, rho C / (2 sigma spacing^2).
+  float airPressureFactor() const;
+  float airFrictionFactor() const;
 };
 
 /// Names of the presets, in the order `--help` lists them.

@@ -58,15 +58,22 @@ SheetTopology buildSheet(const SimParams& p) {
   t.rows = H;
   auto idx = [W](uint32_t i, uint32_t j) { return j * W + i; };
 
-  // Particles: a portrait sheet in the XY plane, facing +Z, row 0 at the top.
-  const float width = float(W - 1) * s, height = float(H - 1) * s;
+  // Particles: a portrait sheet in the XY plane, facing +Z, row 0 at the top; with a tilt it leans
+  // back about its top edge (row j goes down by cos and back by sin of the tilt).
+  const float width = float(W - 1) * s;
+  const float tilt = p.tilt * 0.017453292519943295f;
+  const float down = p.tilt != 0.0f ? std::cos(tilt) : 1.0f, back = p.tilt != 0.0f ? std::sin(tilt) : 0.0f;
+  const float height = float(H - 1) * s * down;
   // Centred on y = 1 (the camera's target), or higher when that would reach the floor.
   const float top = p.top_y != 0.0f ? p.top_y : std::max(1.0f + 0.5f * height, p.floor_y + 1.0f + height);
   t.rest_pos.resize(N);
   t.uv.resize(N);
   for (uint32_t j = 0; j < H; ++j)
     for (uint32_t i = 0; i < W; ++i) {
-      t.rest_pos[idx(i, j)] = glm::vec4(-0.5f * width + float(i) * s, top - float(j) * s, 0.0f, 0.0f);
+      const float along = float(j) * s;
+      t.rest_pos[idx(i, j)] = p.tilt != 0.0f
+                                  ? glm::vec4(-0.5f * width + float(i) * s, top - along * down, -along * back, 0.0f)
+                                  : glm::vec4(-0.5f * width + float(i) * s, top - along, 0.0f, 0.0f);
       t.uv[idx(i, j)] = glm::vec2(W > 1 ? float(i) / float(W - 1) : 0.5f, H > 1 ? float(j) / float(H - 1) : 0.5f);
     }
   for (uint32_t pin : pinIndices(p.pins, W, H)) t.rest_pos[pin].w = 1.0f;

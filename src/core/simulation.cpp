@@ -180,7 +180,8 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   u.tear_factor = p.tear_factor;
   u.tear_kinds = (p.tear_structural ? 1u << SIM_KIND_STRUCTURAL : 0u) | (p.tear_shear ? 1u << SIM_KIND_SHEAR : 0u) |
                  (p.tear_bend ? (1u << SIM_KIND_BEND) | (1u << SIM_KIND_TRIBEND) : 0u);
-  u.flags = (p.collision ? SIM_FLAG_COLLISION : 0u) | (pins_ ? SIM_FLAG_PINS : 0u);
+  u.flags = (p.collision ? SIM_FLAG_COLLISION : 0u) | (pins_ ? SIM_FLAG_PINS : 0u) | (p.air ? SIM_FLAG_AIR : 0u);
+  if (p.air) u.air = glm::vec4(p.airPressureFactor(), p.airFrictionFactor(), 1.0f / (3.0f * u.dt), 0.0f);
   u.stiffness = glm::vec4(p.stiffness, p.stiffness, p.bend_stiffness, p.bend_stiffness);
   u.reset_active = reset_frame_ > 0 ? 1u : 0u;
   u.reset_alpha = reset_frame_ > 0 ? float(SIM_RESET_FRAMES - reset_frame_ + 1) / float(SIM_RESET_FRAMES) : 0.0f;

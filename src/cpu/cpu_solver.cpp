@@ -72,18 +72,42 @@ void CpuSolver::upload(const SheetTopology& topo) {
   collision_.upload(topo.adj_offsets, topo.adj_list, topo.hash_size, grain_);
 }
 
+void CpuSolver::airPass(const SimUniforms& u) {
+  air_.resize(pos_.size());
+  const auto& edges = topo_->tri_edges;
+  pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
+    for (uint32_t i = begin; i < end; ++i) {
+      // airOnParticle in sim_elements.glsl
+      vec3 sum(0.0f);
+      uint32_t count = 0;
+      for (uint32_t k = 0; k < 6; ++k) {
+        const uint32_t t = particleTriangle(i, k, u.cols, u.rows);
+        if (t == SIM_NONE || torn_[edges[t].x] != 0u || torn_[edges[t].y] != 0u) continue;
+        const uvec3 c = gridTriangle(t, u.cols);
+        sum += airOnTriangle(vec3(pos_[c.x]), vec3(pos_[c.y]), vec3(pos_[c.z]), vec3(prev_[c.x]), vec3(prev_[c.y]),
+                             vec3(prev_[c.z]), u.air);
+        ++count;
+      }
+      air_[i] = vec4(meanAir(sum, count), 0.0f);
+    }
+  });
+}
+
 void CpuSolver::integrate(const SimUniforms& u, uint32_t s) {
   const float dt2 = u.dt * u.dt;
   const vec4 wind = u.wind[s], twist = u.wind_twist[s];
   const vec4 target = u.grab_target[s], grab_prev = u.grab_prev[s];
+  const bool air = (u.flags & SIM_FLAG_AIR) != 0u;
+  if (air) airPass(u);
   pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
     vec4* pos = pos_.data();
     vec4* prev = prev_.data();
     const vec4* rest = rest_.data();
     const vec2* uv = uv_.data();
     for (uint32_t i = begin; i < end; ++i) {
-      const VerletState st = integrateParticle(pos[i], prev[i], rest[i], uv[i].x, i == u.grab_index, target, grab_prev,
-                                               u.flags, u.gravity, wind, twist, u.damping, dt2);
+      const VerletState st =
+          integrateParticle(pos[i], prev[i], rest[i], uv[i].x, i == u.grab_index, target, grab_prev, u.flags, u.gravity,
+                            air ? windWithAir(wind, air_[i], u.flags) : wind, twist, u.damping, dt2);
       pos[i] = st.position;
       prev[i] = st.previous;
     }

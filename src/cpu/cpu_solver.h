@@ -65,8 +65,12 @@ public:
   bool usesSimd() const { return simd_; }
 
   // The passes of one substep, public so tests can drive them one by one.
-  /// Verlet integration with gravity, wind, damping; pins and the grab hold their particles.
+  /// Verlet integration with gravity, wind, damping (and, with SIM_FLAG_AIR, the air on each
+  /// particle, from airPass first); pins and the grab hold their particles.
   void integrate(const shaderio::SimUniforms& u, uint32_t substep);
+  /// The air on each particle (airOnParticle in sim_elements.glsl), from the positions and previous
+  /// positions of the start of the substep.
+  void airPass(const shaderio::SimUniforms& u);
   /// Gauss-Seidel over the colours, `iterations` times.
   void project(const shaderio::SimUniforms& u, uint32_t iterations) {
     projectColors(u, 0, iterations * uint32_t(colors_.size()));
@@ -112,6 +116,7 @@ private:
   CpuCollision collision_;
   const SheetTopology* topo_ = nullptr;
   std::vector<glm::vec4> pos_, prev_, rest_, normal_, reset_from_;
+  std::vector<glm::vec4> air_; ///< the air on each particle in this substep (SIM_FLAG_AIR)
   std::vector<glm::vec2> uv_;
   std::vector<shaderio::Constraint> constraints_;
   std::vector<ColorRange> colors_;

@@ -80,7 +80,11 @@ bool GpuSolver::recordSubstep(Slot& slot, const RecordKey& key, uint32_t s, uint
   const uint32_t n = topo_.particleCount(), m = topo_.constraintCount();
   const SimPush all{0, n, s, 0};
   auto stops = [&] { return pass++ == key.stop; };
-  // 1. Verlet integration
+  // 1. The air on each particle (integration reads it), then Verlet integration
+  if (key.air) {
+    dispatch(cmd, pipes_.air, Grid::Threads, n, all);
+    computeToCompute(cmd);
+  }
   dispatch(cmd, pipes_.integrate, Grid::Threads, n, all);
   computeToCompute(cmd);
   timestamp(cmd, slot, kIntegrate);

@@ -121,6 +121,7 @@ void GpuSolver::createPipelines(FusedShape fused) {
   };
   constexpr uint32_t kSim = sizeof(SimPush), kScan = sizeof(ScanPush), kPick = sizeof(PickPush);
   static constexpr PipelineSpec kPasses[] = {
+      {&SimPipelines::air, "air.comp", kSim, 1},
       {&SimPipelines::integrate, "integrate.comp", kSim, 1},
       {&SimPipelines::project, "project.comp", kSim, 1},
       {&SimPipelines::candidates_check, "candidates_check.comp", kSim, 1},
@@ -225,8 +226,8 @@ void GpuSolver::tick(const SimUniforms& u) {
     dispatches_per_tick_ = 1;
     return;
   }
-  RecordKey key{substepCount(u.substeps), u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u, usesFusedPath(u),
-                stop_after_};
+  RecordKey key{substepCount(u.substeps), u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u,
+                usesFusedPath(u),         stop_after_,  (u.flags & SIM_FLAG_AIR) != 0u};
   stop_after_ = SIM_NONE;
   if (slot.recorded != key) recordTick(slot, index, key);
   ctx_.submit(slot.tick, slot.fence);

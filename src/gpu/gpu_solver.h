@@ -35,9 +35,9 @@ struct ComputePipeline {
 
 /// Every pipeline of the simulation (one file per shader in shaders/sim/).
 struct SimPipelines {
-  ComputePipeline integrate, project, candidates_check, candidates_decide, hash_count, scan, scan_add, hash_scatter,
-      hash_sort, collide, candidates_finish, floor, tear_mark, tear_unsupported, tear_flags, tear_compact, normals,
-      reset;
+  ComputePipeline air, integrate, project, candidates_check, candidates_decide, hash_count, scan, scan_add,
+      hash_scatter, hash_sort, collide, candidates_finish, floor, tear_mark, tear_unsupported, tear_flags, tear_compact,
+      normals, reset;
   ComputePipeline tick_fused; ///< null when the device has under 32 KiB of shared memory
   std::array<ComputePipeline, 3> pick;
 };
@@ -127,6 +127,7 @@ private:
     bool collision = false;
     bool fused = false;
     uint32_t stop = SIM_NONE; ///< last pass recorded (stopNextTickAfter)
+    bool air = false;         ///< the air pass runs before integration (SIM_FLAG_AIR)
     bool operator==(const RecordKey&) const = default;
   };
   struct Slot {

@@ -6,7 +6,7 @@ set -u
 . "$(dirname "$0")/lib.sh"
 hash_of() { "$T" sim --backend cpu "$@" | grep -o 'state hash [0-9a-f]*'; }
 
-[ "$("$T" presets | tr '\n' ' ')" = "tender crumple tender-low crumple-low " ] && echo "ok: tender presets" ||
+[ "$("$T" presets | tr '\n' ' ')" = "tender crumple tender-low crumple-low paper " ] && echo "ok: tender presets" ||
   fail "tender presets: $("$T" presets 2>&1)"
 
 # Every key is dumped, and the dump round-trips to the same state.

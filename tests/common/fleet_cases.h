@@ -14,7 +14,7 @@ namespace tender::test {
 /// Sheets of a 12 x 16 grid; sheet i takes its parameters and its script from i, so a batch of
 /// 37 holds every combination below several times: tearing yanks and sheets left hanging, a reset,
 /// a pause, a ray grab, three pin modes, both winds, and different stiffness, damping, gravity,
-/// tear factor, restitution, floor, substeps, iterations, release and collision.
+/// tear factor, restitution, floor, substeps, iterations, release, collision and air.
 inline std::vector<FleetSheet> mixedFleet(uint32_t count) {
   static const char* kScripts[] = {
       "",
@@ -47,6 +47,7 @@ inline std::vector<FleetSheet> mixedFleet(uint32_t count) {
         "iterations=" + std::to_string(3 + i % 2),
         std::string("release=") + (i % 4 == 1 ? "drag" : "zero"),
         std::string("collision=") + (i % 9 == 4 ? "off" : "on"),
+        std::string("air=") + (i % 5 == 1 ? "on" : "off"),
     };
     FleetSheet s;
     s.params = preset("tender", sets);

@@ -33,7 +33,15 @@ TEST(Params, PresetsCarryTheSpecValues) {
   EXPECT_EQ(c.wind_kind, WindKind::Noise);
   EXPECT_EQ(presetParams("tender-low")->cols * presetParams("tender-low")->rows, 24u * 36u);
   EXPECT_EQ(presetParams("crumple-low")->cols * presetParams("crumple-low")->rows, 30u * 45u);
-  EXPECT_FALSE(presetParams("paper"));
+  // paper: a real receipt in SI units
+  const SimParams r = *presetParams("paper");
+  EXPECT_NEAR(float(r.cols - 1) * r.spacing, 0.08f, 1e-6f);
+  EXPECT_NEAR(float(r.rows - 1) * r.spacing, 0.30f, 1e-6f);
+  EXPECT_FLOAT_EQ(r.gravity, 9.81f);
+  EXPECT_TRUE(r.air);
+  EXPECT_FLOAT_EQ(r.damping, 1.0f); // the air slows it, not a uniform damping
+  EXPECT_EQ(r.pins, PinMode::None);
+  EXPECT_FALSE(presetParams("origami"));
   for (auto& name : presetNames()) EXPECT_FALSE(validate(*presetParams(name))) << name;
 }
 
