@@ -110,6 +110,8 @@ const std::vector<Param>& params() {
                 "pinned particles: top3, corners, none"),
       floatParam("top_y", &SimParams::top_y, -1000.0f, 1000.0f, "y of the top edge (0: centre on y = 1)"),
       floatParam("tilt", &SimParams::tilt, 0.0f, 90.0f, "degrees the sheet leans back from hanging (90: flat)"),
+      floatParam("view_scale", &SimParams::view_scale, 1e-3f, 1e3f,
+                 "size of the scene the camera frames and the ground covers (1: the tender sheet's)"),
       boolParam("shear", &SimParams::shear, "diagonal constraints"),
       boolParam("bend", &SimParams::bend, "skip-one bend constraints"),
       boolParam("tri_bend", &SimParams::tri_bend, "bending across adjacent triangles"),
@@ -212,6 +214,7 @@ std::optional<SimParams> presetParams(const std::string& name) {
     p.spacing = 0.005f;
     p.pins = PinMode::None;
     p.tilt = 85.0f;
+    p.view_scale = 0.1f;
     p.paper_weight = 48.0f;
     p.floor_y = 0.0f;
     p.damping = 1.0f; // the air slows it, not a uniform damping

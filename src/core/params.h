@@ -23,11 +23,12 @@ struct SimParams {
   uint32_t rows = 48;    ///< particles down
   float spacing = 0.18f; ///< rest distance between neighbours
   PinMode pins = PinMode::Top3;
-  float top_y = 0.0f;    ///< y of the top edge; 0: centred on y = 1, above the floor
-  float tilt = 0.0f;     ///< degrees the sheet leans back from hanging (about its top edge): 90 lies flat
-  bool shear = true;     ///< diagonal constraints
-  bool bend = true;      ///< skip-one bend constraints (rest 2 x spacing)
-  bool tri_bend = false; ///< bending across each pair of adjacent triangles
+  float top_y = 0.0f;      ///< y of the top edge; 0: centred on y = 1, above the floor
+  float tilt = 0.0f;       ///< degrees the sheet leans back from hanging (about its top edge): 90 lies flat
+  float view_scale = 1.0f; ///< size of the scene the camera frames and the ground covers (1: the tender sheet's)
+  bool shear = true;       ///< diagonal constraints
+  bool bend = true;        ///< skip-one bend constraints (rest 2 x spacing)
+  bool tri_bend = false;   ///< bending across each pair of adjacent triangles
   // Time
   float tick_hz = 120.0f;      ///< fixed ticks per second
   uint32_t substeps = 8;       ///< substeps per tick

@@ -50,6 +50,20 @@ std::vector<ColorRange> sortByColor(std::vector<shaderio::Constraint>& cs, const
   return ranges;
 }
 
+SheetPlacement sheetPlacement(const SimParams& p) {
+  SheetPlacement at;
+  at.length = float(p.rows > 0 ? p.rows - 1 : 0) * p.spacing;
+  if (p.tilt != 0.0f) {
+    const float tilt = p.tilt * 0.017453292519943295f;
+    at.down = std::cos(tilt);
+    at.back = std::sin(tilt);
+  }
+  const float height = p.tilt != 0.0f ? at.length * at.down : at.length;
+  // Centred on y = 1 (the camera's target), or higher when that would reach the floor.
+  at.top = p.top_y != 0.0f ? p.top_y : std::max(1.0f + 0.5f * height, p.floor_y + 1.0f + height);
+  return at;
+}
+
 SheetTopology buildSheet(const SimParams& p) {
   SheetTopology t;
   const uint32_t W = p.cols, H = p.rows, N = W * H;
@@ -59,13 +73,10 @@ SheetTopology buildSheet(const SimParams& p) {
   auto idx = [W](uint32_t i, uint32_t j) { return j * W + i; };
 
   // Particles: a portrait sheet in the XY plane, facing +Z, row 0 at the top; with a tilt it leans
-  // back about its top edge (row j goes down by cos and back by sin of the tilt).
+  // back about its top edge.
   const float width = float(W - 1) * s;
-  const float tilt = p.tilt * 0.017453292519943295f;
-  const float down = p.tilt != 0.0f ? std::cos(tilt) : 1.0f, back = p.tilt != 0.0f ? std::sin(tilt) : 0.0f;
-  const float height = float(H - 1) * s * down;
-  // Centred on y = 1 (the camera's target), or higher when that would reach the floor.
-  const float top = p.top_y != 0.0f ? p.top_y : std::max(1.0f + 0.5f * height, p.floor_y + 1.0f + height);
+  const SheetPlacement at = sheetPlacement(p);
+  const float top = at.top, down = at.down, back = at.back;
   t.rest_pos.resize(N);
   t.uv.resize(N);
   for (uint32_t j = 0; j < H; ++j)

@@ -45,6 +45,15 @@ inline uint32_t constraintId(const shaderio::Constraint& c) { return c.kind_id >
 /// Builds particles, constraints (coloured and sorted), adjacency and triangles.
 SheetTopology buildSheet(const SimParams& p);
 
+/// Where buildSheet places the sheet: the height of its top edge, and how far its rows go down
+/// and back (the tilt) over the sheet's length.
+struct SheetPlacement {
+  float top = 0.0f;
+  float down = 1.0f, back = 0.0f; ///< cos and sin of the tilt
+  float length = 0.0f;            ///< (rows - 1) x spacing
+};
+SheetPlacement sheetPlacement(const SimParams& p);
+
 /// Greedy colouring: colour of each constraint, smallest colour free at both ends.
 std::vector<uint32_t> colorGreedy(const std::vector<shaderio::Constraint>& cs, uint32_t particle_count);
 

@@ -12,10 +12,15 @@ OrbitCamera::OrbitCamera() { lookAt({6.0f, 4.0f, 10.0f}, {0.0f, 1.0f, 0.0f}); }
 void OrbitCamera::lookAt(glm::vec3 eye_pos, glm::vec3 target) {
   target_ = target;
   glm::vec3 d = eye_pos - target;
-  radius_ = std::clamp(glm::length(d), kMinRadius, kMaxRadius);
+  radius_ = std::clamp(glm::length(d), minRadius(), maxRadius());
   float len = glm::length(d);
   phi_ = std::clamp(len > 0.0f ? std::acos(std::clamp(d.y / len, -1.0f, 1.0f)) : 1.0f, kMinPhi, kMaxPhi);
   theta_ = std::atan2(d.x, d.z);
+}
+
+void OrbitCamera::setScale(float scale) {
+  scale_ = scale;
+  radius_ = std::clamp(radius_, minRadius(), maxRadius());
 }
 
 void OrbitCamera::orbit(float dx_pixels, float dy_pixels) {
@@ -27,7 +32,7 @@ void OrbitCamera::orbit(float dx_pixels, float dy_pixels) {
 
 void OrbitCamera::zoom(float wheel_steps) {
   // Each wheel step moves 10% closer (or further).
-  radius_ = std::clamp(radius_ * std::pow(0.9f, wheel_steps), kMinRadius, kMaxRadius);
+  radius_ = std::clamp(radius_ * std::pow(0.9f, wheel_steps), minRadius(), maxRadius());
 }
 
 void OrbitCamera::pan(float dx_pixels, float dy_pixels, float viewport_height) {
@@ -49,7 +54,7 @@ glm::vec3 OrbitCamera::forward() const { return glm::normalize(target_ - eye());
 glm::mat4 OrbitCamera::view() const { return glm::lookAtRH(eye(), target_, glm::vec3(0.0f, 1.0f, 0.0f)); }
 
 glm::mat4 OrbitCamera::projection(float aspect) const {
-  glm::mat4 p = glm::perspectiveRH_ZO(glm::radians(kFovDegrees), aspect, kNear, kFar);
+  glm::mat4 p = glm::perspectiveRH_ZO(glm::radians(kFovDegrees), aspect, kNear * scale_, kFar * scale_);
   p[1][1] *= -1.0f; // Vulkan clip space has y pointing down
   return p;
 }
@@ -67,7 +72,7 @@ Ray OrbitCamera::ray(float x, float y, float width, float height) const {
 
 std::optional<glm::vec2> OrbitCamera::viewPoint(glm::vec3 p, float aspect) const {
   const glm::vec4 clip = projection(aspect) * view() * glm::vec4(p, 1.0f);
-  if (clip.w <= kNear) return std::nullopt;
+  if (clip.w <= kNear * scale_) return std::nullopt;
   return glm::vec2(clip) / clip.w;
 }
 

@@ -22,12 +22,12 @@ public:
   /// Smallest and largest polar angle (keeps the eye off the poles).
   static constexpr float kMinPhi = 0.1f;
   static constexpr float kMaxPhi = 3.14159265f - 0.1f;
-  /// Zoom range (distance to the target).
+  /// Zoom range (distance to the target) at scale 1.
   static constexpr float kMinRadius = 3.0f;
   static constexpr float kMaxRadius = 30.0f;
   /// Vertical field of view in degrees.
   static constexpr float kFovDegrees = 50.0f;
-  /// Near and far clip planes.
+  /// Near and far clip planes at scale 1.
   static constexpr float kNear = 0.1f;
   static constexpr float kFar = 200.0f;
 
@@ -35,10 +35,15 @@ public:
   OrbitCamera();
   /// Places the eye at `eye` looking at `target` (radius and phi clamped to their ranges).
   void lookAt(glm::vec3 eye, glm::vec3 target);
+  /// Scales the zoom range and the clip planes (SimParams::view_scale: a scene of another size).
+  void setScale(float scale);
+  float scale() const { return scale_; }
+  float minRadius() const { return kMinRadius * scale_; }
+  float maxRadius() const { return kMaxRadius * scale_; }
 
   /// Orbits by a cursor movement in pixels (right-drag).
   void orbit(float dx_pixels, float dy_pixels);
-  /// Zooms by wheel steps (positive = closer), keeping the radius in [3, 30].
+  /// Zooms by wheel steps (positive = closer), keeping the radius in [3, 30] x scale.
   void zoom(float wheel_steps);
   /// Pans the target by a cursor movement in pixels in a viewport of this height (middle-drag).
   void pan(float dx_pixels, float dy_pixels, float viewport_height);
@@ -67,6 +72,7 @@ public:
 private:
   glm::vec3 target_{0.0f, 1.0f, 0.0f};
   float radius_ = 1.0f, theta_ = 0.0f, phi_ = 1.0f;
+  float scale_ = 1.0f;
 };
 
 /// Eases an orbit camera after a sheet that leaves the view (a toss): once the centre of the

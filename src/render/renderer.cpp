@@ -6,6 +6,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "core/sheet.h"
+
 namespace tender::render {
 namespace {
 
@@ -27,10 +29,21 @@ VkSampleCountFlagBits pickSamples(const VkPhysicalDeviceProperties& p, uint32_t 
 SceneView defaultSceneView(const SimParams& p) {
   SceneView v;
   v.floor_y = p.floor_y;
-  float height = float(p.rows > 0 ? p.rows - 1 : 0) * p.spacing;
-  float top = std::max(1.0f + 0.5f * height, p.floor_y + 1.0f + height);
+  const float s = p.view_scale;
+  const SheetPlacement at = sheetPlacement(p);
+  const float top = at.top;
+  v.scale = s;
   v.focus = glm::vec3(0.0f, 0.5f * (top + p.floor_y), 0.0f);
-  v.extent = std::max(8.0f, 0.5f * (top - p.floor_y) + 3.0f);
+  v.extent = std::max(8.0f * s, 0.5f * (top - p.floor_y) + 3.0f * s);
+  if (s != 1.0f) {
+    // A scene of another size: the spec's view, scaled, of the sheet's start and the ground below
+    // it, the target between them (and halfway along a tilted sheet's lean).
+    v.camera.setScale(s);
+    const glm::vec3 target(0.0f, 0.5f * (top + p.floor_y), -0.5f * at.length * at.back);
+    v.camera.lookAt(target + glm::vec3(4.0f, 10.0f, 9.0f) * s, target);
+    v.focus = target;
+    v.ground = v.extent; // as far as the shadow reaches
+  }
   return v;
 }
 
@@ -241,8 +254,10 @@ void Renderer::writeUniforms(uint32_t slot, const SceneView& view) {
   u.view_proj = view.camera.projection(aspect) * view.camera.view();
   // Directional light from the upper right of the start view.
   const glm::vec3 to_light = glm::normalize(glm::vec3(7.0f, 10.0f, 6.0f));
-  glm::mat4 light_view = glm::lookAtRH(view.focus + to_light * 40.0f, view.focus, glm::vec3(0.0f, 1.0f, 0.0f));
-  glm::mat4 light_proj = glm::orthoRH_ZO(-view.extent, view.extent, -view.extent, view.extent, 1.0f, 80.0f);
+  glm::mat4 light_view =
+      glm::lookAtRH(view.focus + to_light * (40.0f * view.scale), view.focus, glm::vec3(0.0f, 1.0f, 0.0f));
+  glm::mat4 light_proj =
+      glm::orthoRH_ZO(-view.extent, view.extent, -view.extent, view.extent, view.scale, 80.0f * view.scale);
   u.light_view_proj = light_proj * light_view;
   u.eye = glm::vec4(view.camera.eye(), 1.0f);
   u.light_dir = glm::vec4(to_light, 0.8f);
@@ -251,7 +266,7 @@ void Renderer::writeUniforms(uint32_t slot, const SceneView& view) {
   u.ground = hexColor(0xd0ccc8, 0.5f);
   u.bg_top = hexColor(0xe8e4e0);
   u.bg_bottom = hexColor(0xd8d4d0);
-  u.floor = glm::vec4(view.floor_y, 5.0f, 1.0f, 1.0f / float(RENDER_SHADOW_SIZE));
+  u.floor = glm::vec4(view.floor_y, view.ground, view.scale, 1.0f / float(RENDER_SHADOW_SIZE));
   std::memcpy(uniforms_[slot].mapped, &u, sizeof(u));
 }
 

@@ -26,6 +26,8 @@ struct SceneView {
   float floor_y = -6.0f;
   glm::vec3 focus{0.0f, 0.0f, 0.0f}; ///< centre of the shadow map's box
   float extent = 10.0f;              ///< half size of the shadow map's box
+  float scale = 1.0f;                ///< size of the scene (SimParams::view_scale): grid, light
+  float ground = 5.0f;               ///< half size of the ground square
 };
 
 /// The scene view of a parameter set: the spec's camera, the floor, a shadow box covering the

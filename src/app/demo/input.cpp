@@ -168,7 +168,7 @@ bool isCrumple(const SimParams& p) { return p.preset.rfind("crumple", 0) == 0; }
 } // namespace
 
 render::OrbitCamera DemoApp::startView(const SimParams& p) {
-  render::OrbitCamera c;
+  render::OrbitCamera c = render::defaultSceneView(p).camera;
   if (isCrumple(p)) c.lookAt({7.0f, 3.0f, 19.0f}, {0.0f, -1.8f, 0.0f});
   return c;
 }
