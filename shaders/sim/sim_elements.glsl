@@ -282,7 +282,9 @@ void tearCompact(uint k) {
     color_range[k].y = scratch[range.x + range.y] - scratch[range.x];
   }
   if (k == 0u) {
-    uint live = scratch[m + counters.triangle_count] - scratch[m];
+    // At most the sheet's triangles, whatever the scan held: the renderer draws this many, and a
+    // count gone wrong must not make a draw of billions of vertices
+    uint live = min(scratch[m + counters.triangle_count] - scratch[m], u.triangle_count);
     counters.triangle_count = live;
     counters.draw_args.x = 3u * live;
   }
