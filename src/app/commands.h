@@ -52,6 +52,20 @@ struct DiffOptions {
   std::string a, b; ///< backends: cpu, gpu, gpu:N, gpu-percolor, gpu-percolor:N
 };
 
+/// `tender sweep`, as given on the command line (runSweep parses and checks it).
+struct SweepOptions {
+  std::vector<std::string> vary;                  ///< KEY=v1,v2,... or KEY=a:b:n; KEY=a:b with --samples
+  std::string ticks, samples, seed, batch, shard; ///< empty: not given
+  std::string out;                                ///< the folder of sheets.jsonl and sweep.json
+  bool ply = false;                               ///< also DIR/sheet_NNNNNN.ply per sheet
+};
+
+/// `tender sweep-merge`: the shards' folders and the folder of the whole sweep.
+struct SweepMergeOptions {
+  std::vector<std::string> dirs;
+  std::string out;
+};
+
 struct RenderOptions {
   uint64_t ticks = 0;
   std::string out = "tender.png";
@@ -84,6 +98,11 @@ int runPresets(const std::string& name);
 /// `tender diff`: 0 when the two backends give bitwise the same states every tick, 1 when they
 /// part (where is printed), 2 on bad input.
 int runDiff(const CommonOptions& common, const DiffOptions& o);
+/// `tender sweep`: the sheets of a grid or a sample of parameter values (of one shard), in batches;
+/// writes DIR/sheets.jsonl (one line of stats per sheet) and DIR/sweep.json (its definition).
+int runSweep(const CommonOptions& common, const SweepOptions& o);
+/// `tender sweep-merge`: joins the shards of one sweep into the whole sweep's files.
+int runSweepMerge(const SweepMergeOptions& o);
 int runRender(const CommonOptions& common, const RenderOptions& o);
 /// The offscreen picture `tender render` (and its --video) asks for: the sheet, backend, device,
 /// size and input script of these options (the ticks are the caller's).

@@ -139,6 +139,32 @@ int main(int argc, char** argv) {
   diff_cmd->footer("Exit status: 0 identical, 1 the backends differ (the first tick, substep, pass and\n"
                    "particle or constraint are printed), 2 bad input.");
 
+  SweepOptions sweep;
+  CLI::App* sweep_cmd =
+      app.add_subcommand("sweep", "run many sheets, each with its own values of some parameters, in batches");
+  addCommon(*sweep_cmd, common, true);
+  sweep_cmd->add_option("--vary", sweep.vary, "KEY=v1,v2,... or KEY=a:b:n (n values from a to b); repeat for a grid")
+      ->required();
+  sweep_cmd->add_option("--samples", sweep.samples, "draw N random sheets from the ranges KEY=a:b instead of a grid");
+  sweep_cmd->add_option("--seed", sweep.seed, "seed of --samples (default 0)");
+  sweep_cmd->add_option("--script", common.script, "input script every sheet replays");
+  sweep_cmd->add_option("--ticks", sweep.ticks, "ticks every sheet runs (decimal)")->required();
+  sweep_cmd->add_option("--batch", sweep.batch,
+                        "most sheets per batch (default: cpu 64, gpu 1024, less if memory is short)");
+  sweep_cmd->add_option("--shard", sweep.shard, "i/n: run only the sheets whose index is i modulo n");
+  sweep_cmd->add_option("--out", sweep.out, "folder of sheets.jsonl and sweep.json")->required();
+  sweep_cmd->add_flag("--ply", sweep.ply, "also write each sheet's end state as DIR/sheet_NNNNNN.ply");
+  sweep_cmd->footer("Grid order: the last --vary changes fastest. Each line of sheets.jsonl holds the sheet's index,\n"
+                    "its values and `tender sim --stats`'s fields; how its batch ran is under \"batch\".\n\n" +
+                    keyList());
+
+  SweepMergeOptions merge;
+  CLI::App* merge_cmd = app.add_subcommand("sweep-merge", "join the shards of a sweep (tender sweep --shard) into one");
+  merge_cmd->add_option("dirs", merge.dirs, "the shards' folders")->required();
+  merge_cmd->add_option("--out", merge.out, "folder of the whole sweep's sheets.jsonl and sweep.json")->required();
+  merge_cmd->footer("The folders must hold shards of one sweep that together have every sheet exactly once;\n"
+                    "otherwise one line names what differs or the missing or doubled sheets (exit status 2).");
+
   CLI::App* devices_cmd = app.add_subcommand("devices", "list the Vulkan devices");
   addCommon(*devices_cmd, common, false);
 
@@ -155,6 +181,7 @@ int main(int argc, char** argv) {
   }
   if (*devices_cmd) return runDevices(common);
   if (*presets_cmd) return runPresets(dump_preset);
+  if (*merge_cmd) return runSweepMerge(merge);
   if (*diff_cmd) common.backend = "cpu"; // each side is checked for its own backend
   if (auto err = resolve(common)) return fail(*err);
   if (auto err = parseWhole(sim_ticks, 0, kMaxTicks, sim.ticks)) return fail("--ticks: " + *err);
@@ -170,6 +197,7 @@ int main(int argc, char** argv) {
     if (*sim_cmd) return runSim(common, sim);
     if (*render_cmd) return runRender(common, render);
     if (*diff_cmd) return runDiff(common, diff);
+    if (*sweep_cmd) return runSweep(common, sweep);
     return runDemo(common, demo);
   } catch (const std::exception& e) { // a Vulkan error at run time, out of memory
     return fail(e.what());

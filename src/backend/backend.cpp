@@ -70,7 +70,7 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
 #endif
 }
 
-std::optional<std::string> fleetFits(const std::string& backend, const SimParams& params) {
+std::optional<std::string> fleetFits(const std::string& backend, [[maybe_unused]] const SimParams& params) {
   if (backend == "cpu") return std::nullopt;
 #ifdef TENDER_HAS_GPU
   return gpu::GpuFleet::fits(params);

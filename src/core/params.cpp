@@ -26,7 +26,6 @@ struct Param {
   ParamInfo info;
   std::function<std::optional<std::string>(SimParams&, const std::string&)> set;
   std::function<std::string(const SimParams&)> get; ///< the value, spelled as `set` takes it
-  bool whole = false;                               ///< a whole number (else a float, if a number)
 };
 
 // The shortest decimal that reads back as the same float.
@@ -72,10 +71,9 @@ Param floatParam(const char* key, float SimParams::*m, float lo, float hi, const
           [m](const SimParams& p) { return shortest(p.*m); }};
 }
 Param uintParam(const char* key, uint32_t SimParams::*m, uint32_t lo, uint32_t hi, const char* help) {
-  return {{key, help, double(lo), double(hi)},
+  return {{key, help, double(lo), double(hi), true},
           [m, lo, hi](SimParams& p, const std::string& v) { return parseUint(v, lo, hi, p.*m); },
-          [m](const SimParams& p) { return std::to_string(p.*m); },
-          true};
+          [m](const SimParams& p) { return std::to_string(p.*m); }};
 }
 Param boolParam(const char* key, bool SimParams::*m, const char* help) {
   return {{key, help},
@@ -277,7 +275,7 @@ std::string presetJson(const SimParams& p) {
         j[param.info.key] = v == "on";
       else
         j[param.info.key] = v;
-    } else if (param.whole) {
+    } else if (param.info.whole) {
       j[param.info.key] = std::stoull(v);
     } else {
       // The float's shortest decimal as a double prints as the same digits.

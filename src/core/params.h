@@ -91,6 +91,7 @@ struct ParamInfo {
   std::string key;
   std::string help;
   double lo = 0.0, hi = 0.0; ///< accepted range of a number (lo == hi: not a number)
+  bool whole = false;        ///< a whole number (else a float, if a number)
 };
 /// All keys accepted by `--set`.
 const std::vector<ParamInfo>& paramKeys();
