@@ -108,6 +108,30 @@ if command -v gnuplot >/dev/null && [ -f "$tmp/b.json" ]; then
   fi
 fi
 
+# Fleets: --batch runs batches of sheets per size and backend; the fleet plot draws them.
+if "$B" --sizes 8x12 --backends "$backends" --batch 1,3 --ticks 2 --warmup 0 --no-peak --json "$tmp/f.json" \
+  >"$tmp/out" 2>&1 && python3 - "$tmp/f.json" "$backends" <<'PY'; then
+import json, sys
+j = json.load(open(sys.argv[1]))
+b = j["batches"]
+assert [(r["backend"], r["batch"]) for r in b] == [(k, n) for k in sys.argv[2].split(",") for n in (1, 3)], b
+for r in b:
+    assert r["status"] == "ok", r
+    assert abs(r["sheet_ticks_per_s"] - 1000.0 * r["batch"] / r["ms_median"]) < 1e-6 * r["sheet_ticks_per_s"], r
+    assert r["speedup_vs_single"] > 0 and r["dispatches_per_tick"] >= 1, r
+PY
+  echo "ok: --batch 1,3 ran a fleet per backend"
+else
+  echo "FAIL: --batch"; cat "$tmp/out"; failures=$((failures + 1))
+fi
+if command -v gnuplot >/dev/null && [ -f "$tmp/f.json" ]; then
+  if "$(dirname "$0")/../tools/plot-fleet" -o "$tmp/f.png" "$tmp/f.json" >/dev/null && [ -s "$tmp/f.png" ]; then
+    echo "ok: plot-fleet wrote a PNG"
+  else
+    echo "FAIL: plot-fleet"; failures=$((failures + 1))
+  fi
+fi
+
 expect_bad() { # args...: must exit 2 with one stderr line
   "$B" "$@" >"$tmp/out" 2>"$tmp/err"
   local rc=$? lines
@@ -126,6 +150,8 @@ expect_bad --preset nope
 expect_bad --set nope=1
 expect_bad --set damping=2
 expect_bad --ticks 0
+expect_bad --sizes 8x12 --batch 0
+expect_bad --sizes 8x12 --batch 1,x
 expect_bad --bogus
 expect_bad --sizes 8x12 --max-seconds nan
 expect_bad --sizes 8x12 --max-cpu-particles -1
