@@ -67,6 +67,9 @@ if [ -f "$report" ]; then
   [ -s "$tmp/report/bench.json" ] && [ -s "$tmp/report/bench.csv" ] || fail "no bench.json or bench.csv"
   grep -q '^32x48 *gpu *64 *[0-9.]' "$report" || fail "report.md has no fleet table with a batch of 64"
   [ -s "$tmp/report/fleet.json" ] || fail "no fleet.json"
+  if command -v gnuplot >/dev/null && command -v python3 >/dev/null; then
+    [ -s "$tmp/report/fleet.png" ] || fail "no fleet.png (gnuplot and python3 are here)"
+  fi
   for f in "$tmp"/report/*.tmp "$tmp"/report/.*.tmp "$tmp"/report/logs/*.tmp; do
     [ -e "$f" ] && fail "a temporary file is left: $f"
   done
