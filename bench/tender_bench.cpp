@@ -158,24 +158,41 @@ private:
   bool tty_;
 };
 
-/// Runs one size on one backend and returns its JSON record.
-nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& size, const std::string& backend,
-                       const std::string& label, Progress& progress) {
+/// The JSON record of a case: its size and backend.
+nlohmann::json caseRecord(const Size& size, const std::string& backend) {
   nlohmann::json r;
   r["size"] = size.text();
   r["cols"] = size.cols;
   r["rows"] = size.rows;
   r["particles"] = uint64_t(size.cols) * size.rows;
   r["backend"] = backend;
-  auto skip = [&](const std::string& why) {
+  return r;
+}
+
+/// Marks record `r` skipped with the reason, says so, and returns it.
+auto skipper(nlohmann::json& r, const std::string& label, Progress& progress) {
+  return [&r, &label, &progress](const std::string& why) {
     r["status"] = "skipped";
     r["reason"] = why;
     progress.update(label + ": skipped (" + why + ")", true);
     return r;
   };
+}
+
+/// The parameters of a case (benchParams), checked for the backend; returns why they cannot run.
+std::optional<std::string> caseParams(const BenchOptions& o, const Size& size, const std::string& backend,
+                                      SimParams& p) {
+  if (auto err = benchParams(o, size, p)) return err;
+  return validate(p, backend);
+}
+
+/// Runs one size on one backend and returns its JSON record.
+nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& size, const std::string& backend,
+                       const std::string& label, Progress& progress) {
+  nlohmann::json r = caseRecord(size, backend);
+  auto skip = skipper(r, label, progress);
   SimParams p;
-  if (auto err = benchParams(o, size, p)) return skip(*err);
-  if (auto err = validate(p, backend)) return skip(*err);
+  if (auto err = caseParams(o, size, backend, p)) return skip(*err);
   if (backend == "cpu" && uint64_t(p.particleCount()) > o.max_cpu_particles)
     return skip("over --max-cpu-particles " + std::to_string(o.max_cpu_particles));
   r["spacing"] = p.spacing;
@@ -305,22 +322,11 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
 /// second, and the speed-up over single-sheet runs of the same size (`single_ms`, per tick).
 nlohmann::json runBatchCase(const BenchOptions& o, const Size& size, const std::string& backend, uint32_t sheets,
                             double single_ms, const std::string& label, Progress& progress) {
-  nlohmann::json r;
-  r["size"] = size.text();
-  r["cols"] = size.cols;
-  r["rows"] = size.rows;
-  r["particles"] = uint64_t(size.cols) * size.rows;
-  r["backend"] = backend;
+  nlohmann::json r = caseRecord(size, backend);
   r["batch"] = sheets;
-  auto skip = [&](const std::string& why) {
-    r["status"] = "skipped";
-    r["reason"] = why;
-    progress.update(label + ": skipped (" + why + ")", true);
-    return r;
-  };
+  auto skip = skipper(r, label, progress);
   SimParams p;
-  if (auto err = benchParams(o, size, p)) return skip(*err);
-  if (auto err = validate(p, backend)) return skip(*err);
+  if (auto err = caseParams(o, size, backend, p)) return skip(*err);
   if (auto err = fleetFits(backend, p)) return skip(*err);
   if (estimateSheetBytes(p, backend) * sheets > availableMemoryBytes())
     return skip("a batch of " + std::to_string(sheets) + " sheets needs more memory than this machine has");

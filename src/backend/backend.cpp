@@ -11,6 +11,23 @@
 
 namespace tender {
 
+#ifdef TENDER_HAS_GPU
+namespace {
+
+/// A Vulkan context of the options' device (and validation); one line on failure.
+std::optional<std::string> createContext(const BackendOptions& o, std::unique_ptr<gpu::VulkanContext>& out) {
+  gpu::ContextOptions co;
+  co.device = o.device;
+  co.validation = o.validation;
+  auto ctx = gpu::VulkanContext::create(co);
+  if (!ctx) return ctx.error() + " (try --backend cpu)";
+  out = std::move(ctx.value());
+  return std::nullopt;
+}
+
+} // namespace
+#endif
+
 BackendOptions backendOptionsFor(const std::string& backend, const SimParams& params) {
   BackendOptions o;
   o.backend = backend;
@@ -47,15 +64,13 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
 #ifdef TENDER_HAS_GPU
   try {
     std::unique_ptr<gpu::GpuSolver> solver;
+    std::unique_ptr<gpu::VulkanContext> ctx;
     if (o.context) {
       solver = std::make_unique<gpu::GpuSolver>(*o.context);
+    } else if (auto err = createContext(o, ctx)) {
+      return err;
     } else {
-      gpu::ContextOptions co;
-      co.device = o.device;
-      co.validation = o.validation;
-      auto ctx = gpu::VulkanContext::create(co);
-      if (!ctx) return ctx.error() + " (try --backend cpu)";
-      solver = std::make_unique<gpu::GpuSolver>(std::move(ctx.value()));
+      solver = std::make_unique<gpu::GpuSolver>(std::move(ctx));
     }
     if (o.backend == "gpu-percolor") solver->setFusedPath(false);
     out.gpu = solver.get();
@@ -92,15 +107,13 @@ std::optional<std::string> createBatch(const BackendOptions& o, uint32_t sheets,
   if (o.backend != "gpu") return "a fleet runs on cpu or gpu, not '" + o.backend + "'";
 #ifdef TENDER_HAS_GPU
   try {
+    std::unique_ptr<gpu::VulkanContext> ctx;
     if (o.context) {
       out = std::make_unique<gpu::GpuFleet>(*o.context, sheets);
+    } else if (auto err = createContext(o, ctx)) {
+      return err;
     } else {
-      gpu::ContextOptions co;
-      co.device = o.device;
-      co.validation = o.validation;
-      auto ctx = gpu::VulkanContext::create(co);
-      if (!ctx) return ctx.error() + " (try --backend cpu)";
-      out = std::make_unique<gpu::GpuFleet>(std::move(ctx.value()), sheets);
+      out = std::make_unique<gpu::GpuFleet>(std::move(ctx), sheets);
     }
   } catch (const std::exception& e) {
     out.reset();
