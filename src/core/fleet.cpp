@@ -30,6 +30,17 @@ Fleet::Fleet(SheetBatch& batch, const std::vector<FleetSheet>& sheets) : batch_(
   }
 }
 
+void SheetBatch::readPositions(std::vector<glm::vec4>& pos, std::vector<glm::vec4>& prev) {
+  pos.clear();
+  prev.clear();
+  SimState s;
+  for (uint32_t i = 0; i < size(); ++i) {
+    sheet(i).readback(s);
+    pos.insert(pos.end(), s.pos.begin(), s.pos.end());
+    prev.insert(prev.end(), s.prev.begin(), s.prev.end());
+  }
+}
+
 void Fleet::tick() {
   // Every sheet's events first (a grab reads its particle back), then every sheet's tick queued
   for (auto& sim : sims_) sim->applyDueEvents();

@@ -36,6 +36,9 @@ public:
   virtual uint64_t memoryBytes() const = 0;
   /// Dispatches (GPU) or sheet jobs (CPU) of the last flush.
   virtual uint32_t dispatchesPerFlush() const = 0;
+  /// Every sheet's positions and previous positions, sheet after sheet (size() x N each), in one
+  /// read-back where the backend can (runs the queued ticks first).
+  virtual void readPositions(std::vector<glm::vec4>& pos, std::vector<glm::vec4>& prev);
 };
 
 /// One sheet of a fleet: its parameters and its input script (empty: none).

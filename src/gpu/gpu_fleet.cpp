@@ -263,6 +263,31 @@ void GpuFleet::readSheetDeltas(uint32_t i, std::vector<glm::vec4>& out) {
   ctx_.download(buf_[SIM_BIND_DELTA], out.data(), 16ull * out.size(), sliceOffset(SIM_BIND_DELTA, i));
 }
 
+void GpuFleet::readPositions(std::vector<glm::vec4>& pos, std::vector<glm::vec4>& prev) {
+  flush();
+  finish();
+  const uint32_t n = topo_.particleCount();
+  const VkDeviceSize bytes = 16ull * n * size();
+  pos.resize(size_t(n) * size());
+  prev.resize(pos.size());
+  if (!allocated_ || bytes == 0) return;
+  // Both arrays of every sheet into one host buffer, in one submission.
+  Buffer staging = ctx_.createHostBuffer(2 * bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  ctx_.submitOnce([&](VkCommandBuffer cmd) {
+    std::vector<VkBufferCopy> pos_regions, prev_regions;
+    for (uint32_t i = 0; i < size(); ++i) {
+      pos_regions.push_back({sliceOffset(SIM_BIND_POS, i), 16ull * n * i, 16ull * n});
+      prev_regions.push_back({sliceOffset(SIM_BIND_PREV, i), bytes + 16ull * n * i, 16ull * n});
+    }
+    vkCmdCopyBuffer(cmd, buf_[SIM_BIND_POS].buffer, staging.buffer, uint32_t(pos_regions.size()), pos_regions.data());
+    vkCmdCopyBuffer(cmd, buf_[SIM_BIND_PREV].buffer, staging.buffer, uint32_t(prev_regions.size()),
+                    prev_regions.data());
+  });
+  std::memcpy(pos.data(), staging.mapped, size_t(bytes));
+  std::memcpy(prev.data(), static_cast<const char*>(staging.mapped) + bytes, size_t(bytes));
+  ctx_.destroyBuffer(staging);
+}
+
 void GpuFleet::finish() {
   if (!pending_) return;
   VK_CHECK(vkWaitForFences(ctx_.device(), 1, &fence_, VK_TRUE, UINT64_MAX));

@@ -41,6 +41,7 @@ public:
   void finish() override;
   uint64_t memoryBytes() const override;
   uint32_t dispatchesPerFlush() const override { return last_dispatches_; }
+  void readPositions(std::vector<glm::vec4>& pos, std::vector<glm::vec4>& prev) override;
   VulkanContext& context() { return ctx_; }
 
 private:

@@ -337,16 +337,18 @@ public:
     }
   }
 
-  /// (B, N, 3) float32 of every sheet's positions, or of (pos - prev) / substep dt.
+  /// (B, N, 3) float32 of every sheet's positions, or of (pos - prev) / substep dt (one read-back).
   py::array_t<float> positions(bool velocities) {
     const size_t b = fleet_->size(), n = fleet_->sim(0).topology().particleCount();
+    std::vector<glm::vec4> pos, prev;
+    batch_->readPositions(pos, prev);
     py::array_t<float> a({py::ssize_t(b), py::ssize_t(n), py::ssize_t(3)});
     auto m = a.mutable_unchecked<3>();
     for (size_t i = 0; i < b; ++i) {
-      SimState s = state(i);
       const float dt = fleet_->sim(uint32_t(i)).params().substepDt();
       for (size_t j = 0; j < n; ++j) {
-        const glm::vec3 v = velocities ? (glm::vec3(s.pos[j]) - glm::vec3(s.prev[j])) / dt : glm::vec3(s.pos[j]);
+        const glm::vec3 p(pos[i * n + j]), q(prev[i * n + j]);
+        const glm::vec3 v = velocities ? (p - q) / dt : p;
         for (int k = 0; k < 3; ++k) m(py::ssize_t(i), py::ssize_t(j), k) = v[k];
       }
     }
@@ -368,8 +370,12 @@ public:
   }
 
   std::vector<std::string> stateHashes() {
+    const size_t n = fleet_->sim(0).topology().particleCount();
+    std::vector<glm::vec4> pos, prev;
+    batch_->readPositions(pos, prev);
     std::vector<std::string> out;
-    for (uint32_t i = 0; i < fleet_->size(); ++i) out.push_back(hashHex(hashPositions(state(i).pos)));
+    for (size_t i = 0; i < fleet_->size(); ++i)
+      out.push_back(hashHex(hashPositions(std::vector<glm::vec4>(pos.begin() + i * n, pos.begin() + (i + 1) * n))));
     return out;
   }
 

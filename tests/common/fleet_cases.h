@@ -64,10 +64,20 @@ inline uint32_t expectFleetMatchesAlone(SheetBatch& batch, Solver& alone, const 
                                         int ticks) {
   Fleet fleet(batch, sheets);
   for (int t = 0; t < ticks; ++t) fleet.tick();
+  // Every sheet's positions in one read-back, as each sheet's own read-back gives them
+  std::vector<glm::vec4> all_pos, all_prev;
+  batch.readPositions(all_pos, all_prev);
+  const size_t n = fleet.sim(0).topology().particleCount();
+  EXPECT_EQ(all_pos.size(), n * sheets.size());
+  EXPECT_EQ(all_prev.size(), n * sheets.size());
   uint32_t tore = 0;
   for (uint32_t i = 0; i < sheets.size(); ++i) {
     SimState a, b;
     fleet.sim(i).solver().readback(a);
+    if (all_pos.size() == n * sheets.size()) {
+      EXPECT_TRUE(sameBytes(a.pos, std::vector<glm::vec4>(all_pos.begin() + i * n, all_pos.begin() + (i + 1) * n)));
+      EXPECT_TRUE(sameBytes(a.prev, std::vector<glm::vec4>(all_prev.begin() + i * n, all_prev.begin() + (i + 1) * n)));
+    }
     Simulation sim(sheets[i].params, alone);
     sim.setScript(sheets[i].script);
     b = run(sim, ticks);
