@@ -78,6 +78,11 @@ glm::vec3 QueuedSolver::particlePosition(uint32_t index) {
   return inner_.particlePosition(index);
 }
 
+std::vector<glm::vec3> QueuedSolver::particlePositions(const std::vector<uint32_t>& indices) {
+  batch_.flush();
+  return inner_.particlePositions(indices);
+}
+
 void QueuedSolver::readback(SimState& out) {
   batch_.flush();
   inner_.readback(out);

@@ -89,6 +89,7 @@ public:
   void computeNormals() override;
   shaderio::PickResult pick(glm::vec3 o, glm::vec3 d, float radius) override;
   glm::vec3 particlePosition(uint32_t index) override;
+  std::vector<glm::vec3> particlePositions(const std::vector<uint32_t>& indices) override;
   void readback(SimState& out) override;
   void finish() override;
   uint32_t dispatchesPerTick() const override { return inner_.dispatchesPerTick(); }

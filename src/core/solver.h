@@ -54,6 +54,12 @@ public:
   virtual shaderio::PickResult pick(glm::vec3 o, glm::vec3 d, float radius) = 0;
   /// Position of one particle (a small read-back, used when a grab starts).
   virtual glm::vec3 particlePosition(uint32_t index) = 0;
+  /// Positions of several particles, in one read-back where the backend can.
+  virtual std::vector<glm::vec3> particlePositions(const std::vector<uint32_t>& indices) {
+    std::vector<glm::vec3> out;
+    for (uint32_t i : indices) out.push_back(particlePosition(i));
+    return out;
+  }
   /// Copies the whole state to the host.
   virtual void readback(SimState& out) = 0;
   /// Waits until every tick submitted so far has finished (the GPU runs asynchronously; the CPU

@@ -36,9 +36,7 @@ public:
   /// The normals are computed from the positions when the state is read back.
   void computeNormals() override {}
   PickResult pick(glm::vec3 o, glm::vec3 d, float radius) override {
-    SimState s;
-    fleet_.readSheet(index_, s);
-    return pickNearest(s.pos, o, d, radius);
+    return pickNearest(fleet_.readSheetPositions(index_), o, d, radius);
   }
   glm::vec3 particlePosition(uint32_t index) override { return glm::vec3(fleet_.readParticle(index_, index)); }
   void readback(SimState& out) override { fleet_.readSheet(index_, out); }
@@ -255,6 +253,13 @@ glm::vec4 GpuFleet::readParticle(uint32_t i, uint32_t particle) {
   glm::vec4 p;
   ctx_.download(buf_[SIM_BIND_POS], &p, sizeof(p), sliceOffset(SIM_BIND_POS, i) + 16ull * particle);
   return p;
+}
+
+std::vector<glm::vec4> GpuFleet::readSheetPositions(uint32_t i) {
+  finish();
+  std::vector<glm::vec4> pos(topo_.particleCount());
+  ctx_.download(buf_[SIM_BIND_POS], pos.data(), 16ull * pos.size(), sliceOffset(SIM_BIND_POS, i));
+  return pos;
 }
 
 void GpuFleet::readSheetDeltas(uint32_t i, std::vector<glm::vec4>& out) {

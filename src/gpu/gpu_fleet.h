@@ -55,6 +55,7 @@ private:
   void resetSheet(uint32_t i);
   void readSheet(uint32_t i, SimState& out);
   glm::vec4 readParticle(uint32_t i, uint32_t particle);
+  std::vector<glm::vec4> readSheetPositions(uint32_t i);
   void readSheetDeltas(uint32_t i, std::vector<glm::vec4>& out);
   /// Copies `bytes` of each (binding, sheet) slice listed into one host buffer; returns it.
   Buffer download(const std::vector<std::pair<uint32_t, VkDeviceSize>>& slices, uint32_t sheet,

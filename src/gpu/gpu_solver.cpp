@@ -175,7 +175,7 @@ void GpuSolver::createPipelines(FusedShape fused) {
     qci.queryCount = 2;
     VK_CHECK(vkCreateQueryPool(dev, &qci, nullptr, &normals_queries_));
   }
-  small_readback_ = ctx_.createHostBuffer(64, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  small_readback_ = ctx_.createHostBuffer(256, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
 }
 
 void GpuSolver::writeStaticUniforms() {
@@ -283,15 +283,29 @@ PickResult GpuSolver::pick(glm::vec3 o, glm::vec3 d, float radius) {
   return r;
 }
 
-glm::vec3 GpuSolver::particlePosition(uint32_t index) {
+glm::vec3 GpuSolver::particlePosition(uint32_t index) { return particlePositions({index})[0]; }
+
+std::vector<glm::vec3> GpuSolver::particlePositions(const std::vector<uint32_t>& indices) {
   finish();
+  std::vector<glm::vec3> out(indices.size());
+  if (indices.empty()) return out;
+  // Into the small read-back buffer when they fit, a buffer of their own otherwise.
+  Buffer own;
+  const VkDeviceSize bytes = 16ull * indices.size();
+  if (bytes > small_readback_.size) own = ctx_.createHostBuffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  const Buffer& dst = own.buffer ? own : small_readback_;
   ctx_.submitOnce([&](VkCommandBuffer cmd) {
-    VkBufferCopy region{16ull * index, 0, 16};
-    vkCmdCopyBuffer(cmd, buf_[SIM_BIND_POS].buffer, small_readback_.buffer, 1, &region);
+    std::vector<VkBufferCopy> regions;
+    for (size_t k = 0; k < indices.size(); ++k) regions.push_back({16ull * indices[k], 16ull * k, 16});
+    vkCmdCopyBuffer(cmd, buf_[SIM_BIND_POS].buffer, dst.buffer, uint32_t(regions.size()), regions.data());
   });
-  glm::vec4 p;
-  std::memcpy(&p, small_readback_.mapped, sizeof(p));
-  return glm::vec3(p);
+  for (size_t k = 0; k < indices.size(); ++k) {
+    glm::vec4 p;
+    std::memcpy(&p, static_cast<const char*>(dst.mapped) + 16 * k, sizeof(p));
+    out[k] = glm::vec3(p);
+  }
+  ctx_.destroyBuffer(own);
+  return out;
 }
 
 PassTimes GpuSolver::passTimes() const {

@@ -67,6 +67,8 @@ public:
   void computeNormals() override;
   shaderio::PickResult pick(glm::vec3 o, glm::vec3 d, float radius) override;
   glm::vec3 particlePosition(uint32_t index) override;
+  /// One submission copies every particle's position (the camera follow's samples each frame).
+  std::vector<glm::vec3> particlePositions(const std::vector<uint32_t>& indices) override;
   void readback(SimState& out) override;
   PassTimes passTimes() const override;
   uint32_t dispatchesPerTick() const override { return dispatches_per_tick_; }

@@ -259,6 +259,15 @@ TYPED_TEST_P(SolverCase, PickFindsTheNearestParticleAndWhereItIs) {
   EXPECT_TRUE(sim.grabRay(target + glm::vec3(0.0f, 0.0f, 5.0f), glm::vec3(0.0f, 0.0f, -1.0f)));
   EXPECT_EQ(sim.grabbed(), 200u);
   EXPECT_EQ(solver->particlePosition(200), target);
+  // Several positions in one read-back: a few (the camera follow's 9) and more than a small
+  // buffer holds, in the order asked
+  for (uint32_t count : {9u, 40u}) {
+    std::vector<uint32_t> indices;
+    for (uint32_t k = 0; k < count; ++k) indices.push_back((k * 37u + 5u) % uint32_t(s.pos.size()));
+    const std::vector<glm::vec3> got = solver->particlePositions(indices);
+    ASSERT_EQ(got.size(), indices.size());
+    for (uint32_t k = 0; k < count; ++k) EXPECT_EQ(got[k], glm::vec3(s.pos[indices[k]])) << k;
+  }
 }
 
 REGISTER_TYPED_TEST_SUITE_P(SolverCase, FreeFallMatchesDampedVerlet, HangingSheetSettles, PinsNeverMove,

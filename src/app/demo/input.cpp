@@ -189,11 +189,10 @@ void DemoApp::setFollow(bool on) {
 
 std::vector<glm::vec3> DemoApp::sheetSamples() const {
   const SheetTopology& t = sim_->topology();
-  std::vector<glm::vec3> points;
+  std::vector<uint32_t> samples;
   for (uint32_t r = 0; r < 3; ++r)
-    for (uint32_t c = 0; c < 3; ++c)
-      points.push_back(backend_.solver->particlePosition((t.rows - 1) * r / 2 * t.cols + (t.cols - 1) * c / 2));
-  return points;
+    for (uint32_t c = 0; c < 3; ++c) samples.push_back((t.rows - 1) * r / 2 * t.cols + (t.cols - 1) * c / 2);
+  return backend_.solver->particlePositions(samples);
 }
 
 void DemoApp::updateFollow(float dt) {
