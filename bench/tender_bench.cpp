@@ -327,7 +327,6 @@ nlohmann::json runBatchCase(const BenchOptions& o, const Size& size, const std::
   auto skip = skipper(r, label, progress);
   SimParams p;
   if (auto err = caseParams(o, size, backend, p)) return skip(*err);
-  if (auto err = fleetFits(backend, p)) return skip(*err);
   if (estimateSheetBytes(p, backend) * sheets > availableMemoryBytes())
     return skip("a batch of " + std::to_string(sheets) + " sheets needs more memory than this machine has");
   BackendOptions bo = backendOptionsFor(backend, p);

@@ -66,13 +66,34 @@
 #define SIM_BIND_CANDIDATES 26
 #define SIM_BIND_CANDIDATE_BASE 27
 #define SIM_BIND_HASH_ARGS 28
-// The batched fused tick of a fleet (tick_batch.comp) reaches each binding's buffer through its
-// device address instead: the fleet's table (BatchPush.table) holds, per binding (SIM_BIND_*; the
-// uniforms are one SimUniforms per sheet), the address of sheet 0's slice and the bytes from one
-// sheet's slice to the next, then at SIM_BATCH_QUEUE the list of sheets to tick (one per workgroup)
+// A fleet's shaders (tick_batch.comp, and the per-colour passes built with SIM_BATCH_PASS) reach
+// each binding's buffer through its device address instead: the fleet's table (BatchArgs.table)
+// holds, per binding (SIM_BIND_*; the uniforms are one SimUniforms per sheet), the address of sheet
+// 0's slice and the bytes from one sheet's slice to the next, then at SIM_BATCH_QUEUE the list of
+// sheets to tick (one per workgroup of tick_batch, one per workgroup z of a pass)
 #define SIM_BATCH_QUEUE 29
 // Entries of the fleet's table
 #define SIM_BATCH_ENTRIES 30
+// Which sheets of a batch a per-colour pass runs for (BatchArgs.gate). The batch records the
+// passes of its most substeps and iterations, with air and collision when any sheet has them; a
+// sheet runs a pass exactly when the same sheet ticking alone records or dispatches it. Every
+// gate but SIM_GATE_RESET takes only the sheets that tick (no animated reset) and have the substep.
+// SIM_GATE_TICK: no further condition (integrate, floor, tear_mark)
+#define SIM_GATE_TICK 0u
+// SIM_GATE_AIR: the sheet has air (air)
+#define SIM_GATE_AIR 1u
+// SIM_GATE_ITERATION: the sheet has iteration BatchArgs.gate_arg (project)
+#define SIM_GATE_ITERATION 2u
+// SIM_GATE_COLLISION: the sheet has collision (candidates_*, collide)
+#define SIM_GATE_COLLISION 3u
+// SIM_GATE_HASH: the sheet has collision and its lists do not stand in for the hash this substep
+// (the hash passes, which alone run the grid candidates_decide gives them)
+#define SIM_GATE_HASH 4u
+// SIM_GATE_COMPACTION: something of the sheet tore this substep (the compaction passes, which
+// alone run the grid tear_mark gives them)
+#define SIM_GATE_COMPACTION 5u
+// SIM_GATE_RESET: the sheet runs a frame of the animated reset (reset)
+#define SIM_GATE_RESET 6u
 // Sheets per hardware thread that one dispatch of a fleet takes on a CPU device, which runs a
 // substep per dispatch: each thread keeps its sheet's arrays (under 1 MiB for 32 x 48) in its
 // cache through every substep before the next sheets start (lavapipe, 2 threads, 64 sheets of

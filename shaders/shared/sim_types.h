@@ -81,13 +81,30 @@ struct FusedPush {
   uint stop;          // last pass of the tick to run (passesPerSubstep numbering), SIM_NONE: all
 };
 
-/// Push constants of the batched fused tick of a fleet (tick_batch.comp): the fused tick's, and the
-/// device address of the fleet's table (SIM_BATCH_* in sim_config.h).
+/// What every dispatch of a fleet adds to its pass's push constants: the device address of the
+/// fleet's table (SIM_BATCH_* in sim_config.h), where its sheets start in the table's queue, and
+/// (the per-colour passes, tick_batch's aside) which of those sheets the pass runs for.
+struct BatchArgs {
+  uvec2 table;  // address (low, high 32 bits) of SIM_BATCH_ENTRIES uvec4: xy sheet 0's address, zw the stride
+  uint first;   // the dispatch's sheet k (workgroup k of the fused tick, workgroup z = k of a pass) is queue[first + k]
+  uint substep; // the pass's substep
+  uint gate;    // SIM_GATE_*: the sheets the pass runs for
+  uint gate_arg; // SIM_GATE_ITERATION: the iteration
+  uint pad0;
+  uint pad1;
+};
+
+/// Push constants of the batched fused tick of a fleet (tick_batch.comp).
 struct BatchPush {
   FusedPush fused;
-  uvec2 table; // address (low, high 32 bits) of SIM_BATCH_ENTRIES uvec4: xy sheet 0's address, zw the stride
-  uint first;  // workgroup g ticks the sheet at first + g in the queue
-  uint pad0;
+  BatchArgs batch;
+};
+
+/// Push constants of a batched per-colour pass (shaders/sim/*.comp built with SIM_BATCH_PASS): the
+/// pass's own (SimPush or ScanPush, both 16 bytes; zeros for a pass without), then the batch's.
+struct BatchPassPush {
+  SimPush pass;
+  BatchArgs batch;
 };
 
 /// GPU counters: tear bookkeeping and indirect arguments (one storage buffer).

@@ -2,9 +2,9 @@
 // The air on each particle (SIM_FLAG_AIR: airOnParticle) into delta, which integration reads next.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
+#define SIM_PUSH_TYPE SimPush
 #include "sim_common.glsl"
 #include "sim_elements.glsl"
-layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uint i = threadIndex();

@@ -4,8 +4,8 @@
 // that the hash passes and collide pick the substep's mode (collideModeNow) alike.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
+#define SIM_PUSH_TYPE SimPush
 #include "sim_common.glsl"
-layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uint i = threadIndex();

@@ -3,8 +3,8 @@
 // hash passes of this substep, their full grids, or none when the lists stand in for the hash.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE 1
+#define SIM_PUSH_TYPE SimPush
 #include "sim_common.glsl"
-layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   bool skip = collideModeNow() == SIM_COLLIDE_CANDIDATES;

@@ -3,8 +3,8 @@
 // for the next substep, and the substep's flags cleared.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE 1
+#define SIM_PUSH_TYPE SimPush
 #include "sim_common.glsl"
-layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uvec4 flags = counters.candidate_flags;

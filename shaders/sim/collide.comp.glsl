@@ -4,9 +4,9 @@
 // Cells, and particles within a cell, are summed in the CPU reference's order.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_COLLIDE
+#define SIM_PUSH_TYPE SimPush
 #include "sim_common.glsl"
 #include "sim_elements.glsl"
-layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uint i = threadIndex();

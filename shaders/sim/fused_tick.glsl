@@ -10,12 +10,12 @@
 #define SIM_LOCAL_SIZE_SPECIALIZED
 // Invocations exchange data through buffers between barriers
 #define SIM_COHERENT coherent
+#define SIM_PUSH_TYPE FusedPush
 #include "sim_common.glsl"
 shared vec4 s_pos[SIM_FUSED_MAX_PARTICLES];
 #define SIM_POSITION(j) s_pos[j]
 #include "sim_elements.glsl"
 #ifndef SIM_BATCH
-layout(push_constant) uniform PushBlock { FusedPush p; };
 #endif
 
 // Invocations of the workgroup (specialised)

@@ -3,8 +3,8 @@
 // particles, a toss places the released particle with its drag velocity. Workgroup size (sim_common.glsl declares it
 // and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
+#define SIM_PUSH_TYPE SimPush
 #include "sim_common.glsl"
-layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uint i = threadIndex();

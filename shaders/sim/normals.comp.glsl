@@ -2,8 +2,8 @@
 // Smooth grid normals from central differences (clamped at the edges).
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
+#define SIM_PUSH_TYPE SimPush
 #include "sim_common.glsl"
-layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uint idx = threadIndex();

@@ -5,8 +5,8 @@
 // Squared distances are >= 0, so their float bits order like the floats (atomicMin on uint).
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
+#define SIM_PUSH_TYPE PickPush
 #include "sim_common.glsl"
-layout(push_constant) uniform PushBlock { PickPush p; };
 layout(constant_id = 0) const uint kStep = 0u;
 
 void main() {

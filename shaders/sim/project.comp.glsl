@@ -2,8 +2,8 @@
 // Projects the live constraints of one colour (no two share a particle, so no races).
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PROJECT
+#define SIM_PUSH_TYPE SimPush
 #include "sim_common.glsl"
-layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uint t = threadIndex();

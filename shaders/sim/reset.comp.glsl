@@ -2,8 +2,8 @@
 // One frame of the animated reset: positions blend from where they were to their start.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
+#define SIM_PUSH_TYPE SimPush
 #include "sim_common.glsl"
-layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uint i = threadIndex();

@@ -3,8 +3,8 @@
 // scratch[sums + block]. Blocks are combined by scanning the sums and adding them back (scan_add).
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_SCAN
+#define SIM_PUSH_TYPE ScanPush
 #include "sim_common.glsl"
-layout(push_constant) uniform PushBlock { ScanPush p; };
 
 shared uint partial[SIM_WG_SCAN];
 

@@ -2,8 +2,8 @@
 // Adds each block's scanned offset (scratch[sums + block]) to the elements of that block.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_TEAR
+#define SIM_PUSH_TYPE ScanPush
 #include "sim_common.glsl"
-layout(push_constant) uniform PushBlock { ScanPush p; };
 
 void main() {
   uint i = threadIndex();

@@ -21,18 +21,32 @@ layout(local_size_x = SIM_LOCAL_SIZE) in;
 #define SIM_COHERENT
 #endif
 
-#ifdef SIM_BATCH
-// The batched fused tick of a fleet: every array is sheet sheet's slice of its buffer, reached by
-// device address (SIM_BATCH_* in sim_config.h); the names below stand for those slices, so the
-// passes' code reads the same in both builds.
+// A fleet's shaders: tick_batch.comp (SIM_BATCH: the fused tick, a sheet per workgroup) and the
+// per-colour passes built with SIM_BATCH_PASS (a sheet per workgroup z, BatchArgs.gate choosing the
+// sheets). Every array is the sheet's slice of its buffer, reached by device address (SIM_BATCH_*
+// in sim_config.h); the names below stand for those slices, so the passes' code reads the same in
+// every build.
+#if defined(SIM_BATCH) || defined(SIM_BATCH_PASS)
+#define SIM_BATCHED
+#endif
+
+// Every pass names the type of its push constants (SimPush, ScanPush, ...) in SIM_PUSH_TYPE before
+// including this file; a fleet's shaders follow them with BatchArgs.
+#ifdef SIM_BATCHED
+#ifndef SIM_PUSH_TYPE
+#define SIM_PUSH_TYPE uvec4
+#endif
+layout(push_constant) uniform PushBlock {
+  SIM_PUSH_TYPE p;
+  BatchArgs batch;
+};
+#elif defined(SIM_PUSH_TYPE)
+layout(push_constant) uniform PushBlock { SIM_PUSH_TYPE p; };
+#endif
+
+#ifdef SIM_BATCHED
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
-// BatchPush's members (`p` as in the fused tick, then the table's address)
-layout(push_constant) uniform PushBlock {
-  FusedPush p;
-  uvec2 batch_table;
-  uint batch_first;
-};
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BatchTableRef { uvec4 entry[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer QueueRef { uint sheet[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer UniformsRef { SimUniforms v; };
@@ -51,15 +65,16 @@ Uvec2Ref g_color_range, g_tri_edges;
 UintRef g_adj_offsets, g_adj_list, g_adj_mask, g_cell_count, g_cell_start, g_cell_particles, g_particle_cell, g_torn,
     g_scratch, g_cell_scatter, g_candidates;
 Uvec4Ref g_triangles, g_compact_tmp, g_cell_pos;
+Uvec4Ref g_hash_args;
 CountersRef g_counters;
 
 // The sheet workgroup `group` ticks, and the address of its slice of binding `binding`.
 uint batchSheet(uint group) {
-  return QueueRef(uint64_t(packUint2x32(BatchTableRef(packUint2x32(batch_table)).entry[SIM_BATCH_QUEUE].xy)))
-      .sheet[batch_first + group];
+  return QueueRef(uint64_t(packUint2x32(BatchTableRef(packUint2x32(batch.table)).entry[SIM_BATCH_QUEUE].xy)))
+      .sheet[batch.first + group];
 }
 uint64_t batchSlice(uint binding, uint sheet) {
-  uvec4 e = BatchTableRef(packUint2x32(batch_table)).entry[binding];
+  uvec4 e = BatchTableRef(packUint2x32(batch.table)).entry[binding];
   return packUint2x32(e.xy) + uint64_t(sheet) * packUint2x32(e.zw);
 }
 // Points every array at the slices of `sheet`.
@@ -89,6 +104,7 @@ void bindSheet(uint sheet) {
   g_triangles = Uvec4Ref(batchSlice(SIM_BIND_TRIANGLES, sheet));
   g_compact_tmp = Uvec4Ref(batchSlice(SIM_BIND_COMPACT_TMP, sheet));
   g_cell_pos = Uvec4Ref(batchSlice(SIM_BIND_CELL_POS, sheet));
+  g_hash_args = Uvec4Ref(batchSlice(SIM_BIND_HASH_ARGS, sheet));
   g_counters = CountersRef(batchSlice(SIM_BIND_COUNTERS, sheet));
 }
 #define u g_u.v
@@ -116,6 +132,7 @@ void bindSheet(uint sheet) {
 #define triangles g_triangles.v
 #define compact_tmp g_compact_tmp.v
 #define cell_pos g_cell_pos.v
+#define hash_args g_hash_args.v
 #define counters g_counters.v
 #else
 layout(std140, set = 0, binding = SIM_BIND_UNIFORMS) uniform UniformsBlock { SimUniforms u; };
@@ -208,5 +225,36 @@ uint collideModeNow() { return collideModeOf(counters.candidate_state, counters.
 
 // Slots the tear compaction covers: constraints, triangles, and one end slot for the totals.
 uint compactSlots() { return u.constraint_count + u.triangle_count + 1u; }
+
+#ifdef SIM_BATCH_PASS
+// A per-colour pass of a fleet: workgroup z works on the sheet at queue[batch.first + z], when the
+// pass's gate takes it (SIM_GATE_* in sim_config.h); the pass's own main() follows as simPassMain.
+bool batchGateTakes() {
+  if (batch.gate == SIM_GATE_RESET) return u.reset_active != 0u;
+  if (u.reset_active != 0u || batch.substep >= substepCount(u.substeps)) return false;
+  bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
+  switch (batch.gate) {
+  case SIM_GATE_AIR:
+    return (u.flags & SIM_FLAG_AIR) != 0u;
+  case SIM_GATE_ITERATION:
+    return batch.gate_arg < u.iterations;
+  case SIM_GATE_COLLISION:
+    return collision;
+  case SIM_GATE_HASH:
+    return collision && collideModeNow() != SIM_COLLIDE_CANDIDATES;
+  case SIM_GATE_COMPACTION:
+    return counters.compact_dispatch.x != 0u;
+  default:
+    return true;
+  }
+}
+
+void simPassMain();
+void main() {
+  bindSheet(batchSheet(gl_WorkGroupID.z));
+  if (batchGateTakes()) simPassMain(); // the whole workgroup takes the same branch
+}
+#define main simPassMain
+#endif
 
 #endif

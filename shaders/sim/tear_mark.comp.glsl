@@ -3,9 +3,9 @@
 // the indirect dispatch of the compaction passes (otherwise they run zero workgroups).
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_TEAR
+#define SIM_PUSH_TYPE SimPush
 #include "sim_common.glsl"
 #include "sim_elements.glsl"
-layout(push_constant) uniform PushBlock { SimPush p; };
 
 void main() {
   uint k = threadIndex();

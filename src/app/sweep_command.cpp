@@ -318,17 +318,12 @@ public:
          OutputSet& outputs, Progress& progress)
       : common_(common), plan_(plan), script_(script), dir_(dir), ply_(ply), outputs_(outputs), progress_(progress) {}
 
-  /// Runs every sheet of `indices`: those a batch takes in batches of plan.batch, the others
-  /// (sheets too large for a GPU batch) one at a time on their own solver.
+  /// Runs every sheet of `indices` in batches of plan.batch.
   std::optional<std::string> run(const std::vector<uint64_t>& indices) {
     std::vector<SweepSheet> pending;
     for (uint64_t index : indices) {
       SweepSheet sheet;
       if (auto err = makeSheet(plan_, index, sheet)) return err;
-      if (fleetFits(plan_.backend, sheet.params)) {
-        if (auto err = runAlone(sheet)) return err;
-        continue;
-      }
       pending.push_back(std::move(sheet));
       if (pending.size() == plan_.batch) {
         if (auto err = runBatch(pending)) return err;
@@ -368,18 +363,6 @@ private:
     for (uint32_t i = 0; i < fleet.size(); ++i)
       if (auto err = record(sheets[i], fleet.sim(i), ms, batch->name() == "gpu", fleet.size())) return err;
     return std::nullopt;
-  }
-
-  std::optional<std::string> runAlone(const SweepSheet& sheet) {
-    Backend backend;
-    if (auto err = createBackend(optionsFor(sheet.params), backend)) return err;
-    Simulation sim(sheet.params, *backend.solver);
-    sim.setScript(script_);
-    const auto ms = timedTicks(1, [&] {
-      sim.tick();
-      backend.solver->finish();
-    });
-    return record(sheet, sim, ms, backend.gpu != nullptr, 1);
   }
 
   /// Runs `tick` (one tick of `sheets` sheets, finished) the plan's number of times; returns the

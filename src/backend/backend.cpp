@@ -85,15 +85,6 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
 #endif
 }
 
-std::optional<std::string> fleetFits(const std::string& backend, [[maybe_unused]] const SimParams& params) {
-  if (backend == "cpu") return std::nullopt;
-#ifdef TENDER_HAS_GPU
-  return gpu::GpuFleet::fits(params);
-#else
-  return std::string("this build has no Vulkan backend (try --backend cpu)");
-#endif
-}
-
 std::optional<std::string> createBatch(const BackendOptions& o, uint32_t sheets, std::unique_ptr<SheetBatch>& out) {
   out.reset();
   if (sheets == 0) return std::string("a batch needs at least one sheet");

@@ -57,12 +57,8 @@ bool vulkanBuilt();
 std::optional<std::string> createBackend(const BackendOptions& options, Backend& out);
 
 /// Builds the batch of a fleet of `sheets` sheets ("cpu" or "gpu"; `threads` and `simd` for the
-/// CPU's workers and kernels); on failure returns one line and leaves `out` empty. A GPU batch
-/// runs sheets of at most SIM_FUSED_MAX_PARTICLES particles (fleetFits).
+/// CPU's workers and kernels); on failure returns one line and leaves `out` empty.
 std::optional<std::string> createBatch(const BackendOptions& options, uint32_t sheets,
                                        std::unique_ptr<SheetBatch>& out);
-/// Why sheets of these parameters cannot run as one batch on this backend ("gpu": only sheets the
-/// fused tick takes); nullopt when they can (a sweep runs such sheets one at a time instead).
-std::optional<std::string> fleetFits(const std::string& backend, const SimParams& params);
 
 } // namespace tender

@@ -16,8 +16,10 @@ static_assert(sizeof(Constraint) == 16);
 static_assert(sizeof(SimPush) == 16);
 static_assert(sizeof(Counters) == 80);
 static_assert(sizeof(FusedPush) == 16);
-static_assert(sizeof(BatchPush) == 32);
-static_assert(offsetof(BatchPush, table) == 16);
+static_assert(sizeof(BatchArgs) == 32);
+static_assert(sizeof(BatchPush) == 48 && offsetof(BatchPush, batch) == 16);
+static_assert(sizeof(BatchPassPush) == 48 && offsetof(BatchPassPush, batch) == 16 &&
+              sizeof(ScanPush) == sizeof(SimPush));
 static_assert(offsetof(Counters, compact_dispatch) == 16);
 static_assert(offsetof(Counters, draw_args) == 32);
 static_assert(sizeof(PickResult) == 32);

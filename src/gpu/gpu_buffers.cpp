@@ -49,9 +49,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
   VK_CHECK(vkDeviceWaitIdle(dev));
   destroySheet();
   topo_ = topo;
-  spacing_ = std::numeric_limits<float>::max();
-  for (const Constraint& k : topo.constraints)
-    if ((k.kind_id & SIM_KIND_MASK) == SIM_KIND_STRUCTURAL) spacing_ = std::min(spacing_, k.rest);
+  spacing_ = structuralSpacing(topo);
   const VkDeviceSize max_range = ctx_.properties().limits.maxStorageBufferRange;
   layout_sizes_ = SheetLayout::of(topo, max_range);
   hash_grids_.clear();

@@ -8,6 +8,7 @@
 
 #include "core/host_queries.h"
 #include "gpu/barriers.h"
+#include "gpu/gpu_solver.h"
 
 namespace tender::gpu {
 
@@ -61,17 +62,6 @@ GpuFleet::GpuFleet(std::unique_ptr<VulkanContext> ctx, uint32_t sheets)
   create(sheets);
 }
 
-std::optional<std::string> GpuFleet::fits(const SimParams& p) {
-  const SheetCounts c = sheetCounts(p);
-  if (c.particles > SIM_FUSED_MAX_PARTICLES || c.hash_buckets > SIM_FUSED_MAX_BUCKETS)
-    return "a " + std::to_string(p.cols) + "x" + std::to_string(p.rows) + " sheet is larger than a fleet's sheets (" +
-           std::to_string(SIM_FUSED_MAX_PARTICLES) + " particles at most)";
-  if (p.collision && p.cell_size > SIM_FUSED_CPU_MAX_CELL_SPACINGS * p.spacing)
-    return "a hash cell of " + std::to_string(p.cell_size / p.spacing) + " spacings is larger than a fleet's (" +
-           std::to_string(int(SIM_FUSED_CPU_MAX_CELL_SPACINGS)) + " at most)";
-  return std::nullopt;
-}
-
 void GpuFleet::create(uint32_t sheets) {
   if (sheets == 0 || sheets > ctx_.properties().limits.maxComputeWorkGroupCount[0])
     throw std::runtime_error("a GPU fleet runs 1 to " +
@@ -80,24 +70,27 @@ void GpuFleet::create(uint32_t sheets) {
   if (!ctx_.deviceAddresses())
     throw std::runtime_error("Vulkan device " + ctx_.info().name +
                              " cannot run a fleet: it lacks bufferDeviceAddress or shaderInt64 (try --backend cpu)");
-  if (ctx_.properties().limits.maxComputeSharedMemorySize < 16u * SIM_FUSED_MAX_PARTICLES)
-    throw std::runtime_error("Vulkan device " + ctx_.info().name +
-                             " cannot run a fleet: it has under 32 KiB of shared memory (try --backend cpu)");
   VkDevice dev = ctx_.device();
   VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, uint32_t(sizeof(BatchPush))};
+  static_assert(sizeof(BatchPush) == sizeof(BatchPassPush));
   VkPipelineLayoutCreateInfo pli{};
   pli.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
   pli.pushConstantRangeCount = 1;
   pli.pPushConstantRanges = &range;
   VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &layout_));
-  // The fused tick's shape on this kind of device (see FusedShape in gpu_solver.h)
+  float_rules_ = floatRulesFor(ctx_.floatControls());
+  math_ = MathSwitches::fromEnvironment();
+  passes_ = makePassPipelines(ctx_, layout_, float_rules_, math_, true, owned_pipelines_);
+  // The fused tick's shape on this kind of device (see FusedShape in gpu_solver.h); a device with
+  // too little shared memory for it runs every sheet's per-colour passes, as a sheet alone does.
   const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   const uint32_t workgroup = cpu_device ? SIM_WG_FUSED_CPU : SIM_WG_FUSED;
   substeps_per_dispatch_ = cpu_device ? SIM_FUSED_SUBSTEPS_CPU : SIM_MAX_SUBSTEPS;
+  fused_max_cell_spacings_ = cpu_device ? SIM_FUSED_CPU_MAX_CELL_SPACINGS : -1.0f;
   sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
-  float_rules_ = floatRulesFor(ctx_.floatControls());
-  math_ = MathSwitches::fromEnvironment();
-  pipeline_ = createSimPipeline(ctx_, "tick_batch.comp", layout_, float_rules_, math_, workgroup, module_);
+  if (ctx_.properties().limits.maxComputeSharedMemorySize >= 16u * SIM_FUSED_MAX_PARTICLES)
+    tick_batch_ = makeComputePipeline(ctx_, "tick_batch.comp", layout_, float_rules_, math_, sizeof(BatchPush), 1,
+                                      workgroup, true, owned_pipelines_);
 
   VkFenceCreateInfo fci{};
   fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
@@ -125,13 +118,13 @@ GpuFleet::~GpuFleet() {
   ctx_.destroyBuffer(inputs_);
   if (cmd_) vkFreeCommandBuffers(dev, ctx_.commandPool(), 1, &cmd_);
   if (fence_) vkDestroyFence(dev, fence_, nullptr);
-  if (pipeline_) vkDestroyPipeline(dev, pipeline_, nullptr);
-  if (module_) vkDestroyShaderModule(dev, module_, nullptr);
+  owned_pipelines_.destroy(dev);
   if (layout_) vkDestroyPipelineLayout(dev, layout_, nullptr);
 }
 
 void GpuFleet::allocate(const SheetTopology& topo) {
   topo_ = topo;
+  spacing_ = structuralSpacing(topo);
   sizes_ = SheetLayout::of(topo, ctx_.properties().limits.maxStorageBufferRange);
   const uint32_t sheets = size();
   StartData start;
@@ -300,10 +293,14 @@ void GpuFleet::finish() {
 }
 
 void GpuFleet::flush() {
-  // The queued sheets, their uniforms into the host buffer (the last flush has finished reading it)
+  // The queued sheets, their uniforms into the host buffer (the last flush has finished reading it).
+  // Each takes the path it takes alone: the fused tick or the per-colour passes.
   finish();
-  std::vector<uint32_t> queue;
-  uint32_t substeps = 0;
+  std::vector<uint32_t> fused, passes;
+  uint32_t fused_substeps = 0, pass_substeps = 0;
+  SubstepPlan plan;
+  bool resets = false;
+  const bool fits_fused = tick_batch_.pipeline && fusedTickFits(topo_);
   const VkDeviceSize uniforms_at = alignUp(4ull * size(), kSliceAlign);
   char* inputs = static_cast<char*>(inputs_.mapped);
   for (uint32_t i = 0; i < size(); ++i) {
@@ -313,11 +310,25 @@ void GpuFleet::flush() {
     q.reset();
     if (sizes_.candidates_fit) u.flags |= SIM_FLAG_CANDIDATES; // as the solver keeps them
     std::memcpy(inputs + uniforms_at + stride_[SIM_BIND_UNIFORMS] * i, &u, sizeof(u));
-    substeps = std::max(substeps, u.reset_active ? 1u : substepCount(u.substeps));
-    queue.push_back(i);
+    const uint32_t substeps = u.reset_active ? 0u : substepCount(u.substeps);
+    if (fits_fused && fusedTickTakes(u, spacing_, fused_max_cell_spacings_)) {
+      fused_substeps = std::max(fused_substeps, std::max(substeps, 1u));
+      fused.push_back(i);
+      continue;
+    }
+    passes.push_back(i);
+    resets = resets || u.reset_active;
+    if (u.reset_active) continue;
+    pass_substeps = std::max(pass_substeps, substeps);
+    plan.iterations = std::max(plan.iterations, u.iterations);
+    plan.collision = plan.collision || (u.flags & SIM_FLAG_COLLISION) != 0u;
+    plan.air = plan.air || (u.flags & SIM_FLAG_AIR) != 0u;
   }
-  if (queue.empty()) return;
+  if (fused.empty() && passes.empty()) return;
   last_dispatches_ = 0;
+  // The queue: the fused sheets, then the others
+  std::vector<uint32_t> queue = fused;
+  queue.insert(queue.end(), passes.begin(), passes.end());
   std::memcpy(inputs, queue.data(), 4 * queue.size());
 
   VkCommandBufferBeginInfo bi{};
@@ -334,28 +345,92 @@ void GpuFleet::flush() {
   VkBufferCopy queue_region{0, 0, 4ull * queue.size()};
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_QUEUE].buffer, 1, &queue_region);
   transferToCompute(cmd_);
-  vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-  // On a GPU one dispatch runs every sheet's whole tick. A CPU device runs a substep per dispatch
-  // (SIM_FUSED_SUBSTEPS_CPU): it takes the sheets a few at a time, each few through every substep,
-  // so that their arrays stay in the cache from one substep to the next.
+  bound_ = VK_NULL_HANDLE;
   const VkDeviceAddress table = ctx_.address(table_);
-  const uint32_t per_group = substeps_per_dispatch_ >= substeps ? uint32_t(queue.size()) : sheets_per_group_;
-  for (uint32_t first_sheet = 0; first_sheet < queue.size(); first_sheet += per_group)
-    for (uint32_t first = 0; first < substeps; first += substeps_per_dispatch_) {
-      if (last_dispatches_ > 0) computeToCompute(cmd_);
-      BatchPush push{};
-      push.fused = {topo_.particleCount(), first, substeps_per_dispatch_, SIM_NONE};
-      push.table = glm::uvec2(uint32_t(table), uint32_t(table >> 32));
-      push.first = first_sheet;
-      vkCmdPushConstants(cmd_, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
-      vkCmdDispatch(cmd_, std::min<uint32_t>(per_group, uint32_t(queue.size()) - first_sheet), 1, 1);
-      ++last_dispatches_;
+  if (!fused.empty()) {
+    // On a GPU one dispatch runs every fused sheet's whole tick. A CPU device runs a substep per
+    // dispatch (SIM_FUSED_SUBSTEPS_CPU): it takes the sheets a few at a time, each few through every
+    // substep, so that their arrays stay in the cache from one substep to the next.
+    vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, tick_batch_.pipeline);
+    bound_ = tick_batch_.pipeline;
+    const uint32_t count = uint32_t(fused.size());
+    const uint32_t per_group = substeps_per_dispatch_ >= fused_substeps ? count : sheets_per_group_;
+    uint32_t dispatched = 0;
+    for (uint32_t first_sheet = 0; first_sheet < count; first_sheet += per_group)
+      for (uint32_t first = 0; first < fused_substeps; first += substeps_per_dispatch_) {
+        if (dispatched++ > 0) computeToCompute(cmd_);
+        BatchPush push{};
+        push.fused = {topo_.particleCount(), first, substeps_per_dispatch_, SIM_NONE};
+        push.batch.table = glm::uvec2(uint32_t(table), uint32_t(table >> 32));
+        push.batch.first = first_sheet;
+        vkCmdPushConstants(cmd_, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+        vkCmdDispatch(cmd_, std::min(per_group, count - first_sheet), 1, 1);
+      }
+    last_dispatches_ += dispatched;
+  }
+  if (!passes.empty()) {
+    // The per-colour passes of the most substeps and iterations, each for every sheet; a sheet
+    // runs those it runs alone (the gates). They touch other sheets' slices than the fused tick.
+    pass_first_ = uint32_t(fused.size());
+    pass_sheets_ = uint32_t(passes.size());
+    const uint32_t n = topo_.particleCount();
+    if (resets) {
+      const SimPush all{0, n, 0, 0};
+      pass(passes_.reset, Grid::Threads, n, &all, sizeof(all), 0, SIM_GATE_RESET, 0);
+      barrier();
     }
+    uint32_t count = 0;
+    for (uint32_t s = 0; s < pass_substeps; ++s) recordSubstep(*this, passes_, topo_, sizes_, plan, s, count);
+  }
   allToAllAndHost(cmd_);
   VK_CHECK(vkEndCommandBuffer(cmd_));
   ctx_.submit(cmd_, fence_);
   pending_ = true;
 }
+
+void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
+                    uint32_t substep, uint32_t gate, uint32_t gate_arg) {
+  if (push_size > sizeof(SimPush) || p.push_size != sizeof(BatchPassPush))
+    vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
+  // The grid a sheet alone gets: from the element count; for the hash passes the full grid
+  // candidates_decide gives them, for the compaction the one tear_mark gives it (the gates skip
+  // the sheets whose grid is empty).
+  uint32_t groups = 1;
+  switch (grid) {
+  case Grid::Threads:
+  case Grid::Hash:
+    if (count == 0) return;
+    groups = (count + p.workgroup - 1) / p.workgroup;
+    break;
+  case Grid::Workgroup:
+    break;
+  case Grid::Compaction:
+    groups = (sizes_.tear_slots + SIM_WG_TEAR - 1) / SIM_WG_TEAR;
+    break;
+  }
+  const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X), gy = (groups + gx - 1) / gx;
+  BatchPassPush bp{};
+  if (push_size) std::memcpy(&bp.pass, push, push_size);
+  const VkDeviceAddress table = ctx_.address(table_);
+  bp.batch.table = glm::uvec2(uint32_t(table), uint32_t(table >> 32));
+  bp.batch.substep = substep;
+  bp.batch.gate = gate;
+  bp.batch.gate_arg = gate_arg;
+  if (bound_ != p.pipeline) {
+    vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+    bound_ = p.pipeline;
+  }
+  // A sheet per workgroup z, as many at a time as the device's grid takes
+  const uint32_t max_z = ctx_.properties().limits.maxComputeWorkGroupCount[2];
+  for (uint32_t first = 0; first < pass_sheets_; first += max_z) {
+    bp.batch.first = pass_first_ + first;
+    vkCmdPushConstants(cmd_, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(bp), &bp);
+    vkCmdDispatch(cmd_, gx, gy, std::min(max_z, pass_sheets_ - first));
+    ++last_dispatches_;
+  }
+}
+
+void GpuFleet::barrier() { computeToCompute(cmd_); }
 
 uint64_t GpuFleet::memoryBytes() const {
   uint64_t total = table_.size + inputs_.size;

@@ -1,9 +1,11 @@
 #pragma once
-/// A fleet of small sheets on Vulkan: each of the sheet's storage buffers holds a slice per sheet,
-/// and one dispatch of tick_batch.comp runs the fused tick of every queued sheet, one workgroup
-/// each, with its own uniforms (parameters, wind, grab). The shader reaches a sheet's slices by
-/// device address from a table (SIM_BATCH_* in sim_config.h); its arithmetic is the fused tick's,
-/// so sheet i ends bitwise where the same sheet run alone on the GPU ends.
+/// A fleet of sheets on Vulkan: each of the sheet's storage buffers holds a slice per sheet, and
+/// the shaders reach a sheet's slices by device address from a table (SIM_BATCH_* in sim_config.h).
+/// Sheets that take the fused tick run it in one dispatch of tick_batch.comp, one workgroup each;
+/// the others run the per-colour passes, each pass one dispatch for all of them (a sheet per
+/// workgroup z, the pass's gate picking the sheets it runs for). Every sheet has its own uniforms
+/// (parameters, wind, grab), and its arithmetic is that of the same sheet alone, so sheet i ends
+/// bitwise where the same sheet run alone on the GPU solver ends.
 #include <array>
 #include <memory>
 #include <optional>
@@ -14,25 +16,20 @@
 #include "gpu/context.h"
 #include "gpu/sheet_buffers.h"
 #include "gpu/sim_pipeline.h"
+#include "gpu/substep_passes.h"
 
 namespace tender::gpu {
 
-class GpuFleet final : public SheetBatch {
+class GpuFleet final : public SheetBatch, private PassSink {
 public:
   /// A fleet of `sheets` sheets on an existing context (it must outlive the fleet). Throws with
-  /// one line when the device cannot run it (no device addresses, too little shared memory).
+  /// one line when the device cannot run it (no device addresses).
   GpuFleet(VulkanContext& ctx, uint32_t sheets);
   /// A fleet that owns its context.
   GpuFleet(std::unique_ptr<VulkanContext> ctx, uint32_t sheets);
   ~GpuFleet() override;
   GpuFleet(const GpuFleet&) = delete;
   GpuFleet& operator=(const GpuFleet&) = delete;
-
-  /// Why sheets of these parameters cannot join a fleet (more than SIM_FUSED_MAX_PARTICLES
-  /// particles or SIM_FUSED_MAX_BUCKETS buckets; with collision, a hash cell over
-  /// SIM_FUSED_CPU_MAX_CELL_SPACINGS spacings, which a CPU device's fused tick does not take);
-  /// nullopt when they can.
-  static std::optional<std::string> fits(const SimParams& params);
 
   std::string name() const override { return "gpu"; }
   uint32_t size() const override { return uint32_t(queued_.size()); }
@@ -49,6 +46,11 @@ private:
   friend class Sheet;
 
   void create(uint32_t sheets);
+  // PassSink: a pass of the per-colour path for the sheets at queue[pass_first_, + pass_sheets_)
+  void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t substep,
+            uint32_t gate, uint32_t gate_arg) override;
+  void barrier() override;
+  void mark(PassCategory) override {}
   /// Allocates every buffer for the fleet from the first sheet's topology.
   void allocate(const SheetTopology& topo);
   void uploadSheet(uint32_t i, const SheetTopology& topo);
@@ -71,8 +73,13 @@ private:
   std::vector<std::unique_ptr<QueuedSolver>> queued_;
 
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
-  VkShaderModule module_ = VK_NULL_HANDLE;
+  PipelineSet owned_pipelines_;
+  ComputePipeline tick_batch_;            ///< the fused tick of a fleet (null: the device has too little shared memory)
+  SimPipelines passes_;                   ///< the per-colour passes of a fleet (SIM_BATCH_PASS)
+  float fused_max_cell_spacings_ = -1.0f; ///< largest hash cell the fused tick takes (< 0: any; FusedShape)
+  float spacing_ = 0.0f;                  ///< the sheets' grid spacing
+  uint32_t pass_first_ = 0, pass_sheets_ = 0; ///< the sheets in the queue the passes being recorded run for
+  VkPipeline bound_ = VK_NULL_HANDLE;         ///< pipeline bound while recording
   FloatRules float_rules_;
   MathSwitches math_;
   uint32_t substeps_per_dispatch_ = 1;

@@ -53,20 +53,7 @@ void GpuSolver::dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid gri
   ++recorded_dispatches_;
 }
 
-void GpuSolver::recordScan(VkCommandBuffer cmd, uint32_t mode, uint32_t offset, uint32_t count, uint32_t sums,
-                           Grid grid) {
-  // Exclusive scan: block scans, then (several blocks) scan the block sums and add them back.
-  const uint32_t blocks = (count + SIM_SCAN_BLOCK - 1) / SIM_SCAN_BLOCK;
-  ScanPush push{mode, offset, count, sums};
-  dispatch(cmd, pipes_.scan, grid, count, push);
-  computeToCompute(cmd);
-  if (blocks <= 1) return;
-  recordScan(cmd, SIM_SCAN_SCRATCH, sums, blocks, sums + blocks, grid);
-  dispatch(cmd, pipes_.scan_add, grid, count, push);
-  computeToCompute(cmd);
-}
-
-void GpuSolver::timestamp(VkCommandBuffer cmd, Slot& slot, Category c) {
+void GpuSolver::timestamp(VkCommandBuffer cmd, Slot& slot, PassCategory c) {
   if (!slot.queries) return;
   // Query k closes interval k - 1, which belongs to category c.
   const uint32_t q = uint32_t(slot.categories.size()) + 1;
@@ -75,76 +62,17 @@ void GpuSolver::timestamp(VkCommandBuffer cmd, Slot& slot, Category c) {
   slot.categories.push_back(uint8_t(c));
 }
 
-bool GpuSolver::recordSubstep(Slot& slot, const RecordKey& key, uint32_t s, uint32_t& pass) {
-  VkCommandBuffer cmd = slot.tick;
-  const uint32_t n = topo_.particleCount(), m = topo_.constraintCount();
-  const SimPush all{0, n, s, 0};
-  auto stops = [&] { return pass++ == key.stop; };
-  // 1. The air on each particle (integration reads it), then Verlet integration
-  if (key.air) {
-    dispatch(cmd, pipes_.air, Grid::Threads, n, all);
-    computeToCompute(cmd);
-  }
-  dispatch(cmd, pipes_.integrate, Grid::Threads, n, all);
-  computeToCompute(cmd);
-  timestamp(cmd, slot, kIntegrate);
-  if (stops()) return true;
-  // 2. Gauss-Seidel over colours; constraints beyond a colour's live count exit
-  for (uint32_t it = 0; it < key.iterations; ++it)
-    for (uint32_t c = 0; c < topo_.colorCount(); ++c) {
-      const ColorRange& range = topo_.colors[c];
-      if (range.count > 0) {
-        dispatch(cmd, pipes_.project, Grid::Threads, range.count, SimPush{range.first, range.count, s, c});
-        computeToCompute(cmd);
-      }
-      if (stops()) return true;
-    }
-  timestamp(cmd, slot, kProject);
-  if (key.collision) {
-    // 3. Candidate lists still good? Spatial hash: count, scan, scatter, order within bucket
-    // (each pass does nothing when the lists stand in for it); then gather repulsion and
-    // update the lists' state
-    dispatch(cmd, pipes_.candidates_check, Grid::Threads, n, all);
-    computeToCompute(cmd);
-    dispatch(cmd, pipes_.candidates_decide, Grid::Threads, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0});
-    computeToCompute(cmd);
-    hash_slot_ = 0;
-    dispatch(cmd, pipes_.hash_count, Grid::Hash, n, all);
-    computeToCompute(cmd);
-    recordScan(cmd, SIM_SCAN_HASH, 0, topo_.hash_size, layout_sizes_.hash_sums, Grid::Hash);
-    dispatch(cmd, pipes_.hash_scatter, Grid::Hash, n, all);
-    computeToCompute(cmd);
-    dispatch(cmd, pipes_.hash_sort, Grid::Hash, n, all);
-    computeToCompute(cmd);
-    timestamp(cmd, slot, kHash);
-    dispatch(cmd, pipes_.collide, Grid::Threads, n, all);
-    computeToCompute(cmd);
-    dispatch(cmd, pipes_.candidates_finish, Grid::Threads, 1, all);
-    computeToCompute(cmd);
-    timestamp(cmd, slot, kCollide);
-    if (stops()) return true;
-  }
-  // 4. Collision deltas and ground contact
-  dispatch(cmd, pipes_.floor, Grid::Threads, n, all);
-  computeToCompute(cmd);
-  timestamp(cmd, slot, kFloor);
-  if (stops()) return true;
-  // 5. Tear marking; what stood on the triangles lost and the compaction run zero workgroups
-  // unless something tore this substep
-  if (m > 0) {
-    dispatch(cmd, pipes_.tear_mark, Grid::Threads, m, SimPush{0, m, s, 0});
-    computeToCompute(cmd);
-    dispatch(cmd, pipes_.tear_unsupported, Grid::Compaction, 0, nullptr, 0);
-    computeToCompute(cmd);
-    dispatch(cmd, pipes_.tear_flags, Grid::Compaction, 0, nullptr, 0);
-    computeToCompute(cmd);
-    recordScan(cmd, SIM_SCAN_SCRATCH, 0, layout_sizes_.tear_slots, layout_sizes_.tear_sums, Grid::Compaction);
-    dispatch(cmd, pipes_.tear_compact, Grid::Compaction, 0, nullptr, 0);
-    computeToCompute(cmd);
-  }
-  timestamp(cmd, slot, kTear);
-  return stops();
+void GpuSolver::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
+                     uint32_t, uint32_t, uint32_t) {
+  // One sheet: it runs every pass recorded for it. Each run of hash passes takes the live hash
+  // arguments from the first.
+  if (grid != Grid::Hash) hash_slot_ = 0;
+  dispatch(recording_->tick, p, grid, count, push, push_size);
 }
+
+void GpuSolver::barrier() { computeToCompute(recording_->tick); }
+
+void GpuSolver::mark(PassCategory c) { timestamp(recording_->tick, *recording_, c); }
 
 void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
   VkCommandBuffer cmd = slot.tick;
@@ -173,8 +101,11 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
     timestamp(cmd, slot, kFused);
   } else {
     uint32_t pass = 0;
+    const SubstepPlan plan{key.iterations, key.collision, key.air, key.stop};
+    recording_ = &slot;
     for (uint32_t s = 0; s < key.substeps; ++s)
-      if (recordSubstep(slot, key, s, pass)) break;
+      if (recordSubstep(*this, pipes_, topo_, layout_sizes_, plan, s, pass)) break;
+    recording_ = nullptr;
   }
   computeToAll(cmd); // the renderer and copies see this tick
   VK_CHECK(vkEndCommandBuffer(cmd));

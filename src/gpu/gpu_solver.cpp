@@ -19,30 +19,6 @@ using namespace shaderio;
 static_assert(sizeof(ScanPush) == 16);
 static_assert(sizeof(PickPush) == 48);
 
-namespace {
-
-/// local_size_x of a compute shader's SPIR-V: its OpExecutionMode LocalSize, or the constant
-/// its OpExecutionModeId LocalSizeId names; 0 when that is a specialization constant.
-uint32_t localSizeX(std::span<const uint32_t> code) {
-  constexpr uint32_t kOpExecutionMode = 16, kOpExecutionModeId = 331, kOpConstant = 43;
-  constexpr uint32_t kLocalSize = 17, kLocalSizeId = 38;
-  uint32_t size_id = 0;
-  std::vector<std::pair<uint32_t, uint32_t>> constants; // result id, value
-  for (size_t w = 5; w < code.size();) {
-    const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
-    if (count == 0 || w + count > code.size()) break;
-    if (op == kOpExecutionMode && count >= 4 && code[w + 2] == kLocalSize) return code[w + 3];
-    if (op == kOpExecutionModeId && count >= 4 && code[w + 2] == kLocalSizeId) size_id = code[w + 3];
-    if (op == kOpConstant && count == 4) constants.emplace_back(code[w + 2], code[w + 3]);
-    w += count;
-  }
-  for (auto [id, value] : constants)
-    if (id == size_id) return value;
-  return 0;
-}
-
-} // namespace
-
 GpuSolver::GpuSolver(std::unique_ptr<VulkanContext> ctx) : owned_ctx_(std::move(ctx)), ctx_(*owned_ctx_) {
   createPipelines({});
 }
@@ -60,8 +36,7 @@ GpuSolver::~GpuSolver() {
   if (normals_fence_) vkDestroyFence(dev, normals_fence_, nullptr);
   if (normals_queries_) vkDestroyQueryPool(dev, normals_queries_, nullptr);
   ctx_.destroyBuffer(small_readback_);
-  for (VkPipeline p : pipelines_) vkDestroyPipeline(dev, p, nullptr);
-  for (VkShaderModule m : modules_) vkDestroyShaderModule(dev, m, nullptr);
+  owned_pipelines_.destroy(dev);
   if (layout_) vkDestroyPipelineLayout(dev, layout_, nullptr);
   if (set_layout_) vkDestroyDescriptorSetLayout(dev, set_layout_, nullptr);
 }
@@ -97,51 +72,7 @@ void GpuSolver::createPipelines(FusedShape fused) {
   // (TENDER_UNCORRECTED_MATH=1).
   float_rules_ = floatRulesFor(ctx_.floatControls());
   math_ = MathSwitches::fromEnvironment();
-  // spec: specialization constant 0 when >= 0 (the step of a pick pass, the fused tick's workgroup size)
-  auto make = [&](const char* key, uint32_t push_size, uint32_t per_invocation, int spec = -1) {
-    ComputePipeline p;
-    VkShaderModule module = VK_NULL_HANDLE;
-    p.pipeline = createSimPipeline(ctx_, key, layout_, float_rules_, math_,
-                                   spec >= 0 ? std::optional<uint32_t>(uint32_t(spec)) : std::nullopt, module);
-    modules_.push_back(module);
-    pipelines_.push_back(p.pipeline);
-    p.push_size = push_size;
-    // The workgroup size comes from the shader itself (its local_size_x, or the specialised size).
-    const uint32_t local =
-        spec >= 0 && std::string_view(key) == "tick_fused.comp" ? uint32_t(spec) : localSizeX(simShader(key));
-    if (local == 0) vkCheckFailed(VK_ERROR_INITIALIZATION_FAILED, key, __FILE__, __LINE__);
-    p.workgroup = local * per_invocation;
-    return p;
-  };
-  // Every pass: its shader, push constants and elements per invocation.
-  struct PipelineSpec {
-    ComputePipeline SimPipelines::*member;
-    const char* key;
-    uint32_t push_size, per_invocation;
-  };
-  constexpr uint32_t kSim = sizeof(SimPush), kScan = sizeof(ScanPush), kPick = sizeof(PickPush);
-  static constexpr PipelineSpec kPasses[] = {
-      {&SimPipelines::air, "air.comp", kSim, 1},
-      {&SimPipelines::integrate, "integrate.comp", kSim, 1},
-      {&SimPipelines::project, "project.comp", kSim, 1},
-      {&SimPipelines::candidates_check, "candidates_check.comp", kSim, 1},
-      {&SimPipelines::candidates_decide, "candidates_decide.comp", kSim, 1},
-      {&SimPipelines::hash_count, "hash_count.comp", kSim, 1},
-      {&SimPipelines::scan, "scan.comp", kScan, SIM_SCAN_PER_THREAD},
-      {&SimPipelines::scan_add, "scan_add.comp", kScan, 1},
-      {&SimPipelines::hash_scatter, "hash_scatter.comp", kSim, 1},
-      {&SimPipelines::hash_sort, "hash_sort.comp", kSim, 1},
-      {&SimPipelines::collide, "collide.comp", kSim, 1},
-      {&SimPipelines::candidates_finish, "candidates_finish.comp", kSim, 1},
-      {&SimPipelines::floor, "floor.comp", kSim, 1},
-      {&SimPipelines::tear_mark, "tear_mark.comp", kSim, 1},
-      {&SimPipelines::tear_unsupported, "tear_unsupported.comp", 0, 1},
-      {&SimPipelines::tear_flags, "tear_flags.comp", 0, 1},
-      {&SimPipelines::tear_compact, "tear_compact.comp", 0, 1},
-      {&SimPipelines::normals, "normals.comp", kSim, 1},
-      {&SimPipelines::reset, "reset.comp", kSim, 1},
-  };
-  for (const PipelineSpec& spec : kPasses) pipes_.*spec.member = make(spec.key, spec.push_size, spec.per_invocation);
+  pipes_ = makePassPipelines(ctx_, layout_, float_rules_, math_, false, owned_pipelines_);
   // The fused tick keeps the positions in shared memory; its shape suits the device.
   const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   uint32_t fused_workgroup = fused.workgroup ? fused.workgroup : cpu_device ? SIM_WG_FUSED_CPU : SIM_WG_FUSED;
@@ -153,8 +84,11 @@ void GpuSolver::createPipelines(FusedShape fused) {
                              : cpu_device                    ? SIM_FUSED_CPU_MAX_CELL_SPACINGS
                                                              : -1.0f;
   if (ctx_.properties().limits.maxComputeSharedMemorySize >= 16u * SIM_FUSED_MAX_PARTICLES)
-    pipes_.tick_fused = make("tick_fused.comp", kSim, 1, int(fused_workgroup));
-  for (int s = 0; s < 3; ++s) pipes_.pick[size_t(s)] = make("pick.comp", kPick, 1, s);
+    pipes_.tick_fused = makeComputePipeline(ctx_, "tick_fused.comp", layout_, float_rules_, math_, sizeof(FusedPush), 1,
+                                            fused_workgroup, true, owned_pipelines_);
+  for (uint32_t s = 0; s < 3; ++s)
+    pipes_.pick[s] = makeComputePipeline(ctx_, "pick.comp", layout_, float_rules_, math_, sizeof(PickPush), 1, s, false,
+                                         owned_pipelines_);
 
   // Per-slot fences and timestamp pools (chain of timestamps at pass boundaries).
   query_capacity_ = 2 + 6 * SIM_MAX_SUBSTEPS;
@@ -330,15 +264,26 @@ PassTimes GpuSolver::passTimes() const {
 
 Arithmetic GpuSolver::arithmetic() const { return arithmeticOf(float_rules_, math_); }
 
-bool GpuSolver::usesFusedPath() const {
-  return fused_allowed_ && pipes_.tick_fused.pipeline && topo_.particleCount() <= SIM_FUSED_MAX_PARTICLES &&
-         topo_.hash_size <= SIM_FUSED_MAX_BUCKETS;
+float structuralSpacing(const SheetTopology& topo) {
+  float spacing = std::numeric_limits<float>::max();
+  for (const Constraint& k : topo.constraints)
+    if ((k.kind_id & SIM_KIND_MASK) == SIM_KIND_STRUCTURAL) spacing = std::min(spacing, k.rest);
+  return spacing;
 }
 
+bool fusedTickFits(const SheetTopology& topo) {
+  return topo.particleCount() <= SIM_FUSED_MAX_PARTICLES && topo.hash_size <= SIM_FUSED_MAX_BUCKETS;
+}
+
+bool fusedTickTakes(const SimUniforms& u, float spacing, float max_cell_spacings) {
+  if ((u.flags & SIM_FLAG_COLLISION) == 0u || max_cell_spacings < 0.0f) return true;
+  return u.inv_cell * max_cell_spacings * spacing >= 1.0f;
+}
+
+bool GpuSolver::usesFusedPath() const { return fused_allowed_ && pipes_.tick_fused.pipeline && fusedTickFits(topo_); }
+
 bool GpuSolver::usesFusedPath(const SimUniforms& u) const {
-  if (!usesFusedPath()) return false;
-  if ((u.flags & SIM_FLAG_COLLISION) == 0u || fused_max_cell_spacings_ < 0.0f) return true;
-  return u.inv_cell * fused_max_cell_spacings_ * spacing_ >= 1.0f;
+  return usesFusedPath() && fusedTickTakes(u, spacing_, fused_max_cell_spacings_);
 }
 
 } // namespace tender::gpu

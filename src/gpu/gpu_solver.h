@@ -13,6 +13,7 @@
 #include "gpu/context.h"
 #include "gpu/sheet_buffers.h"
 #include "gpu/sim_pipeline.h"
+#include "gpu/substep_passes.h"
 
 namespace tender::gpu {
 
@@ -26,21 +27,17 @@ struct FusedShape {
   float max_cell_spacings = 0.0f;     ///< largest hash cell (in grid spacings) with collision on; < 0: any
 };
 
-/// A compute pipeline and what dispatching it needs.
-struct ComputePipeline {
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  uint32_t push_size = 0; ///< bytes of the shader's push-constant block (0: none)
-  uint32_t workgroup = 0; ///< elements one workgroup covers: local_size_x (from the SPIR-V) x elements per invocation
-};
+/// The grid spacing of a topology: its shortest structural rest length.
+float structuralSpacing(const SheetTopology& topo);
 
-/// Every pipeline of the simulation (one file per shader in shaders/sim/).
-struct SimPipelines {
-  ComputePipeline air, integrate, project, candidates_check, candidates_decide, hash_count, scan, scan_add,
-      hash_scatter, hash_sort, collide, candidates_finish, floor, tear_mark, tear_unsupported, tear_flags, tear_compact,
-      normals, reset;
-  ComputePipeline tick_fused; ///< null when the device has under 32 KiB of shared memory
-  std::array<ComputePipeline, 3> pick;
-};
+/// True when a sheet of this topology is small enough for the fused tick: at most
+/// SIM_FUSED_MAX_PARTICLES particles and SIM_FUSED_MAX_BUCKETS hash buckets.
+bool fusedTickFits(const SheetTopology& topo);
+
+/// True when a tick with these uniforms, of a sheet of grid spacing `spacing` that fits the fused
+/// tick, takes it on a device whose fused tick takes hash cells of at most `max_cell_spacings`
+/// spacings (< 0: any) when collision is on.
+bool fusedTickTakes(const shaderio::SimUniforms& u, float spacing, float max_cell_spacings);
 
 /// The Solver on Vulkan compute. Per substep: integrate, project (one dispatch per colour), hash
 /// count/scan/scatter/sort, collide, floor, tear mark, and the tear compaction as indirect
@@ -49,7 +46,7 @@ struct SimPipelines {
 /// dispatch per substep (see FusedShape). The fused tick keeps collision candidate lists with a
 /// skin (SIM_CANDIDATE_* in sim_config.h) and rebuilds the hash only when a particle has travelled too
 /// far for them; the sums, and so the results, are those of the hash search.
-class GpuSolver final : public Solver {
+class GpuSolver final : public Solver, private PassSink {
 public:
   /// A solver on an existing context (the renderer's); the context must outlive the solver.
   /// `fused` overrides the shape of the fused tick (the tests run a GPU's shape on lavapipe).
@@ -117,13 +114,6 @@ private:
   /// Uniform slot of the normals and pick passes (static: written at upload).
   static constexpr uint32_t kStaticSlot = kSlots;
   static constexpr uint32_t kBindingCount = SIM_BIND_HASH_ARGS + 1;
-  /// How a dispatch gets its grid: from the element count, one workgroup, the tear compaction's
-  /// arguments (zero workgroups unless something tore), or the next live hash-pass argument.
-  enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash };
-  /// Timestamp categories, in passTimes() order.
-  /// kFused: the fused small-sheet tick, every pass in one dispatch.
-  enum Category : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kFused, kCategoryCount };
-
   struct RecordKey {
     uint32_t substeps = 0, iterations = 0;
     bool collision = false;
@@ -150,9 +140,11 @@ private:
   void destroySheet();
   void writeStaticUniforms();
   void recordTick(Slot& slot, uint32_t index, const RecordKey& key);
-  /// Records the passes of substep s of the per-colour path; `pass` counts them. Returns true
-  /// when the tick stops within it (RecordKey::stop).
-  bool recordSubstep(Slot& slot, const RecordKey& key, uint32_t s, uint32_t& pass);
+  // PassSink: the passes of the per-colour path go to the tick being recorded (recording_)
+  void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t substep,
+            uint32_t gate, uint32_t gate_arg) override;
+  void barrier() override;
+  void mark(PassCategory c) override;
   void recordReset(Slot& slot, uint32_t index);
   void recordNormals();
   void bindSet(VkCommandBuffer cmd, uint32_t uniform_slot);
@@ -165,8 +157,7 @@ private:
   void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const Push& push) {
     dispatch(cmd, p, grid, count, &push, uint32_t(sizeof(Push)));
   }
-  void recordScan(VkCommandBuffer cmd, uint32_t mode, uint32_t offset, uint32_t count, uint32_t sums, Grid grid);
-  void timestamp(VkCommandBuffer cmd, Slot& slot, Category c);
+  void timestamp(VkCommandBuffer cmd, Slot& slot, PassCategory c);
   void waitSlot(Slot& slot) const;
   void collectTimes(const Slot& slot) const;
 
@@ -180,8 +171,8 @@ private:
   VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   SimPipelines pipes_;
-  std::vector<VkShaderModule> modules_;
-  std::vector<VkPipeline> pipelines_; ///< every pipeline created, for the destructor
+  PipelineSet owned_pipelines_; ///< every pipeline created, for the destructor
+  Slot* recording_ = nullptr;   ///< the slot whose tick is being recorded
 
   std::array<Buffer, kBindingCount> buf_{};
   Buffer small_readback_; ///< host-visible: pick result and particle positions

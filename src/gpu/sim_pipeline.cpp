@@ -61,6 +61,96 @@ VkPipeline createSimPipeline(VulkanContext& ctx, std::string_view key, VkPipelin
   return pipeline;
 }
 
+namespace {
+
+/// local_size_x of a compute shader's SPIR-V: its OpExecutionMode LocalSize, or the constant
+/// its OpExecutionModeId LocalSizeId names; 0 when that is a specialization constant.
+uint32_t localSizeX(std::span<const uint32_t> code) {
+  constexpr uint32_t kOpExecutionMode = 16, kOpExecutionModeId = 331, kOpConstant = 43;
+  constexpr uint32_t kLocalSize = 17, kLocalSizeId = 38;
+  uint32_t size_id = 0;
+  std::vector<std::pair<uint32_t, uint32_t>> constants; // result id, value
+  for (size_t w = 5; w < code.size();) {
+    const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
+    if (count == 0 || w + count > code.size()) break;
+    if (op == kOpExecutionMode && count >= 4 && code[w + 2] == kLocalSize) return code[w + 3];
+    if (op == kOpExecutionModeId && count >= 4 && code[w + 2] == kLocalSizeId) size_id = code[w + 3];
+    if (op == kOpConstant && count == 4) constants.emplace_back(code[w + 2], code[w + 3]);
+    w += count;
+  }
+  for (auto [id, value] : constants)
+    if (id == size_id) return value;
+  return 0;
+}
+
+} // namespace
+
+void PipelineSet::destroy(VkDevice dev) {
+  for (VkPipeline p : pipelines) vkDestroyPipeline(dev, p, nullptr);
+  for (VkShaderModule m : modules) vkDestroyShaderModule(dev, m, nullptr);
+  pipelines.clear();
+  modules.clear();
+}
+
+ComputePipeline makeComputePipeline(VulkanContext& ctx, std::string_view key, VkPipelineLayout layout,
+                                    const FloatRules& rules, MathSwitches math, uint32_t push_size,
+                                    uint32_t per_invocation, std::optional<uint32_t> spec0, bool spec0_is_size,
+                                    PipelineSet& owned) {
+  ComputePipeline p;
+  VkShaderModule module = VK_NULL_HANDLE;
+  p.pipeline = createSimPipeline(ctx, key, layout, rules, math, spec0, module);
+  owned.modules.push_back(module);
+  owned.pipelines.push_back(p.pipeline);
+  p.push_size = push_size;
+  // The workgroup size comes from the shader itself (its local_size_x, or the specialised size).
+  const uint32_t local = spec0_is_size && spec0 ? *spec0 : localSizeX(simShader(key));
+  if (local == 0) vkCheckFailed(VK_ERROR_INITIALIZATION_FAILED, std::string(key).c_str(), __FILE__, __LINE__);
+  p.workgroup = local * per_invocation;
+  return p;
+}
+
+SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
+                               bool batched, PipelineSet& owned) {
+  using namespace shaderio;
+  // Every pass: its shader, push constants and elements per invocation.
+  struct PipelineSpec {
+    ComputePipeline SimPipelines::*member;
+    const char* key;
+    uint32_t push_size, per_invocation;
+  };
+  constexpr uint32_t kSim = sizeof(SimPush), kScan = sizeof(ScanPush);
+  static constexpr PipelineSpec kPasses[] = {
+      {&SimPipelines::air, "air.comp", kSim, 1},
+      {&SimPipelines::integrate, "integrate.comp", kSim, 1},
+      {&SimPipelines::project, "project.comp", kSim, 1},
+      {&SimPipelines::candidates_check, "candidates_check.comp", kSim, 1},
+      {&SimPipelines::candidates_decide, "candidates_decide.comp", kSim, 1},
+      {&SimPipelines::hash_count, "hash_count.comp", kSim, 1},
+      {&SimPipelines::scan, "scan.comp", kScan, SIM_SCAN_PER_THREAD},
+      {&SimPipelines::scan_add, "scan_add.comp", kScan, 1},
+      {&SimPipelines::hash_scatter, "hash_scatter.comp", kSim, 1},
+      {&SimPipelines::hash_sort, "hash_sort.comp", kSim, 1},
+      {&SimPipelines::collide, "collide.comp", kSim, 1},
+      {&SimPipelines::candidates_finish, "candidates_finish.comp", kSim, 1},
+      {&SimPipelines::floor, "floor.comp", kSim, 1},
+      {&SimPipelines::tear_mark, "tear_mark.comp", kSim, 1},
+      {&SimPipelines::tear_unsupported, "tear_unsupported.comp", 0, 1},
+      {&SimPipelines::tear_flags, "tear_flags.comp", 0, 1},
+      {&SimPipelines::tear_compact, "tear_compact.comp", 0, 1},
+      {&SimPipelines::normals, "normals.comp", kSim, 1},
+      {&SimPipelines::reset, "reset.comp", kSim, 1},
+  };
+  SimPipelines pipes;
+  for (const PipelineSpec& spec : kPasses) {
+    if (batched && spec.member == &SimPipelines::normals) continue;
+    const std::string key = batched ? std::string(spec.key) + ".batch" : std::string(spec.key);
+    pipes.*spec.member =
+        makeComputePipeline(ctx, key, layout, rules, math, batched ? uint32_t(sizeof(BatchPassPush)) : spec.push_size,
+                            spec.per_invocation, std::nullopt, false, owned);
+  }
+  return pipes;
+}
+
 void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math, MathOp op) {
   static_assert(sizeof(MathCase) == 16);
   if (cases.empty()) return;

@@ -1,6 +1,7 @@
 #pragma once
 /// Compute pipelines of the simulation's shaders: their SPIR-V under the device's float rules
 /// (spirv_rules.h) and the switches of exact_math.h as specialization constants.
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string_view>
@@ -32,6 +33,44 @@ Arithmetic arithmeticOf(const FloatRules& rules, MathSwitches math);
 /// VulkanError when the shader is missing or Vulkan fails.
 VkPipeline createSimPipeline(VulkanContext& ctx, std::string_view key, VkPipelineLayout layout, const FloatRules& rules,
                              MathSwitches math, std::optional<uint32_t> spec0, VkShaderModule& module);
+
+/// A compute pipeline and what dispatching it needs.
+struct ComputePipeline {
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  uint32_t push_size = 0; ///< bytes of the shader's push-constant block (0: none)
+  uint32_t workgroup = 0; ///< elements one workgroup covers: local_size_x (from the SPIR-V) x elements per invocation
+};
+
+/// Every pipeline of the simulation (one file per shader in shaders/sim/).
+struct SimPipelines {
+  ComputePipeline air, integrate, project, candidates_check, candidates_decide, hash_count, scan, scan_add,
+      hash_scatter, hash_sort, collide, candidates_finish, floor, tear_mark, tear_unsupported, tear_flags, tear_compact,
+      normals, reset;
+  ComputePipeline tick_fused; ///< null when the device has under 32 KiB of shared memory
+  std::array<ComputePipeline, 3> pick;
+};
+
+/// Pipelines and modules to destroy together.
+struct PipelineSet {
+  std::vector<VkShaderModule> modules;
+  std::vector<VkPipeline> pipelines;
+  void destroy(VkDevice dev);
+};
+
+/// A ComputePipeline of shaders/sim/<key>.glsl (see createSimPipeline) whose push constants take
+/// `push_size` bytes and whose invocations take `per_invocation` elements each; the workgroup size
+/// comes from the SPIR-V, or is `spec0` for a shader whose size is specialization constant 0
+/// (`spec0_is_size`). What it creates joins `owned`.
+ComputePipeline makeComputePipeline(VulkanContext& ctx, std::string_view key, VkPipelineLayout layout,
+                                    const FloatRules& rules, MathSwitches math, uint32_t push_size,
+                                    uint32_t per_invocation, std::optional<uint32_t> spec0, bool spec0_is_size,
+                                    PipelineSet& owned);
+
+/// The passes of the per-colour path (every SimPipelines member but tick_fused and pick) on
+/// `layout`: a sheet's own, or a fleet's (`batched`: the SIM_BATCH_PASS builds, "<key>.batch",
+/// whose push constants are BatchPassPush; no normals pass).
+SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
+                               bool batched, PipelineSet& owned);
 
 /// One input of the device math check and its results (bits of floats).
 struct MathCase {

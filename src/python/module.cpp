@@ -319,7 +319,6 @@ public:
       if (auto err = batchMismatch(list[0].params, list[i].params))
         throw py::value_error("sheet " + std::to_string(i) + ": " + *err);
     }
-    if (auto err = fleetFits(backend, list[0].params)) throw py::value_error(*err);
     BackendOptions options = backendOptionsFor(backend, list[0].params);
     options.device = device.value_or(-1);
     if (auto err = createBatch(options, uint32_t(list.size()), batch_)) throw std::runtime_error(*err);

@@ -11,11 +11,13 @@
 
 namespace tender::test {
 
-/// Sheets of a 12 x 16 grid; sheet i takes its parameters and its script from i, so a batch of
-/// 37 holds every combination below several times: tearing yanks and sheets left hanging, a reset,
-/// a pause, a ray grab, three pin modes, both winds, and different stiffness, damping, gravity,
-/// tear factor, restitution, floor, substeps, iterations, release, collision and air.
-inline std::vector<FleetSheet> mixedFleet(uint32_t count) {
+/// Sheets of a cols x rows grid (12 x 16: small enough for the fused tick); sheet i takes its
+/// parameters and its script from i, so a batch of 37 holds every combination below several times:
+/// tearing yanks and sheets left hanging, a reset, a pause, a ray grab, three pin modes, both
+/// winds, and different stiffness, damping, gravity, tear factor, restitution, floor, substeps,
+/// iterations, release, collision, air and hash cell (sheets 5, 13, ... have cells of 5 spacings,
+/// which a CPU device's fused tick does not take).
+inline std::vector<FleetSheet> mixedFleet(uint32_t count, uint32_t cols = 12, uint32_t rows = 16) {
   static const char* kScripts[] = {
       "",
       // A hard yank: tears unless the tear factor is high
@@ -29,8 +31,8 @@ inline std::vector<FleetSheet> mixedFleet(uint32_t count) {
   std::vector<FleetSheet> sheets;
   for (uint32_t i = 0; i < count; ++i) {
     std::vector<std::string> sets = {
-        "cols=12",
-        "rows=16",
+        "cols=" + std::to_string(cols),
+        "rows=" + std::to_string(rows),
         "spacing=0.16",
         std::string("pins=") + kPins[i % 3],
         std::string("wind_kind=") + (i % 2 ? "noise" : "sinusoid"),
@@ -48,6 +50,7 @@ inline std::vector<FleetSheet> mixedFleet(uint32_t count) {
         std::string("release=") + (i % 4 == 1 ? "drag" : "zero"),
         std::string("collision=") + (i % 9 == 4 ? "off" : "on"),
         std::string("air=") + (i % 5 == 1 ? "on" : "off"),
+        std::string("cell_size=") + (i % 8 == 5 ? "0.8" : "0.4"),
     };
     FleetSheet s;
     s.params = preset("tender", sets);

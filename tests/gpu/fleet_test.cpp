@@ -1,5 +1,5 @@
-// A fleet on the GPU: one dispatch ticks every sheet, and each sheet ends bitwise where the same
-// sheet ends run alone on the GPU solver (fused or per-colour: they agree).
+// A fleet on the GPU: one dispatch ticks every sheet the fused tick takes, one dispatch per pass
+// the others, and each sheet ends bitwise where the same sheet ends run alone on the GPU solver.
 #include <algorithm>
 #include <thread>
 
@@ -43,14 +43,38 @@ TEST_F(GpuFleetTest, OneDispatchRunsEveryQueuedSheetsTick) {
   EXPECT_EQ(batch.dispatchesPerFlush(), cpu_device ? (4 + group - 1) / group * 8 : 1u);
 }
 
-TEST_F(GpuFleetTest, LargeSheetsAndLargeCellsAreRefused) {
-  SimParams p = preset("tender");
-  EXPECT_FALSE(gpu::GpuFleet::fits(p));
-  p.cols = 64;
-  p.rows = 64;
-  EXPECT_TRUE(gpu::GpuFleet::fits(p));
-  p = preset("tender", {"cell_size=2"});
-  EXPECT_TRUE(gpu::GpuFleet::fits(p));
+TEST_F(GpuFleetTest, SheetsTooLargeForTheFusedTickRunThePerColourPassesBatched) {
+  // 48 x 48: over SIM_FUSED_MAX_PARTICLES, so each pass is one dispatch for every sheet, and a
+  // gate picks the sheets that run it (substeps, iterations, air, collision, hash, tears, reset)
+  const std::vector<FleetSheet> sheets = mixedFleet(9, 48, 48);
+  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()));
+  gpu::GpuSolver alone(ctx());
+  const uint32_t tore = expectFleetMatchesAlone(batch, alone, sheets, 40);
+  EXPECT_FALSE(alone.usesFusedPath());
+  EXPECT_GT(tore, 0u);
+  EXPECT_LT(tore, sheets.size());
+}
+
+TEST_F(GpuFleetTest, ThePerColourFleetMatchesTheCpuReference) {
+  const std::vector<FleetSheet> sheets = mixedFleet(3, 48, 48);
+  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()));
+  CpuSolver alone(cpuOptionsLike(ctx()));
+  expectFleetMatchesAlone(batch, alone, sheets, 20);
+}
+
+TEST_F(GpuFleetTest, APassOfLargeSheetsIsOneDispatchForTheWholeBatch) {
+  // Five sheets of one size record the passes one of them records alone
+  const SimParams p = preset("tender", {"cols=48", "rows=48"});
+  gpu::GpuFleet batch(ctx(), 5);
+  Fleet fleet(batch, std::vector<FleetSheet>(5, FleetSheet{p, {}}));
+  gpu::GpuSolver alone(ctx());
+  Simulation sim(p, alone);
+  for (int t = 0; t < 2; ++t) {
+    fleet.tick();
+    sim.tick();
+  }
+  EXPECT_GT(alone.dispatchesPerTick(), 50u);
+  EXPECT_EQ(batch.dispatchesPerFlush(), alone.dispatchesPerTick());
 }
 
 } // namespace

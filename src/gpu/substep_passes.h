@@ -1,0 +1,54 @@
+#pragma once
+/// The passes of one substep of the per-colour path, in the order of DESIGN.md §3, recorded into a
+/// PassSink: the GPU solver dispatches them for its sheet; a fleet dispatches each for every sheet
+/// of a batch, and its gate (SIM_GATE_* in sim_config.h) picks the sheets that run it, those that
+/// would run it alone.
+#include <cstdint>
+
+#include "core/sheet.h"
+#include "gpu/sheet_buffers.h"
+#include "gpu/sim_pipeline.h"
+
+namespace tender::gpu {
+
+/// How a dispatch gets its grid: from the element count, one workgroup, the tear compaction's
+/// arguments (zero workgroups unless something tore), or the next live hash-pass argument (zero
+/// workgroups when the candidate lists stand in for the hash).
+enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash };
+
+/// Timestamp categories of a tick, in Solver::passTimes() order. kFused: the fused small-sheet
+/// tick, every pass in one dispatch.
+enum PassCategory : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kFused, kCategoryCount };
+
+/// Where the passes of a substep go.
+class PassSink {
+public:
+  /// A pass of substep `substep`: `count` elements of `p` (Grid::Threads) or the grid `grid` names,
+  /// with `push_size` bytes of push constants; `gate` and `gate_arg` say which sheets of a batch
+  /// run it.
+  virtual void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
+                    uint32_t substep, uint32_t gate, uint32_t gate_arg) = 0;
+  /// What the passes recorded so far wrote is seen by the next.
+  virtual void barrier() = 0;
+  /// The passes recorded since the last mark belong to category `c` (timestamps).
+  virtual void mark(PassCategory c) = 0;
+
+protected:
+  ~PassSink() = default;
+};
+
+/// What the passes of a substep cover: for a fleet, the most iterations of its sheets, and air and
+/// collision when any sheet has them.
+struct SubstepPlan {
+  uint32_t iterations = 0;
+  bool collision = false;
+  bool air = false;
+  uint32_t stop = SIM_NONE; ///< last pass to record (passesPerSubstep numbering; Solver::stopNextTickAfter)
+};
+
+/// Records the passes of substep `s` of a sheet of this topology and layout; `pass` counts them.
+/// Returns true when the tick stops within it (SubstepPlan::stop).
+bool recordSubstep(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,
+                   const SubstepPlan& plan, uint32_t s, uint32_t& pass);
+
+} // namespace tender::gpu
