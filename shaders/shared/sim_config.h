@@ -72,8 +72,19 @@
 // 0's slice and the bytes from one sheet's slice to the next, then at SIM_BATCH_QUEUE the list of
 // sheets to tick (one per workgroup of tick_batch, one per workgroup z of a pass)
 #define SIM_BATCH_QUEUE 29
+// ... and at SIM_BATCH_ARGS the indirect arguments of the per-colour passes of a batch (uvec4 each,
+// workgroup counts x, y and z = the batch's sheets): the full grids of the hash passes (a slot per
+// pass, as SIM_BIND_HASH_ARGS) and of the compaction, which the host writes, then per substep the
+// live ones, which the host writes with x = 0 and a sheet's candidates_decide (hash) or tear_mark
+// (compaction) raises to the full grid's x when that sheet needs them: a pass that no sheet of the
+// batch needs runs zero workgroups, as it does for a sheet alone
+#define SIM_BATCH_ARGS 30
 // Entries of the fleet's table
-#define SIM_BATCH_ENTRIES 30
+#define SIM_BATCH_ENTRIES 31
+#define SIM_BATCH_ARGS_FULL_COMPACT SIM_HASH_DISPATCHES
+#define SIM_BATCH_ARGS_LIVE_HASH (SIM_BATCH_ARGS_FULL_COMPACT + 1u)
+#define SIM_BATCH_ARGS_LIVE_COMPACT (SIM_BATCH_ARGS_LIVE_HASH + SIM_MAX_SUBSTEPS * SIM_HASH_DISPATCHES)
+#define SIM_BATCH_ARGS_COUNT (SIM_BATCH_ARGS_LIVE_COMPACT + SIM_MAX_SUBSTEPS)
 // Which sheets of a batch a per-colour pass runs for (BatchArgs.gate). The batch records the
 // passes of its most substeps and iterations, with air and collision when any sheet has them; a
 // sheet runs a pass exactly when the same sheet ticking alone records or dispatches it. Every

@@ -249,6 +249,13 @@ bool batchGateTakes() {
   }
 }
 
+// The batch's indirect argument `live` (SIM_BATCH_ARGS_* in sim_config.h) gets the workgroups of
+// the full grid `full`: a sheet of the batch needs the pass.
+void batchArmArgs(uint live, uint full) {
+  UintRef args = UintRef(batchSlice(SIM_BATCH_ARGS, 0u));
+  atomicMax(args.v[4u * live], args.v[4u * full]);
+}
+
 void simPassMain();
 void main() {
   bindSheet(batchSheet(gl_WorkGroupID.z));

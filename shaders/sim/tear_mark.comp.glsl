@@ -19,5 +19,9 @@ void main() {
     uint groups = (compactSlots() + SIM_WG_TEAR - 1u) / SIM_WG_TEAR;
     uint gx = min(groups, SIM_MAX_GROUPS_X);
     counters.compact_dispatch = uvec4(gx, (groups + gx - 1u) / gx, 1u, 0u);
+#ifdef SIM_BATCH_PASS
+    // A fleet: the batch's compaction of this substep runs
+    batchArmArgs(SIM_BATCH_ARGS_LIVE_COMPACT + p.substep, SIM_BATCH_ARGS_FULL_COMPACT);
+#endif
   }
 }

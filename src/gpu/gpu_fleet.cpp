@@ -20,6 +20,7 @@ namespace {
 constexpr VkDeviceSize kSliceAlign = 256;
 constexpr VkBufferUsageFlags kSliceUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                                            VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+constexpr VkDeviceSize kArgsBytes = 16ull * SIM_BATCH_ARGS_COUNT;
 
 VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
 
@@ -63,10 +64,12 @@ GpuFleet::GpuFleet(std::unique_ptr<VulkanContext> ctx, uint32_t sheets)
 }
 
 void GpuFleet::create(uint32_t sheets) {
-  if (sheets == 0 || sheets > ctx_.properties().limits.maxComputeWorkGroupCount[0])
-    throw std::runtime_error("a GPU fleet runs 1 to " +
-                             std::to_string(ctx_.properties().limits.maxComputeWorkGroupCount[0]) +
-                             " sheets per batch, not " + std::to_string(sheets));
+  // A sheet per workgroup: x of the fused tick's grid, z of a pass's
+  const uint32_t most = std::min(ctx_.properties().limits.maxComputeWorkGroupCount[0],
+                                 ctx_.properties().limits.maxComputeWorkGroupCount[2]);
+  if (sheets == 0 || sheets > most)
+    throw std::runtime_error("a GPU fleet runs 1 to " + std::to_string(most) + " sheets per batch, not " +
+                             std::to_string(sheets));
   if (!ctx_.deviceAddresses())
     throw std::runtime_error("Vulkan device " + ctx_.info().name +
                              " cannot run a fleet: it lacks bufferDeviceAddress or shaderInt64 (try --backend cpu)");
@@ -132,19 +135,23 @@ void GpuFleet::allocate(const SheetTopology& topo) {
   // A slice per sheet in each binding's buffer; the uniforms as one binding more.
   stride_[SIM_BIND_UNIFORMS] = alignUp(sizeof(SimUniforms), kSliceAlign);
   for (const BindingSpec& b : table) stride_[b.binding] = alignUp(std::max<VkDeviceSize>(b.bytes, 16), kSliceAlign);
-  stride_[SIM_BATCH_QUEUE] = 0;
+  stride_[SIM_BATCH_QUEUE] = stride_[SIM_BATCH_ARGS] = 0;
   std::array<glm::uvec4, SIM_BATCH_ENTRIES> entries{};
   try {
     for (uint32_t b = 0; b < SIM_BATCH_ENTRIES; ++b) {
-      const VkDeviceSize bytes = b == SIM_BATCH_QUEUE ? 4ull * sheets : stride_[b] * sheets;
+      const VkDeviceSize bytes = b == SIM_BATCH_QUEUE  ? 4ull * sheets
+                                 : b == SIM_BATCH_ARGS ? kArgsBytes
+                                                       : stride_[b] * sheets;
       if (bytes == 0) continue;
-      buf_[b] = ctx_.createDeviceBuffer(bytes, kSliceUsage);
+      buf_[b] = ctx_.createDeviceBuffer(bytes, b == SIM_BATCH_ARGS ? kSliceUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT
+                                                                   : kSliceUsage);
       const VkDeviceAddress a = ctx_.address(buf_[b]);
       entries[b] = glm::uvec4(uint32_t(a), uint32_t(a >> 32), uint32_t(stride_[b]), uint32_t(stride_[b] >> 32));
     }
     table_ = ctx_.createDeviceBuffer(sizeof(entries), kSliceUsage);
-    inputs_ = ctx_.createHostBuffer(alignUp(4ull * sheets, kSliceAlign) + stride_[SIM_BIND_UNIFORMS] * sheets,
-                                    VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    inputs_ =
+        ctx_.createHostBuffer(alignUp(4ull * sheets, kSliceAlign) + stride_[SIM_BIND_UNIFORMS] * sheets + kArgsBytes,
+                              VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   } catch (const VulkanError&) {
     for (Buffer& b : buf_) ctx_.destroyBuffer(b);
     ctx_.destroyBuffer(table_);
@@ -330,6 +337,7 @@ void GpuFleet::flush() {
   std::vector<uint32_t> queue = fused;
   queue.insert(queue.end(), passes.begin(), passes.end());
   std::memcpy(inputs, queue.data(), 4 * queue.size());
+  const VkDeviceSize args_at = uniforms_at + stride_[SIM_BIND_UNIFORMS] * size();
 
   VkCommandBufferBeginInfo bi{};
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
@@ -344,7 +352,15 @@ void GpuFleet::flush() {
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BIND_UNIFORMS].buffer, uint32_t(regions.size()), regions.data());
   VkBufferCopy queue_region{0, 0, 4ull * queue.size()};
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_QUEUE].buffer, 1, &queue_region);
-  transferToCompute(cmd_);
+  if (!passes.empty()) {
+    VkBufferCopy args_region{args_at, 0, kArgsBytes};
+    vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_ARGS].buffer, 1, &args_region);
+  }
+  // ... seen by the passes and by their indirect dispatches
+  memoryBarrier(cmd_, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
+                    VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   bound_ = VK_NULL_HANDLE;
   const VkDeviceAddress table = ctx_.address(table_);
   if (!fused.empty()) {
@@ -380,7 +396,21 @@ void GpuFleet::flush() {
       barrier();
     }
     uint32_t count = 0;
+    hash_grids_.clear();
     for (uint32_t s = 0; s < pass_substeps; ++s) recordSubstep(*this, passes_, topo_, sizes_, plan, s, count);
+    // The batch's indirect arguments (the copy recorded above takes them at submission): the full
+    // grids, and the live ones of every substep with no workgroups until a sheet needs them
+    glm::uvec4 args[SIM_BATCH_ARGS_COUNT] = {};
+    const uint32_t compact_groups = (sizes_.tear_slots + SIM_WG_TEAR - 1) / SIM_WG_TEAR;
+    const uint32_t cx = std::min<uint32_t>(compact_groups, SIM_MAX_GROUPS_X);
+    args[SIM_BATCH_ARGS_FULL_COMPACT] = glm::uvec4(cx, (compact_groups + cx - 1) / cx, pass_sheets_, 0);
+    for (uint32_t k = 0; k < hash_grids_.size(); ++k) args[k] = hash_grids_[k];
+    for (uint32_t s = 0; s < SIM_MAX_SUBSTEPS; ++s) {
+      for (uint32_t k = 0; k < SIM_HASH_DISPATCHES; ++k)
+        args[SIM_BATCH_ARGS_LIVE_HASH + s * SIM_HASH_DISPATCHES + k] = glm::uvec4(0, args[k].y, pass_sheets_, 0);
+      args[SIM_BATCH_ARGS_LIVE_COMPACT + s] = glm::uvec4(0, args[SIM_BATCH_ARGS_FULL_COMPACT].y, pass_sheets_, 0);
+    }
+    std::memcpy(inputs + args_at, args, sizeof(args));
   }
   allToAllAndHost(cmd_);
   VK_CHECK(vkEndCommandBuffer(cmd_));
@@ -392,27 +422,18 @@ void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
                     uint32_t substep, uint32_t gate, uint32_t gate_arg) {
   if (push_size > sizeof(SimPush) || p.push_size != sizeof(BatchPassPush))
     vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
-  // The grid a sheet alone gets: from the element count; for the hash passes the full grid
-  // candidates_decide gives them, for the compaction the one tear_mark gives it (the gates skip
-  // the sheets whose grid is empty).
-  uint32_t groups = 1;
-  switch (grid) {
-  case Grid::Threads:
-  case Grid::Hash:
-    if (count == 0) return;
-    groups = (count + p.workgroup - 1) / p.workgroup;
-    break;
-  case Grid::Workgroup:
-    break;
-  case Grid::Compaction:
-    groups = (sizes_.tear_slots + SIM_WG_TEAR - 1) / SIM_WG_TEAR;
-    break;
-  }
+  // The grid a sheet alone gets, with a workgroup z per sheet: from the element count; the hash
+  // passes and the compaction from the batch's live arguments, which the sheets that need them
+  // arm (the gates skip the other sheets).
+  if ((grid == Grid::Threads || grid == Grid::Hash) && count == 0) return;
+  const uint32_t groups = grid == Grid::Threads || grid == Grid::Hash ? (count + p.workgroup - 1) / p.workgroup : 1u;
   const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X), gy = (groups + gx - 1) / gx;
+  if (grid != Grid::Hash) hash_slot_ = 0;
   BatchPassPush bp{};
   if (push_size) std::memcpy(&bp.pass, push, push_size);
   const VkDeviceAddress table = ctx_.address(table_);
   bp.batch.table = glm::uvec2(uint32_t(table), uint32_t(table >> 32));
+  bp.batch.first = pass_first_;
   bp.batch.substep = substep;
   bp.batch.gate = gate;
   bp.batch.gate_arg = gate_arg;
@@ -420,14 +441,28 @@ void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
     vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
     bound_ = p.pipeline;
   }
-  // A sheet per workgroup z, as many at a time as the device's grid takes
-  const uint32_t max_z = ctx_.properties().limits.maxComputeWorkGroupCount[2];
-  for (uint32_t first = 0; first < pass_sheets_; first += max_z) {
-    bp.batch.first = pass_first_ + first;
-    vkCmdPushConstants(cmd_, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(bp), &bp);
-    vkCmdDispatch(cmd_, gx, gy, std::min(max_z, pass_sheets_ - first));
-    ++last_dispatches_;
+  vkCmdPushConstants(cmd_, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(bp), &bp);
+  switch (grid) {
+  case Grid::Threads:
+  case Grid::Workgroup:
+    vkCmdDispatch(cmd_, gx, gy, pass_sheets_);
+    break;
+  case Grid::Hash: {
+    // Every substep records the same hash passes into the same slots
+    const uint32_t slot = hash_slot_++;
+    const glm::uvec4 full(gx, gy, pass_sheets_, 0);
+    if (slot >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
+    if (slot == hash_grids_.size()) hash_grids_.push_back(full);
+    if (hash_grids_[slot] != full) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
+    vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer,
+                          16ull * (SIM_BATCH_ARGS_LIVE_HASH + substep * SIM_HASH_DISPATCHES + slot));
+    break;
   }
+  case Grid::Compaction:
+    vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer, 16ull * (SIM_BATCH_ARGS_LIVE_COMPACT + substep));
+    break;
+  }
+  ++last_dispatches_;
 }
 
 void GpuFleet::barrier() { computeToCompute(cmd_); }

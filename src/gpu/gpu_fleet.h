@@ -79,6 +79,8 @@ private:
   float fused_max_cell_spacings_ = -1.0f; ///< largest hash cell the fused tick takes (< 0: any; FusedShape)
   float spacing_ = 0.0f;                  ///< the sheets' grid spacing
   uint32_t pass_first_ = 0, pass_sheets_ = 0; ///< the sheets in the queue the passes being recorded run for
+  std::vector<glm::uvec4> hash_grids_;        ///< full grids of the hash passes, in recording order (their slots)
+  uint32_t hash_slot_ = 0;                    ///< next hash-pass slot while recording
   VkPipeline bound_ = VK_NULL_HANDLE;         ///< pipeline bound while recording
   FloatRules float_rules_;
   MathSwitches math_;
@@ -91,7 +93,7 @@ private:
   std::array<Buffer, SIM_BATCH_ENTRIES> buf_{};          ///< per binding: a slice per sheet; the queue
   std::array<VkDeviceSize, SIM_BATCH_ENTRIES> stride_{}; ///< bytes from one sheet's slice to the next
   Buffer table_;                                         ///< SIM_BATCH_ENTRIES uvec4 (device)
-  Buffer inputs_;                                        ///< host: the queue, then the uniforms of each sheet
+  Buffer inputs_; ///< host: the queue, the uniforms of each sheet, then the batch's indirect arguments
 
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;

@@ -58,7 +58,7 @@ if [ "$rc" -ne 0 ]; then
 fi
 if [ -f "$report" ]; then
   for check in environment devices gpu-tests render-tests diff-tender-hanging diff-tender-yank diff-crumple-hanging \
-    diff-crumple-yank bench fleet; do
+    diff-crumple-yank bench fleet fleet-large; do
     grep -q "^| $check | .* | pass | " "$report" || fail "report.md: check $check did not pass or is missing"
   done
   grep -q '^\*\*PASS\*\*' "$report" || fail "report.md does not say PASS"
@@ -66,7 +66,8 @@ if [ -f "$report" ]; then
   grep -q '^| 128x192 | 24576 | gpu-percolor | [0-9]' "$report" || fail "report.md has no benchmark table"
   [ -s "$tmp/report/bench.json" ] && [ -s "$tmp/report/bench.csv" ] || fail "no bench.json or bench.csv"
   grep -q '^32x48 *gpu *64 *[0-9.]' "$report" || fail "report.md has no fleet table with a batch of 64"
-  [ -s "$tmp/report/fleet.json" ] || fail "no fleet.json"
+  grep -q '^128x192 *gpu *4 *[0-9.]' "$report" || fail "report.md has no large-sheet fleet table with a batch of 4"
+  [ -s "$tmp/report/fleet.json" ] && [ -s "$tmp/report/fleet-large.json" ] || fail "no fleet.json or fleet-large.json"
   if command -v gnuplot >/dev/null && command -v python3 >/dev/null; then
     [ -s "$tmp/report/fleet.png" ] || fail "no fleet.png (gnuplot and python3 are here)"
   fi
