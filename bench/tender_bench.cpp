@@ -327,7 +327,10 @@ nlohmann::json runBatchCase(const BenchOptions& o, const Size& size, const std::
   auto skip = skipper(r, label, progress);
   SimParams p;
   if (auto err = caseParams(o, size, backend, p)) return skip(*err);
-  if (estimateSheetBytes(p, backend) * sheets > availableMemoryBytes())
+  uint64_t memory = availableMemoryBytes();
+  if (backend != "cpu")
+    if (const uint64_t device_bytes = gpuMemoryBytes(o.device)) memory = std::min(memory, device_bytes);
+  if (estimateSheetBytes(p, backend) * sheets > memory)
     return skip("a batch of " + std::to_string(sheets) + " sheets needs more memory than this machine has");
   BackendOptions bo = backendOptionsFor(backend, p);
   bo.device = o.device;

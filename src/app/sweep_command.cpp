@@ -259,11 +259,15 @@ std::optional<std::string> makePlan(const CommonOptions& common, const SweepOpti
   return std::nullopt;
 }
 
-/// Picks the sheets per batch: --batch, or the backend's default, within the memory available.
-std::optional<std::string> chooseBatch(Plan& plan, uint64_t shard_sheets) {
+/// Picks the sheets per batch: --batch, or the backend's default, within the memory available (on
+/// the GPU, also the device's).
+std::optional<std::string> chooseBatch(Plan& plan, uint64_t shard_sheets, int device) {
   const std::string mem_backend = plan.backend == "cpu" ? "cpu" : "gpu";
   const uint64_t per_sheet = std::max<uint64_t>(1, estimateSheetBytes(plan.base, mem_backend));
-  const uint64_t budget = availableMemoryBytes() / 10 * 9, fit = budget / per_sheet;
+  uint64_t memory = availableMemoryBytes();
+  if (plan.backend != "cpu")
+    if (const uint64_t device_bytes = gpuMemoryBytes(device)) memory = std::min(memory, device_bytes);
+  const uint64_t budget = memory / 10 * 9, fit = budget / per_sheet;
   if (plan.batch == 0) plan.batch = std::min(plan.backend == "cpu" ? kDefaultCpuBatch : kDefaultGpuBatch, fit);
   plan.batch = std::max<uint64_t>(1, std::min(plan.batch, shard_sheets));
   if (plan.batch > fit)
@@ -433,7 +437,7 @@ int runSweep(const CommonOptions& common, const SweepOptions& o) {
   Plan plan;
   if (auto err = makePlan(common, o, plan)) return fail(*err);
   const std::vector<uint64_t> indices = shardIndices(plan);
-  if (auto err = chooseBatch(plan, indices.size())) return fail(*err);
+  if (auto err = chooseBatch(plan, indices.size(), common.device)) return fail(*err);
   // Every sheet is checked before anything runs.
   for (uint64_t index : indices) {
     SweepSheet sheet;

@@ -85,6 +85,19 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
 #endif
 }
 
+uint64_t gpuMemoryBytes([[maybe_unused]] int device) {
+#ifdef TENDER_HAS_GPU
+  auto devices = gpu::listDevices();
+  if (!devices) return 0;
+  const gpu::DeviceInfo* chosen = nullptr;
+  for (const gpu::DeviceInfo& d : *devices)
+    if (device >= 0 ? int(d.index) == device : d.usable && (!chosen || d.preference < chosen->preference)) chosen = &d;
+  return chosen ? chosen->memory_bytes : 0;
+#else
+  return 0;
+#endif
+}
+
 std::optional<std::string> createBatch(const BackendOptions& o, uint32_t sheets, std::unique_ptr<SheetBatch>& out) {
   out.reset();
   if (sheets == 0) return std::string("a batch needs at least one sheet");

@@ -56,6 +56,10 @@ bool vulkanBuilt();
 /// error) and leaves `out` empty.
 std::optional<std::string> createBackend(const BackendOptions& options, Backend& out);
 
+/// Bytes of device-local memory of Vulkan device `device` (-1: the one a solver given no index
+/// takes); 0 when it is unknown (no such device, or no Vulkan).
+uint64_t gpuMemoryBytes(int device);
+
 /// Builds the batch of a fleet of `sheets` sheets ("cpu" or "gpu"; `threads` and `simd` for the
 /// CPU's workers and kernels); on failure returns one line and leaves `out` empty.
 std::optional<std::string> createBatch(const BackendOptions& options, uint32_t sheets,

@@ -96,6 +96,7 @@ DeviceInfo describe(VkPhysicalDevice pd, uint32_t index) {
   DeviceInfo d;
   d.index = index;
   d.name = p.deviceName;
+  d.preference = uint32_t(typeRank(p.deviceType));
   d.type = typeName(p.deviceType);
   d.driver = std::string(driver.driverName);
   if (driver.driverInfo[0]) d.driver += std::string(" ") + driver.driverInfo;
@@ -279,10 +280,8 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
     for (uint32_t i = 0; i < pds.size(); ++i) {
       DeviceInfo d = describe(pds[i], i);
       if (!d.usable || (o.graphics && !findQueueFamily(pds[i], true))) continue;
-      VkPhysicalDeviceProperties p;
-      vkGetPhysicalDeviceProperties(pds[i], &p);
-      if (typeRank(p.deviceType) < best_rank) {
-        best_rank = typeRank(p.deviceType);
+      if (int(d.preference) < best_rank) {
+        best_rank = int(d.preference);
         chosen = int(i);
       }
     }

@@ -106,6 +106,7 @@ struct DeviceInfo {
   FloatControls floats;       ///< the 32-bit float controls it can be asked for
   uint32_t subgroup_size = 0; ///< invocations per subgroup
   uint32_t shared_memory = 0; ///< bytes of shared memory per workgroup
+  uint32_t preference = 0;    ///< a context given no index takes the usable device that comes first here
 };
 
 /// Lists the Vulkan devices, or fails with one line when Vulkan or a device is missing.
