@@ -43,6 +43,23 @@ TEST_F(GpuFleetTest, OneDispatchRunsEveryQueuedSheetsTick) {
   EXPECT_EQ(batch.dispatchesPerFlush(), cpu_device ? (4 + group - 1) / group * 8 : 1u);
 }
 
+TEST_F(GpuFleetTest, AFlushRunsFusedAndPerColourSheetsTogether) {
+  // Sheet 5 has hash cells of 5 spacings: a CPU device's fused tick does not take it, so alone
+  // and in the fleet it runs the per-colour passes, while the others run the fused tick.
+  const std::vector<FleetSheet> sheets = mixedFleet(6);
+  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()));
+  gpu::GpuSolver alone(ctx());
+  expectFleetMatchesAlone(batch, alone, sheets, 12);
+  const bool cpu_device = ctx().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  Simulation sim(sheets[5].params, alone);
+  sim.tick();
+  EXPECT_EQ(alone.usesFusedPath(sim.lastUniforms()), !cpu_device);
+  if (cpu_device)
+    EXPECT_GT(batch.dispatchesPerFlush(), alone.dispatchesPerTick()); // the fused sheets' dispatches as well
+  else
+    EXPECT_EQ(batch.dispatchesPerFlush(), 1u);
+}
+
 TEST_F(GpuFleetTest, SheetsTooLargeForTheFusedTickRunThePerColourPassesBatched) {
   // 48 x 48: over SIM_FUSED_MAX_PARTICLES, so each pass is one dispatch for every sheet, and a
   // gate picks the sheets that run it (substeps, iterations, air, collision, hash, tears, reset)
