@@ -74,34 +74,17 @@ void GpuSolver::upload(const SheetTopology& topo) {
   for (Buffer& b : staging) ctx_.destroyBuffer(b);
 
   // One descriptor set over every buffer.
-  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, 1},
-                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 1}};
-  VkDescriptorPoolCreateInfo dpi{};
-  dpi.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  dpi.maxSets = 1;
-  dpi.poolSizeCount = 2;
-  dpi.pPoolSizes = sizes;
-  VK_CHECK(vkCreateDescriptorPool(dev, &dpi, nullptr, &descriptor_pool_));
+  descriptor_pool_ = createSheetSetPool(dev, 1);
   VkDescriptorSetAllocateInfo dai{};
   dai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
   dai.descriptorPool = descriptor_pool_;
   dai.descriptorSetCount = 1;
   dai.pSetLayouts = &set_layout_;
   VK_CHECK(vkAllocateDescriptorSets(dev, &dai, &set_));
-  std::vector<VkDescriptorBufferInfo> infos(kBindingCount);
-  std::vector<VkWriteDescriptorSet> writes(kBindingCount);
-  for (uint32_t b = 0; b < kBindingCount; ++b) {
-    infos[b] = {buf_[b].buffer, 0, b == SIM_BIND_UNIFORMS ? VkDeviceSize(sizeof(SimUniforms)) : VK_WHOLE_SIZE};
-    writes[b] = {};
-    writes[b].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    writes[b].dstSet = set_;
-    writes[b].dstBinding = b;
-    writes[b].descriptorCount = 1;
-    writes[b].descriptorType =
-        b == SIM_BIND_UNIFORMS ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[b].pBufferInfo = &infos[b];
-  }
-  vkUpdateDescriptorSets(dev, kBindingCount, writes.data(), 0, nullptr);
+  std::array<VkDescriptorBufferInfo, kSheetBindingCount> where{};
+  for (uint32_t b = 0; b < kBindingCount; ++b)
+    where[b] = {buf_[b].buffer, 0, b == SIM_BIND_UNIFORMS ? VkDeviceSize(sizeof(SimUniforms)) : VK_WHOLE_SIZE};
+  writeSheetSet(dev, set_, where);
   writeStaticUniforms();
 
   // Command buffers: per slot a tick (recorded on first use) and a reset; one normals buffer.

@@ -56,14 +56,14 @@ private:
   uint32_t index_;
 };
 
-GpuFleet::GpuFleet(VulkanContext& ctx, uint32_t sheets) : ctx_(ctx) { create(sheets); }
+GpuFleet::GpuFleet(VulkanContext& ctx, uint32_t sheets, FleetPasses passes) : ctx_(ctx) { create(sheets, passes); }
 
 GpuFleet::GpuFleet(std::unique_ptr<VulkanContext> ctx, uint32_t sheets)
     : owned_ctx_(std::move(ctx)), ctx_(*owned_ctx_) {
-  create(sheets);
+  create(sheets, FleetPasses::Auto);
 }
 
-void GpuFleet::create(uint32_t sheets) {
+void GpuFleet::create(uint32_t sheets, FleetPasses passes) {
   // A sheet per workgroup: x of the fused tick's grid, z of a pass's
   const uint32_t most = std::min(ctx_.properties().limits.maxComputeWorkGroupCount[0],
                                  ctx_.properties().limits.maxComputeWorkGroupCount[2]);
@@ -91,6 +91,16 @@ void GpuFleet::create(uint32_t sheets) {
   substeps_per_dispatch_ = cpu_device ? SIM_FUSED_SUBSTEPS_CPU : SIM_MAX_SUBSTEPS;
   fused_max_cell_spacings_ = cpu_device ? SIM_FUSED_CPU_MAX_CELL_SPACINGS : -1.0f;
   sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
+  per_sheet_ = passes == FleetPasses::PerSheet || (passes == FleetPasses::Auto && cpu_device);
+  if (per_sheet_) {
+    sheet_set_layout_ = createSheetSetLayout(dev);
+    VkPushConstantRange sheet_range{VK_SHADER_STAGE_COMPUTE_BIT, 0, uint32_t(sizeof(SimPush))};
+    pli.setLayoutCount = 1;
+    pli.pSetLayouts = &sheet_set_layout_;
+    pli.pPushConstantRanges = &sheet_range;
+    VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &sheet_layout_));
+    sheet_passes_ = makePassPipelines(ctx_, sheet_layout_, float_rules_, math_, false, owned_pipelines_);
+  }
   if (ctx_.properties().limits.maxComputeSharedMemorySize >= 16u * SIM_FUSED_MAX_PARTICLES)
     tick_batch_ = makeComputePipeline(ctx_, "tick_batch.comp", layout_, float_rules_, math_, sizeof(BatchPush), 1,
                                       workgroup, true, owned_pipelines_);
@@ -122,6 +132,9 @@ GpuFleet::~GpuFleet() {
   if (cmd_) vkFreeCommandBuffers(dev, ctx_.commandPool(), 1, &cmd_);
   if (fence_) vkDestroyFence(dev, fence_, nullptr);
   owned_pipelines_.destroy(dev);
+  if (sheet_pool_) vkDestroyDescriptorPool(dev, sheet_pool_, nullptr);
+  if (sheet_layout_) vkDestroyPipelineLayout(dev, sheet_layout_, nullptr);
+  if (sheet_set_layout_) vkDestroyDescriptorSetLayout(dev, sheet_set_layout_, nullptr);
   if (layout_) vkDestroyPipelineLayout(dev, layout_, nullptr);
 }
 
@@ -143,8 +156,12 @@ void GpuFleet::allocate(const SheetTopology& topo) {
                                  : b == SIM_BATCH_ARGS ? kArgsBytes
                                                        : stride_[b] * sheets;
       if (bytes == 0) continue;
-      buf_[b] = ctx_.createDeviceBuffer(bytes, b == SIM_BATCH_ARGS ? kSliceUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT
-                                                                   : kSliceUsage);
+      // Indirect arguments: the batch's, and (PerSheet) each sheet's counters and hash arguments
+      const bool indirect = b == SIM_BATCH_ARGS || b == SIM_BIND_COUNTERS || b == SIM_BIND_HASH_ARGS;
+      VkBufferUsageFlags usage = kSliceUsage;
+      if (indirect) usage |= VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
+      if (b == SIM_BIND_UNIFORMS) usage |= VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT;
+      buf_[b] = ctx_.createDeviceBuffer(bytes, usage);
       const VkDeviceAddress a = ctx_.address(buf_[b]);
       entries[b] = glm::uvec4(uint32_t(a), uint32_t(a >> 32), uint32_t(stride_[b]), uint32_t(stride_[b] >> 32));
     }
@@ -160,6 +177,25 @@ void GpuFleet::allocate(const SheetTopology& topo) {
                              ctx_.info().name + " (try a smaller --batch)");
   }
   ctx_.submitOnce([&](VkCommandBuffer cmd) { vkCmdUpdateBuffer(cmd, table_.buffer, 0, sizeof(entries), &entries); });
+  if (per_sheet_) {
+    // Each sheet's descriptor set over its slices
+    VkDevice dev = ctx_.device();
+    sheet_pool_ = createSheetSetPool(dev, sheets);
+    sheet_sets_.assign(sheets, VK_NULL_HANDLE);
+    std::vector<VkDescriptorSetLayout> layouts(sheets, sheet_set_layout_);
+    VkDescriptorSetAllocateInfo dai{};
+    dai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+    dai.descriptorPool = sheet_pool_;
+    dai.descriptorSetCount = sheets;
+    dai.pSetLayouts = layouts.data();
+    VK_CHECK(vkAllocateDescriptorSets(dev, &dai, sheet_sets_.data()));
+    for (uint32_t i = 0; i < sheets; ++i) {
+      std::array<VkDescriptorBufferInfo, kSheetBindingCount> where{};
+      for (uint32_t b = 0; b < kSheetBindingCount; ++b)
+        where[b] = {buf_[b].buffer, sliceOffset(b, i), b == SIM_BIND_UNIFORMS ? sizeof(SimUniforms) : stride_[b]};
+      writeSheetSet(dev, sheet_sets_[i], where);
+    }
+  }
   allocated_ = true;
 }
 
@@ -304,6 +340,7 @@ void GpuFleet::flush() {
   // Each takes the path it takes alone: the fused tick or the per-colour passes.
   finish();
   std::vector<uint32_t> fused, passes;
+  std::vector<SimUniforms> pass_uniforms;
   uint32_t fused_substeps = 0, pass_substeps = 0;
   SubstepPlan plan;
   bool resets = false;
@@ -324,6 +361,7 @@ void GpuFleet::flush() {
       continue;
     }
     passes.push_back(i);
+    pass_uniforms.push_back(u);
     resets = resets || u.reset_active;
     if (u.reset_active) continue;
     pass_substeps = std::max(pass_substeps, substeps);
@@ -352,7 +390,15 @@ void GpuFleet::flush() {
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BIND_UNIFORMS].buffer, uint32_t(regions.size()), regions.data());
   VkBufferCopy queue_region{0, 0, 4ull * queue.size()};
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_QUEUE].buffer, 1, &queue_region);
-  if (!passes.empty()) {
+  if (!passes.empty() && per_sheet_) {
+    // Each sheet's full hash-pass grids, which its candidates_decide copies to the live ones
+    std::vector<VkBufferCopy> grid_regions;
+    for (uint32_t i : passes)
+      grid_regions.push_back(
+          {args_at, sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * SIM_HASH_DISPATCHES, 16ull * SIM_HASH_DISPATCHES});
+    vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BIND_HASH_ARGS].buffer, uint32_t(grid_regions.size()),
+                    grid_regions.data());
+  } else if (!passes.empty()) {
     VkBufferCopy args_region{args_at, 0, kArgsBytes};
     vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_ARGS].buffer, 1, &args_region);
   }
@@ -360,7 +406,7 @@ void GpuFleet::flush() {
   memoryBarrier(cmd_, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
                 VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
-                    VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+                    VK_ACCESS_2_UNIFORM_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   bound_ = VK_NULL_HANDLE;
   const VkDeviceAddress table = ctx_.address(table_);
   if (!fused.empty()) {
@@ -384,7 +430,31 @@ void GpuFleet::flush() {
       }
     last_dispatches_ += dispatched;
   }
-  if (!passes.empty()) {
+  if (!passes.empty() && per_sheet_) {
+    // Each sheet's per-colour passes, on its own descriptor set, as it records them alone
+    const uint32_t n = topo_.particleCount();
+    hash_grids_.clear();
+    for (size_t k = 0; k < passes.size(); ++k) {
+      const SimUniforms& u = pass_uniforms[k];
+      pass_sheet_ = passes[k];
+      const uint32_t zero = 0;
+      vkCmdBindDescriptorSets(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, sheet_layout_, 0, 1, &sheet_sets_[passes[k]], 1,
+                              &zero);
+      uint32_t count = 0;
+      if (u.reset_active) {
+        const SimPush all{0, n, 0, 0};
+        pass(sheet_passes_.reset, Grid::Threads, n, &all, sizeof(all), 0, SIM_GATE_RESET, 0);
+        continue;
+      }
+      const SubstepPlan sheet_plan{u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u, (u.flags & SIM_FLAG_AIR) != 0u};
+      for (uint32_t s = 0; s < substepCount(u.substeps); ++s)
+        recordSubstep(*this, sheet_passes_, topo_, sizes_, sheet_plan, s, count);
+    }
+    pass_sheet_ = -1;
+    glm::uvec4 grids[SIM_HASH_DISPATCHES] = {};
+    std::copy(hash_grids_.begin(), hash_grids_.end(), grids);
+    std::memcpy(inputs + args_at, grids, sizeof(grids));
+  } else if (!passes.empty()) {
     // The per-colour passes of the most substeps and iterations, each for every sheet; a sheet
     // runs those it runs alone (the gates). They touch other sheets' slices than the fused tick.
     pass_first_ = uint32_t(fused.size());
@@ -420,6 +490,10 @@ void GpuFleet::flush() {
 
 void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
                     uint32_t substep, uint32_t gate, uint32_t gate_arg) {
+  if (pass_sheet_ >= 0) {
+    passOfSheet(uint32_t(pass_sheet_), p, grid, count, push, push_size);
+    return;
+  }
   if (push_size > sizeof(SimPush) || p.push_size != sizeof(BatchPassPush))
     vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
   // The grid a sheet alone gets, with a workgroup z per sheet: from the element count; the hash
@@ -460,6 +534,43 @@ void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
   }
   case Grid::Compaction:
     vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer, 16ull * (SIM_BATCH_ARGS_LIVE_COMPACT + substep));
+    break;
+  }
+  ++last_dispatches_;
+}
+
+void GpuFleet::passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
+                           uint32_t push_size) {
+  if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
+  if (grid == Grid::Threads && count == 0) return;
+  const uint32_t groups = (count + p.workgroup - 1) / p.workgroup;
+  const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X), gy = gx ? (groups + gx - 1) / gx : 0u;
+  if (grid != Grid::Hash) hash_slot_ = 0;
+  if (bound_ != p.pipeline) {
+    vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+    bound_ = p.pipeline;
+  }
+  if (push_size) vkCmdPushConstants(cmd_, sheet_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_size, push);
+  switch (grid) {
+  case Grid::Threads:
+    vkCmdDispatch(cmd_, gx, gy, 1);
+    break;
+  case Grid::Workgroup:
+    vkCmdDispatch(cmd_, 1, 1, 1);
+    break;
+  case Grid::Hash: {
+    // The sheet's live hash arguments, which its candidates_decide copies from the full grids
+    const uint32_t slot = hash_slot_++;
+    const glm::uvec4 full(gx, gy, 1, 0);
+    if (slot >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
+    if (slot == hash_grids_.size()) hash_grids_.push_back(full);
+    if (hash_grids_[slot] != full) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
+    vkCmdDispatchIndirect(cmd_, buf_[SIM_BIND_HASH_ARGS].buffer, sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * slot);
+    break;
+  }
+  case Grid::Compaction:
+    vkCmdDispatchIndirect(cmd_, buf_[SIM_BIND_COUNTERS].buffer,
+                          sliceOffset(SIM_BIND_COUNTERS, i) + offsetof(Counters, compact_dispatch));
     break;
   }
   ++last_dispatches_;

@@ -20,13 +20,25 @@
 
 namespace tender::gpu {
 
+/// How a fleet runs the per-colour passes of the sheets the fused tick does not take. Both give
+/// every sheet the bits of its run alone.
+enum class FleetPasses : uint8_t {
+  Auto,    ///< Batched on a GPU, PerSheet on a CPU device
+  Batched, ///< each pass one dispatch for every sheet (a sheet per workgroup z, the SIM_BATCH_PASS builds)
+  /// each sheet's passes in turn, on a descriptor set over its slices (the solver's own shaders):
+  /// a CPU device runs these faster, its cost being per workgroup rather than per dispatch
+  PerSheet,
+};
+
 class GpuFleet final : public SheetBatch, private PassSink {
 public:
   /// A fleet of `sheets` sheets on an existing context (it must outlive the fleet). Throws with
   /// one line when the device cannot run it (no device addresses).
-  GpuFleet(VulkanContext& ctx, uint32_t sheets);
+  GpuFleet(VulkanContext& ctx, uint32_t sheets, FleetPasses passes = FleetPasses::Auto);
   /// A fleet that owns its context.
   GpuFleet(std::unique_ptr<VulkanContext> ctx, uint32_t sheets);
+  /// True when the per-colour passes run sheet by sheet (FleetPasses::PerSheet).
+  bool passesPerSheet() const { return per_sheet_; }
   ~GpuFleet() override;
   GpuFleet(const GpuFleet&) = delete;
   GpuFleet& operator=(const GpuFleet&) = delete;
@@ -45,10 +57,13 @@ private:
   class Sheet;
   friend class Sheet;
 
-  void create(uint32_t sheets);
+  void create(uint32_t sheets, FleetPasses passes);
   // PassSink: a pass of the per-colour path for the sheets at queue[pass_first_, + pass_sheets_)
   void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t substep,
             uint32_t gate, uint32_t gate_arg) override;
+  /// PerSheet: a pass of sheet i on its descriptor set (bound), as the solver dispatches it.
+  void passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
+                   uint32_t push_size);
   void barrier() override;
   void mark(PassCategory) override {}
   /// Allocates every buffer for the fleet from the first sheet's topology.
@@ -74,10 +89,17 @@ private:
 
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   PipelineSet owned_pipelines_;
-  ComputePipeline tick_batch_;            ///< the fused tick of a fleet (null: the device has too little shared memory)
-  SimPipelines passes_;                   ///< the per-colour passes of a fleet (SIM_BATCH_PASS)
-  float fused_max_cell_spacings_ = -1.0f; ///< largest hash cell the fused tick takes (< 0: any; FusedShape)
-  float spacing_ = 0.0f;                  ///< the sheets' grid spacing
+  ComputePipeline tick_batch_; ///< the fused tick of a fleet (null: the device has too little shared memory)
+  SimPipelines passes_;        ///< the per-colour passes of a fleet (SIM_BATCH_PASS)
+  bool per_sheet_ = false;     ///< FleetPasses::PerSheet
+  VkDescriptorSetLayout sheet_set_layout_ = VK_NULL_HANDLE; ///< PerSheet: a sheet's set, as the solver's
+  VkPipelineLayout sheet_layout_ = VK_NULL_HANDLE;
+  VkDescriptorPool sheet_pool_ = VK_NULL_HANDLE;
+  std::vector<VkDescriptorSet> sheet_sets_;   ///< PerSheet: each sheet's set over its slices
+  SimPipelines sheet_passes_;                 ///< PerSheet: the solver's passes
+  int64_t pass_sheet_ = -1;                   ///< PerSheet: the sheet whose passes are being recorded
+  float fused_max_cell_spacings_ = -1.0f;     ///< largest hash cell the fused tick takes (< 0: any; FusedShape)
+  float spacing_ = 0.0f;                      ///< the sheets' grid spacing
   uint32_t pass_first_ = 0, pass_sheets_ = 0; ///< the sheets in the queue the passes being recorded run for
   std::vector<glm::uvec4> hash_grids_;        ///< full grids of the hash passes, in recording order (their slots)
   uint32_t hash_slot_ = 0;                    ///< next hash-pass slot while recording

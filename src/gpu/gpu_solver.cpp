@@ -44,19 +44,7 @@ GpuSolver::~GpuSolver() {
 void GpuSolver::createPipelines(FusedShape fused) {
   VkDevice dev = ctx_.device();
   // One set layout: the uniforms (dynamic offset per tick slot) and every storage array.
-  std::vector<VkDescriptorSetLayoutBinding> bindings(kBindingCount);
-  for (uint32_t b = 0; b < kBindingCount; ++b) {
-    bindings[b].binding = b;
-    bindings[b].descriptorType =
-        b == SIM_BIND_UNIFORMS ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    bindings[b].descriptorCount = 1;
-    bindings[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-  }
-  VkDescriptorSetLayoutCreateInfo sli{};
-  sli.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  sli.bindingCount = kBindingCount;
-  sli.pBindings = bindings.data();
-  VK_CHECK(vkCreateDescriptorSetLayout(dev, &sli, nullptr, &set_layout_));
+  set_layout_ = createSheetSetLayout(dev);
   VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, uint32_t(sizeof(PickPush))};
   VkPipelineLayoutCreateInfo pli{};
   pli.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;

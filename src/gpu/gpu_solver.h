@@ -113,7 +113,7 @@ private:
   static constexpr uint32_t kSlots = 2;
   /// Uniform slot of the normals and pick passes (static: written at upload).
   static constexpr uint32_t kStaticSlot = kSlots;
-  static constexpr uint32_t kBindingCount = SIM_BIND_HASH_ARGS + 1;
+  static constexpr uint32_t kBindingCount = kSheetBindingCount;
   struct RecordKey {
     uint32_t substeps = 0, iterations = 0;
     bool collision = false;

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "gpu/context.h"
+
 namespace tender::gpu {
 
 using namespace shaderio;
@@ -35,6 +37,52 @@ VkDeviceSize bytesOf(const std::vector<T>& v) {
 }
 
 } // namespace
+
+VkDescriptorSetLayout createSheetSetLayout(VkDevice dev) {
+  std::array<VkDescriptorSetLayoutBinding, kSheetBindingCount> bindings{};
+  for (uint32_t b = 0; b < kSheetBindingCount; ++b) {
+    bindings[b].binding = b;
+    bindings[b].descriptorType =
+        b == SIM_BIND_UNIFORMS ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[b].descriptorCount = 1;
+    bindings[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  VkDescriptorSetLayoutCreateInfo sli{};
+  sli.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  sli.bindingCount = kSheetBindingCount;
+  sli.pBindings = bindings.data();
+  VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateDescriptorSetLayout(dev, &sli, nullptr, &layout));
+  return layout;
+}
+
+VkDescriptorPool createSheetSetPool(VkDevice dev, uint32_t sets) {
+  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, sets},
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, (kSheetBindingCount - 1) * sets}};
+  VkDescriptorPoolCreateInfo dpi{};
+  dpi.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  dpi.maxSets = sets;
+  dpi.poolSizeCount = 2;
+  dpi.pPoolSizes = sizes;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateDescriptorPool(dev, &dpi, nullptr, &pool));
+  return pool;
+}
+
+void writeSheetSet(VkDevice dev, VkDescriptorSet set,
+                   const std::array<VkDescriptorBufferInfo, kSheetBindingCount>& where) {
+  std::array<VkWriteDescriptorSet, kSheetBindingCount> writes{};
+  for (uint32_t b = 0; b < kSheetBindingCount; ++b) {
+    writes[b].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    writes[b].dstSet = set;
+    writes[b].dstBinding = b;
+    writes[b].descriptorCount = 1;
+    writes[b].descriptorType =
+        b == SIM_BIND_UNIFORMS ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[b].pBufferInfo = &where[b];
+  }
+  vkUpdateDescriptorSets(dev, kSheetBindingCount, writes.data(), 0, nullptr);
+}
 
 uint32_t scanSumsSize(uint32_t count) {
   uint32_t groups = (count + SIM_SCAN_BLOCK - 1) / SIM_SCAN_BLOCK;

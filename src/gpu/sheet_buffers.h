@@ -2,6 +2,7 @@
 /// The storage buffers of one sheet, described by one table of bindings: the size of each from
 /// the topology, its start contents, whether a reset restores it and whether a read-back copies it.
 /// The solver (one sheet) and the fleet (a slice of each buffer per sheet) both work from it.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -41,6 +42,20 @@ struct StartData {
   uint32_t last_start = 0;
   shaderio::Counters counters{};
 };
+
+/// Bindings of a sheet's descriptor set: the uniforms (SIM_BIND_UNIFORMS, a dynamic uniform buffer)
+/// and every storage array, up to SIM_BIND_HASH_ARGS.
+constexpr uint32_t kSheetBindingCount = SIM_BIND_HASH_ARGS + 1;
+
+/// The layout of a sheet's descriptor set (kSheetBindingCount bindings).
+VkDescriptorSetLayout createSheetSetLayout(VkDevice dev);
+
+/// A pool of `sets` sheet descriptor sets.
+VkDescriptorPool createSheetSetPool(VkDevice dev, uint32_t sets);
+
+/// Points `set`'s bindings at `where[binding]` (the uniforms take sizeof(SimUniforms)).
+void writeSheetSet(VkDevice dev, VkDescriptorSet set,
+                   const std::array<VkDescriptorBufferInfo, kSheetBindingCount>& where);
 
 /// Elements of the per-block sums of a scan of `count` elements (every level).
 uint32_t scanSumsSize(uint32_t count);

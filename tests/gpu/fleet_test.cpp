@@ -43,11 +43,15 @@ TEST_F(GpuFleetTest, OneDispatchRunsEveryQueuedSheetsTick) {
   EXPECT_EQ(batch.dispatchesPerFlush(), cpu_device ? (4 + group - 1) / group * 8 : 1u);
 }
 
-TEST_F(GpuFleetTest, AFlushRunsFusedAndPerColourSheetsTogether) {
+// The per-colour passes of sheets the fused tick does not take, both ways: batched (a GPU's
+// default) and sheet by sheet (a CPU device's)
+class GpuFleetPasses : public GpuTest, public testing::WithParamInterface<gpu::FleetPasses> {};
+
+TEST_P(GpuFleetPasses, AFlushRunsFusedAndPerColourSheetsTogether) {
   // Sheet 5 has hash cells of 5 spacings: a CPU device's fused tick does not take it, so alone
   // and in the fleet it runs the per-colour passes, while the others run the fused tick.
   const std::vector<FleetSheet> sheets = mixedFleet(6);
-  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()));
+  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()), GetParam());
   gpu::GpuSolver alone(ctx());
   expectFleetMatchesAlone(batch, alone, sheets, 12);
   const bool cpu_device = ctx().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
@@ -60,11 +64,12 @@ TEST_F(GpuFleetTest, AFlushRunsFusedAndPerColourSheetsTogether) {
     EXPECT_EQ(batch.dispatchesPerFlush(), 1u);
 }
 
-TEST_F(GpuFleetTest, SheetsTooLargeForTheFusedTickRunThePerColourPassesBatched) {
-  // 48 x 48: over SIM_FUSED_MAX_PARTICLES, so each pass is one dispatch for every sheet, and a
-  // gate picks the sheets that run it (substeps, iterations, air, collision, hash, tears, reset)
+TEST_P(GpuFleetPasses, SheetsTooLargeForTheFusedTickMatchTheirRunsAlone) {
+  // 48 x 48: over SIM_FUSED_MAX_PARTICLES. Batched, each pass is one dispatch for every sheet and
+  // a gate picks the sheets that run it (substeps, iterations, air, collision, hash, tears, reset).
   const std::vector<FleetSheet> sheets = mixedFleet(9, 48, 48);
-  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()));
+  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()), GetParam());
+  EXPECT_EQ(batch.passesPerSheet(), GetParam() == gpu::FleetPasses::PerSheet);
   gpu::GpuSolver alone(ctx());
   const uint32_t tore = expectFleetMatchesAlone(batch, alone, sheets, 40);
   EXPECT_FALSE(alone.usesFusedPath());
@@ -72,17 +77,18 @@ TEST_F(GpuFleetTest, SheetsTooLargeForTheFusedTickRunThePerColourPassesBatched) 
   EXPECT_LT(tore, sheets.size());
 }
 
-TEST_F(GpuFleetTest, ThePerColourFleetMatchesTheCpuReference) {
+TEST_P(GpuFleetPasses, ThePerColourFleetMatchesTheCpuReference) {
   const std::vector<FleetSheet> sheets = mixedFleet(3, 48, 48);
-  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()));
+  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()), GetParam());
   CpuSolver alone(cpuOptionsLike(ctx()));
   expectFleetMatchesAlone(batch, alone, sheets, 20);
 }
 
-TEST_F(GpuFleetTest, APassOfLargeSheetsIsOneDispatchForTheWholeBatch) {
-  // Five sheets of one size record the passes one of them records alone
+TEST_P(GpuFleetPasses, LargeSheetsRecordTheDispatchesOfOneSheetPerPassOrPerSheet) {
+  // Five sheets of one size: batched, the passes one of them records alone; sheet by sheet, five
+  // times those
   const SimParams p = preset("tender", {"cols=48", "rows=48"});
-  gpu::GpuFleet batch(ctx(), 5);
+  gpu::GpuFleet batch(ctx(), 5, GetParam());
   Fleet fleet(batch, std::vector<FleetSheet>(5, FleetSheet{p, {}}));
   gpu::GpuSolver alone(ctx());
   Simulation sim(p, alone);
@@ -91,7 +97,18 @@ TEST_F(GpuFleetTest, APassOfLargeSheetsIsOneDispatchForTheWholeBatch) {
     sim.tick();
   }
   EXPECT_GT(alone.dispatchesPerTick(), 50u);
-  EXPECT_EQ(batch.dispatchesPerFlush(), alone.dispatchesPerTick());
+  EXPECT_EQ(batch.dispatchesPerFlush(), alone.dispatchesPerTick() * (batch.passesPerSheet() ? 5u : 1u));
+}
+
+INSTANTIATE_TEST_SUITE_P(Fleet, GpuFleetPasses, testing::Values(gpu::FleetPasses::Batched, gpu::FleetPasses::PerSheet),
+                         [](const testing::TestParamInfo<gpu::FleetPasses>& param) {
+                           return param.param == gpu::FleetPasses::Batched ? std::string("batched")
+                                                                           : std::string("per_sheet");
+                         });
+
+TEST_F(GpuFleetTest, ACpuDeviceRunsThePerColourPassesSheetBySheet) {
+  gpu::GpuFleet batch(ctx(), 2);
+  EXPECT_EQ(batch.passesPerSheet(), ctx().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
 }
 
 } // namespace
