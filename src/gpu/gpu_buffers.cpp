@@ -52,7 +52,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
   spacing_ = structuralSpacing(topo);
   const VkDeviceSize max_range = ctx_.properties().limits.maxStorageBufferRange;
   layout_sizes_ = SheetLayout::of(topo, max_range);
-  hash_grids_.clear();
+  hash_slots_.clear();
   hash_grids_uploaded_.clear();
 
   // The uniforms (host-visible, one slot per tick in flight and one static), then the table.

@@ -433,7 +433,7 @@ void GpuFleet::flush() {
   if (!passes.empty() && per_sheet_) {
     // Each sheet's per-colour passes, on its own descriptor set, as it records them alone
     const uint32_t n = topo_.particleCount();
-    hash_grids_.clear();
+    hash_slots_.clear();
     for (size_t k = 0; k < passes.size(); ++k) {
       const SimUniforms& u = pass_uniforms[k];
       pass_sheet_ = passes[k];
@@ -452,7 +452,7 @@ void GpuFleet::flush() {
     }
     pass_sheet_ = -1;
     glm::uvec4 grids[SIM_HASH_DISPATCHES] = {};
-    std::copy(hash_grids_.begin(), hash_grids_.end(), grids);
+    std::copy(hash_slots_.grids().begin(), hash_slots_.grids().end(), grids);
     std::memcpy(inputs + args_at, grids, sizeof(grids));
   } else if (!passes.empty()) {
     // The per-colour passes of the most substeps and iterations, each for every sheet; a sheet
@@ -466,7 +466,7 @@ void GpuFleet::flush() {
       barrier();
     }
     uint32_t count = 0;
-    hash_grids_.clear();
+    hash_slots_.clear();
     for (uint32_t s = 0; s < pass_substeps; ++s) recordSubstep(*this, passes_, topo_, sizes_, plan, s, count);
     // The batch's indirect arguments (the copy recorded above takes them at submission): the full
     // grids, and the live ones of every substep with no workgroups until a sheet needs them
@@ -474,7 +474,7 @@ void GpuFleet::flush() {
     const uint32_t compact_groups = (sizes_.tear_slots + SIM_WG_TEAR - 1) / SIM_WG_TEAR;
     const uint32_t cx = std::min<uint32_t>(compact_groups, SIM_MAX_GROUPS_X);
     args[SIM_BATCH_ARGS_FULL_COMPACT] = glm::uvec4(cx, (compact_groups + cx - 1) / cx, pass_sheets_, 0);
-    for (uint32_t k = 0; k < hash_grids_.size(); ++k) args[k] = hash_grids_[k];
+    for (uint32_t k = 0; k < hash_slots_.grids().size(); ++k) args[k] = hash_slots_.grids()[k];
     for (uint32_t s = 0; s < SIM_MAX_SUBSTEPS; ++s) {
       for (uint32_t k = 0; k < SIM_HASH_DISPATCHES; ++k)
         args[SIM_BATCH_ARGS_LIVE_HASH + s * SIM_HASH_DISPATCHES + k] = glm::uvec4(0, args[k].y, pass_sheets_, 0);
@@ -500,9 +500,8 @@ void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
   // passes and the compaction from the batch's live arguments, which the sheets that need them
   // arm (the gates skip the other sheets).
   if ((grid == Grid::Threads || grid == Grid::Hash) && count == 0) return;
-  const uint32_t groups = grid == Grid::Threads || grid == Grid::Hash ? (count + p.workgroup - 1) / p.workgroup : 1u;
-  const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X), gy = (groups + gx - 1) / gx;
-  if (grid != Grid::Hash) hash_slot_ = 0;
+  const glm::uvec4 full = fullGrid(p, grid == Grid::Threads || grid == Grid::Hash ? count : 1u, pass_sheets_);
+  const uint32_t hash_slot = hash_slots_.record(grid, full);
   BatchPassPush bp{};
   if (push_size) std::memcpy(&bp.pass, push, push_size);
   const VkDeviceAddress table = ctx_.address(table_);
@@ -518,20 +517,15 @@ void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
   vkCmdPushConstants(cmd_, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(bp), &bp);
   switch (grid) {
   case Grid::Threads:
+    vkCmdDispatch(cmd_, full.x, full.y, pass_sheets_);
+    break;
   case Grid::Workgroup:
-    vkCmdDispatch(cmd_, gx, gy, pass_sheets_);
+    vkCmdDispatch(cmd_, 1, 1, pass_sheets_);
     break;
-  case Grid::Hash: {
-    // Every substep records the same hash passes into the same slots
-    const uint32_t slot = hash_slot_++;
-    const glm::uvec4 full(gx, gy, pass_sheets_, 0);
-    if (slot >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
-    if (slot == hash_grids_.size()) hash_grids_.push_back(full);
-    if (hash_grids_[slot] != full) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
+  case Grid::Hash:
     vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer,
-                          16ull * (SIM_BATCH_ARGS_LIVE_HASH + substep * SIM_HASH_DISPATCHES + slot));
+                          16ull * (SIM_BATCH_ARGS_LIVE_HASH + substep * SIM_HASH_DISPATCHES + hash_slot));
     break;
-  }
   case Grid::Compaction:
     vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer, 16ull * (SIM_BATCH_ARGS_LIVE_COMPACT + substep));
     break;
@@ -543,9 +537,8 @@ void GpuFleet::passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint
                            uint32_t push_size) {
   if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
   if (grid == Grid::Threads && count == 0) return;
-  const uint32_t groups = (count + p.workgroup - 1) / p.workgroup;
-  const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X), gy = gx ? (groups + gx - 1) / gx : 0u;
-  if (grid != Grid::Hash) hash_slot_ = 0;
+  const glm::uvec4 full = fullGrid(p, count);
+  const uint32_t hash_slot = hash_slots_.record(grid, full);
   if (bound_ != p.pipeline) {
     vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
     bound_ = p.pipeline;
@@ -553,21 +546,16 @@ void GpuFleet::passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint
   if (push_size) vkCmdPushConstants(cmd_, sheet_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_size, push);
   switch (grid) {
   case Grid::Threads:
-    vkCmdDispatch(cmd_, gx, gy, 1);
+    vkCmdDispatch(cmd_, full.x, full.y, 1);
     break;
   case Grid::Workgroup:
     vkCmdDispatch(cmd_, 1, 1, 1);
     break;
-  case Grid::Hash: {
+  case Grid::Hash:
     // The sheet's live hash arguments, which its candidates_decide copies from the full grids
-    const uint32_t slot = hash_slot_++;
-    const glm::uvec4 full(gx, gy, 1, 0);
-    if (slot >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
-    if (slot == hash_grids_.size()) hash_grids_.push_back(full);
-    if (hash_grids_[slot] != full) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
-    vkCmdDispatchIndirect(cmd_, buf_[SIM_BIND_HASH_ARGS].buffer, sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * slot);
+    vkCmdDispatchIndirect(cmd_, buf_[SIM_BIND_HASH_ARGS].buffer,
+                          sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * hash_slot);
     break;
-  }
   case Grid::Compaction:
     vkCmdDispatchIndirect(cmd_, buf_[SIM_BIND_COUNTERS].buffer,
                           sliceOffset(SIM_BIND_COUNTERS, i) + offsetof(Counters, compact_dispatch));

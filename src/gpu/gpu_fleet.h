@@ -101,8 +101,7 @@ private:
   float fused_max_cell_spacings_ = -1.0f;     ///< largest hash cell the fused tick takes (< 0: any; FusedShape)
   float spacing_ = 0.0f;                      ///< the sheets' grid spacing
   uint32_t pass_first_ = 0, pass_sheets_ = 0; ///< the sheets in the queue the passes being recorded run for
-  std::vector<glm::uvec4> hash_grids_;        ///< full grids of the hash passes, in recording order (their slots)
-  uint32_t hash_slot_ = 0;                    ///< next hash-pass slot while recording
+  HashSlots hash_slots_;                      ///< full grids of the hash passes, in recording order
   VkPipeline bound_ = VK_NULL_HANDLE;         ///< pipeline bound while recording
   FloatRules float_rules_;
   MathSwitches math_;

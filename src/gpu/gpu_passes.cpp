@@ -18,19 +18,8 @@ void GpuSolver::dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid gri
                          uint32_t push_size) {
   if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
   if (grid == Grid::Threads && count == 0) return;
-  // The full grid of `count` elements; wider than SIM_MAX_GROUPS_X spills into Y (the shaders
-  // linearise the group index).
-  const uint32_t groups = (count + p.workgroup - 1) / p.workgroup;
-  const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X);
-  const glm::uvec4 full(gx, gx ? (groups + gx - 1) / gx : 0u, 1u, 0u);
-  uint32_t hash_slot = 0;
-  if (grid == Grid::Hash) {
-    // Every substep records the same hash passes into the same live slots
-    hash_slot = hash_slot_++;
-    if (hash_slot >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
-    if (hash_slot == hash_grids_.size()) hash_grids_.push_back(full);
-    if (hash_grids_[hash_slot] != full) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
-  }
+  const glm::uvec4 full = fullGrid(p, count);
+  const uint32_t hash_slot = hash_slots_.record(grid, full);
   if (bound_ != p.pipeline) {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
     bound_ = p.pipeline;
@@ -64,9 +53,7 @@ void GpuSolver::timestamp(VkCommandBuffer cmd, Slot& slot, PassCategory c) {
 
 void GpuSolver::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
                      uint32_t, uint32_t, uint32_t) {
-  // One sheet: it runs every pass recorded for it. Each run of hash passes takes the live hash
-  // arguments from the first.
-  if (grid != Grid::Hash) hash_slot_ = 0;
+  // One sheet: it runs every pass recorded for it
   dispatch(recording_->tick, p, grid, count, push, push_size);
 }
 
@@ -111,12 +98,12 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
   VK_CHECK(vkEndCommandBuffer(cmd));
   slot.recorded = key;
   // The full grids of the hash passes, which candidates_decide copies to the live slots
-  if (hash_grids_ != hash_grids_uploaded_) {
+  if (hash_slots_.grids() != hash_grids_uploaded_) {
     ctx_.submitOnce([&](VkCommandBuffer up) {
       vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * SIM_HASH_DISPATCHES,
-                        16 * hash_grids_.size(), hash_grids_.data());
+                        16 * hash_slots_.grids().size(), hash_slots_.grids().data());
     });
-    hash_grids_uploaded_ = hash_grids_;
+    hash_grids_uploaded_ = hash_slots_.grids();
   }
   slot.dispatches = recorded_dispatches_;
 }

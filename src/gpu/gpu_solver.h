@@ -197,9 +197,8 @@ private:
   float fused_max_cell_spacings_ = -1.0f;       ///< largest hash cell of the fused tick (< 0: any)
   float spacing_ = 0.0f;                        ///< grid spacing: the shortest structural rest length
   bool candidates_allowed_ = true;              ///< setCandidateLists
-  std::vector<glm::uvec4> hash_grids_;          ///< full grids of the hash passes, in recording order
+  HashSlots hash_slots_;                        ///< full grids of the hash passes, in recording order
   std::vector<glm::uvec4> hash_grids_uploaded_; ///< what SIM_BIND_HASH_ARGS holds of them
-  uint32_t hash_slot_ = 0;                      ///< next live hash-pass argument while recording
   uint32_t stop_after_ = SIM_NONE;              ///< stopNextTickAfter
   mutable std::array<double, kCategoryCount> last_ms_{};
 };

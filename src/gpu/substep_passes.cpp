@@ -1,8 +1,28 @@
 #include "gpu/substep_passes.h"
 
+#include <algorithm>
+
 namespace tender::gpu {
 
 using namespace shaderio;
+
+glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets) {
+  const uint32_t groups = (count + p.workgroup - 1) / p.workgroup;
+  const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X);
+  return glm::uvec4(gx, gx ? (groups + gx - 1) / gx : 0u, sheets, 0u);
+}
+
+uint32_t HashSlots::record(Grid grid, glm::uvec4 full) {
+  if (grid != Grid::Hash) {
+    next_ = 0;
+    return 0;
+  }
+  const uint32_t slot = next_++;
+  if (slot >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
+  if (slot == grids_.size()) grids_.push_back(full);
+  if (grids_[slot] != full) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
+  return slot;
+}
 
 namespace {
 

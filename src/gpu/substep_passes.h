@@ -4,6 +4,7 @@
 /// of a batch, and its gate (SIM_GATE_* in sim_config.h) picks the sheets that run it, those that
 /// would run it alone.
 #include <cstdint>
+#include <vector>
 
 #include "core/sheet.h"
 #include "gpu/sheet_buffers.h"
@@ -19,6 +20,30 @@ enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash };
 /// Timestamp categories of a tick, in Solver::passTimes() order. kFused: the fused small-sheet
 /// tick, every pass in one dispatch.
 enum PassCategory : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kFused, kCategoryCount };
+
+/// The full grid of `count` elements of `p`, with `sheets` workgroups in z: wider than
+/// SIM_MAX_GROUPS_X spills into y (the shaders linearise the group index).
+glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets = 1);
+
+/// The full grids of the hash passes, in recording order: every substep records the same hash
+/// passes into the same slots (at most SIM_HASH_DISPATCHES), whose live arguments the passes
+/// dispatch from.
+class HashSlots {
+public:
+  /// A pass of grid `grid` is recorded. A hash pass of full grid `full` takes the next slot and
+  /// returns it (its grid checked against earlier substeps'); any other pass makes the next hash
+  /// pass take slot 0.
+  uint32_t record(Grid grid, glm::uvec4 full);
+  const std::vector<glm::uvec4>& grids() const { return grids_; }
+  void clear() {
+    grids_.clear();
+    next_ = 0;
+  }
+
+private:
+  std::vector<glm::uvec4> grids_;
+  uint32_t next_ = 0;
+};
 
 /// Where the passes of a substep go.
 class PassSink {
