@@ -494,4 +494,17 @@ void VulkanContext::download(const Buffer& src, void* data, VkDeviceSize size, V
   destroyBuffer(staging);
 }
 
+std::vector<VkDescriptorSet> allocateDescriptorSets(VkDevice dev, VkDescriptorPool pool, VkDescriptorSetLayout layout,
+                                                    uint32_t count) {
+  std::vector<VkDescriptorSetLayout> layouts(count, layout);
+  std::vector<VkDescriptorSet> sets(count, VK_NULL_HANDLE);
+  VkDescriptorSetAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  ai.descriptorPool = pool;
+  ai.descriptorSetCount = count;
+  ai.pSetLayouts = layouts.data();
+  if (count) VK_CHECK(vkAllocateDescriptorSets(dev, &ai, sets.data()));
+  return sets;
+}
+
 } // namespace tender::gpu

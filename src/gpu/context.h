@@ -112,6 +112,10 @@ struct DeviceInfo {
 /// Lists the Vulkan devices, or fails with one line when Vulkan or a device is missing.
 Result<std::vector<DeviceInfo>> listDevices();
 
+/// `count` descriptor sets of `layout` from `pool` (throws VulkanError when Vulkan fails).
+std::vector<VkDescriptorSet> allocateDescriptorSets(VkDevice dev, VkDescriptorPool pool, VkDescriptorSetLayout layout,
+                                                    uint32_t count);
+
 /// A buffer with its own memory; `mapped` is set for host-visible buffers.
 struct Buffer {
   VkBuffer buffer = VK_NULL_HANDLE;

@@ -75,12 +75,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
 
   // One descriptor set over every buffer.
   descriptor_pool_ = createSheetSetPool(dev, 1);
-  VkDescriptorSetAllocateInfo dai{};
-  dai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  dai.descriptorPool = descriptor_pool_;
-  dai.descriptorSetCount = 1;
-  dai.pSetLayouts = &set_layout_;
-  VK_CHECK(vkAllocateDescriptorSets(dev, &dai, &set_));
+  set_ = allocateDescriptorSets(dev, descriptor_pool_, set_layout_, 1)[0];
   std::array<VkDescriptorBufferInfo, kSheetBindingCount> where{};
   for (uint32_t b = 0; b < kBindingCount; ++b)
     where[b] = {buf_[b].buffer, 0, b == SIM_BIND_UNIFORMS ? VkDeviceSize(sizeof(SimUniforms)) : VK_WHOLE_SIZE};

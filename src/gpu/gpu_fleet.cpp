@@ -181,14 +181,7 @@ void GpuFleet::allocate(const SheetTopology& topo) {
     // Each sheet's descriptor set over its slices
     VkDevice dev = ctx_.device();
     sheet_pool_ = createSheetSetPool(dev, sheets);
-    sheet_sets_.assign(sheets, VK_NULL_HANDLE);
-    std::vector<VkDescriptorSetLayout> layouts(sheets, sheet_set_layout_);
-    VkDescriptorSetAllocateInfo dai{};
-    dai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-    dai.descriptorPool = sheet_pool_;
-    dai.descriptorSetCount = sheets;
-    dai.pSetLayouts = layouts.data();
-    VK_CHECK(vkAllocateDescriptorSets(dev, &dai, sheet_sets_.data()));
+    sheet_sets_ = allocateDescriptorSets(dev, sheet_pool_, sheet_set_layout_, sheets);
     for (uint32_t i = 0; i < sheets; ++i) {
       std::array<VkDescriptorBufferInfo, kSheetBindingCount> where{};
       for (uint32_t b = 0; b < kSheetBindingCount; ++b)
@@ -535,33 +528,13 @@ void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
 
 void GpuFleet::passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
                            uint32_t push_size) {
-  if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
-  if (grid == Grid::Threads && count == 0) return;
-  const glm::uvec4 full = fullGrid(p, count);
-  const uint32_t hash_slot = hash_slots_.record(grid, full);
-  if (bound_ != p.pipeline) {
-    vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-    bound_ = p.pipeline;
-  }
-  if (push_size) vkCmdPushConstants(cmd_, sheet_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_size, push);
-  switch (grid) {
-  case Grid::Threads:
-    vkCmdDispatch(cmd_, full.x, full.y, 1);
-    break;
-  case Grid::Workgroup:
-    vkCmdDispatch(cmd_, 1, 1, 1);
-    break;
-  case Grid::Hash:
-    // The sheet's live hash arguments, which its candidates_decide copies from the full grids
-    vkCmdDispatchIndirect(cmd_, buf_[SIM_BIND_HASH_ARGS].buffer,
-                          sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * hash_slot);
-    break;
-  case Grid::Compaction:
-    vkCmdDispatchIndirect(cmd_, buf_[SIM_BIND_COUNTERS].buffer,
-                          sliceOffset(SIM_BIND_COUNTERS, i) + offsetof(Counters, compact_dispatch));
-    break;
-  }
-  ++last_dispatches_;
+  const SheetPassTarget target{cmd_,
+                               sheet_layout_,
+                               buf_[SIM_BIND_HASH_ARGS].buffer,
+                               sliceOffset(SIM_BIND_HASH_ARGS, i),
+                               buf_[SIM_BIND_COUNTERS].buffer,
+                               sliceOffset(SIM_BIND_COUNTERS, i)};
+  if (recordSheetPass(target, bound_, hash_slots_, p, grid, count, push, push_size)) ++last_dispatches_;
 }
 
 void GpuFleet::barrier() { computeToCompute(cmd_); }

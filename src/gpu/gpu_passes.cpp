@@ -16,30 +16,8 @@ void GpuSolver::bindSet(VkCommandBuffer cmd, uint32_t uniform_slot) {
 
 void GpuSolver::dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
                          uint32_t push_size) {
-  if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
-  if (grid == Grid::Threads && count == 0) return;
-  const glm::uvec4 full = fullGrid(p, count);
-  const uint32_t hash_slot = hash_slots_.record(grid, full);
-  if (bound_ != p.pipeline) {
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-    bound_ = p.pipeline;
-  }
-  if (push_size) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_size, push);
-  switch (grid) {
-  case Grid::Threads:
-    vkCmdDispatch(cmd, full.x, full.y, 1);
-    break;
-  case Grid::Workgroup:
-    vkCmdDispatch(cmd, 1, 1, 1);
-    break;
-  case Grid::Compaction:
-    vkCmdDispatchIndirect(cmd, buf_[SIM_BIND_COUNTERS].buffer, offsetof(Counters, compact_dispatch));
-    break;
-  case Grid::Hash:
-    vkCmdDispatchIndirect(cmd, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * hash_slot);
-    break;
-  }
-  ++recorded_dispatches_;
+  const SheetPassTarget target{cmd, layout_, buf_[SIM_BIND_HASH_ARGS].buffer, 0, buf_[SIM_BIND_COUNTERS].buffer, 0};
+  if (recordSheetPass(target, bound_, hash_slots_, p, grid, count, push, push_size)) ++recorded_dispatches_;
 }
 
 void GpuSolver::timestamp(VkCommandBuffer cmd, Slot& slot, PassCategory c) {

@@ -201,13 +201,7 @@ void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitche
   // At most 2^16 - 1 workgroups of 64 per row; the rest of a batch spills into Y
   const uint64_t per_batch = std::min<uint64_t>(cases.size(), 1u << 22);
   o.buffer = ctx.createHostBuffer(per_batch * sizeof(MathCase), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  VkDescriptorSetAllocateInfo dai{};
-  dai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  dai.descriptorPool = o.pool;
-  dai.descriptorSetCount = 1;
-  dai.pSetLayouts = &o.set_layout;
-  VkDescriptorSet set;
-  VK_CHECK(vkAllocateDescriptorSets(dev, &dai, &set));
+  VkDescriptorSet set = allocateDescriptorSets(dev, o.pool, o.set_layout, 1)[0];
   VkDescriptorBufferInfo bi{o.buffer.buffer, 0, VK_WHOLE_SIZE};
   VkWriteDescriptorSet w{};
   w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;

@@ -24,6 +24,35 @@ uint32_t HashSlots::record(Grid grid, glm::uvec4 full) {
   return slot;
 }
 
+bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashSlots& slots, const ComputePipeline& p, Grid grid,
+                     uint32_t count, const void* push, uint32_t push_size) {
+  if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
+  if (grid == Grid::Threads && count == 0) return false;
+  const glm::uvec4 full = fullGrid(p, count);
+  const uint32_t hash_slot = slots.record(grid, full);
+  if (bound != p.pipeline) {
+    vkCmdBindPipeline(t.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+    bound = p.pipeline;
+  }
+  if (push_size) vkCmdPushConstants(t.cmd, t.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_size, push);
+  switch (grid) {
+  case Grid::Threads:
+    vkCmdDispatch(t.cmd, full.x, full.y, 1);
+    break;
+  case Grid::Workgroup:
+    vkCmdDispatch(t.cmd, 1, 1, 1);
+    break;
+  case Grid::Compaction:
+    vkCmdDispatchIndirect(t.cmd, t.counters, t.counters_offset + offsetof(Counters, compact_dispatch));
+    break;
+  case Grid::Hash:
+    // The live arguments candidates_decide copied from the full grids (or zero workgroups)
+    vkCmdDispatchIndirect(t.cmd, t.hash_args, t.hash_offset + 16ull * hash_slot);
+    break;
+  }
+  return true;
+}
+
 namespace {
 
 template <class Push>

@@ -45,6 +45,23 @@ private:
   uint32_t next_ = 0;
 };
 
+/// Where one sheet's arrays and indirect arguments are bound for its passes.
+struct SheetPassTarget {
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE; ///< the sheet's descriptor set is bound on it
+  VkBuffer hash_args = VK_NULL_HANDLE;      ///< its SIM_BIND_HASH_ARGS (live arguments from hash_offset)
+  VkDeviceSize hash_offset = 0;
+  VkBuffer counters = VK_NULL_HANDLE; ///< its SIM_BIND_COUNTERS (the Counters from counters_offset)
+  VkDeviceSize counters_offset = 0;
+};
+
+/// Records a pass of one sheet on its descriptor set, as the solver dispatches it: `count`
+/// elements (Grid::Threads; none: nothing recorded), one workgroup, the compaction's indirect
+/// arguments, or the next hash slot's live arguments. `bound` is the pipeline bound on `t.cmd`.
+/// Returns false when nothing was recorded.
+bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashSlots& slots, const ComputePipeline& p, Grid grid,
+                     uint32_t count, const void* push, uint32_t push_size);
+
 /// Where the passes of a substep go.
 class PassSink {
 public:

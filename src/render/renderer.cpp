@@ -178,14 +178,7 @@ void Renderer::createDescriptors() {
   dp.poolSizeCount = 3;
   dp.pPoolSizes = sizes;
   VK_CHECK(vkCreateDescriptorPool(dev_, &dp, nullptr, &pool_));
-  std::vector<VkDescriptorSetLayout> layouts(n, set_layout_);
-  sets_.resize(n);
-  VkDescriptorSetAllocateInfo ai{};
-  ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  ai.descriptorPool = pool_;
-  ai.descriptorSetCount = n;
-  ai.pSetLayouts = layouts.data();
-  VK_CHECK(vkAllocateDescriptorSets(dev_, &ai, sets_.data()));
+  sets_ = gpu::allocateDescriptorSets(dev_, pool_, set_layout_, n);
   uniforms_.resize(n);
   paper_.resize(n);
   for (uint32_t i = 0; i < n; ++i) {
