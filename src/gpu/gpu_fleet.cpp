@@ -87,9 +87,9 @@ void GpuFleet::create(uint32_t sheets, FleetPasses passes) {
   // The fused tick's shape on this kind of device (see FusedShape in gpu_solver.h); a device with
   // too little shared memory for it runs every sheet's per-colour passes, as a sheet alone does.
   const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
-  const uint32_t workgroup = cpu_device ? SIM_WG_FUSED_CPU : SIM_WG_FUSED;
-  substeps_per_dispatch_ = cpu_device ? SIM_FUSED_SUBSTEPS_CPU : SIM_MAX_SUBSTEPS;
-  fused_max_cell_spacings_ = cpu_device ? SIM_FUSED_CPU_MAX_CELL_SPACINGS : -1.0f;
+  const FusedShape shape = resolveFusedShape(ctx_);
+  substeps_per_dispatch_ = shape.substeps_per_dispatch;
+  fused_max_cell_spacings_ = shape.max_cell_spacings;
   sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
   per_sheet_ = passes == FleetPasses::PerSheet || (passes == FleetPasses::Auto && cpu_device);
   if (per_sheet_) {
@@ -101,9 +101,9 @@ void GpuFleet::create(uint32_t sheets, FleetPasses passes) {
     VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &sheet_layout_));
     sheet_passes_ = makePassPipelines(ctx_, sheet_layout_, float_rules_, math_, false, owned_pipelines_);
   }
-  if (ctx_.properties().limits.maxComputeSharedMemorySize >= 16u * SIM_FUSED_MAX_PARTICLES)
+  if (fusedTickSupported(ctx_))
     tick_batch_ = makeComputePipeline(ctx_, "tick_batch.comp", layout_, float_rules_, math_, sizeof(BatchPush), 1,
-                                      workgroup, true, owned_pipelines_);
+                                      shape.workgroup, true, owned_pipelines_);
 
   VkFenceCreateInfo fci{};
   fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
@@ -166,6 +166,7 @@ void GpuFleet::allocate(const SheetTopology& topo) {
       entries[b] = glm::uvec4(uint32_t(a), uint32_t(a >> 32), uint32_t(stride_[b]), uint32_t(stride_[b] >> 32));
     }
     table_ = ctx_.createDeviceBuffer(sizeof(entries), kSliceUsage);
+    table_address_ = ctx_.address(table_);
     inputs_ =
         ctx_.createHostBuffer(alignUp(4ull * sheets, kSliceAlign) + stride_[SIM_BIND_UNIFORMS] * sheets + kArgsBytes,
                               VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
@@ -401,7 +402,7 @@ void GpuFleet::flush() {
                 VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
                     VK_ACCESS_2_UNIFORM_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   bound_ = VK_NULL_HANDLE;
-  const VkDeviceAddress table = ctx_.address(table_);
+  const VkDeviceAddress table = table_address_;
   if (!fused.empty()) {
     // On a GPU one dispatch runs every fused sheet's whole tick. A CPU device runs a substep per
     // dispatch (SIM_FUSED_SUBSTEPS_CPU): it takes the sheets a few at a time, each few through every
@@ -497,7 +498,7 @@ void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
   const uint32_t hash_slot = hash_slots_.record(grid, full);
   BatchPassPush bp{};
   if (push_size) std::memcpy(&bp.pass, push, push_size);
-  const VkDeviceAddress table = ctx_.address(table_);
+  const VkDeviceAddress table = table_address_;
   bp.batch.table = glm::uvec2(uint32_t(table), uint32_t(table >> 32));
   bp.batch.first = pass_first_;
   bp.batch.substep = substep;

@@ -114,6 +114,7 @@ private:
   std::array<Buffer, SIM_BATCH_ENTRIES> buf_{};          ///< per binding: a slice per sheet; the queue
   std::array<VkDeviceSize, SIM_BATCH_ENTRIES> stride_{}; ///< bytes from one sheet's slice to the next
   Buffer table_;                                         ///< SIM_BATCH_ENTRIES uvec4 (device)
+  VkDeviceAddress table_address_ = 0;                    ///< its device address (the shaders' push constants)
   Buffer inputs_; ///< host: the queue, the uniforms of each sheet, then the batch's indirect arguments
 
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;

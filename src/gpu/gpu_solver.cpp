@@ -62,16 +62,11 @@ void GpuSolver::createPipelines(FusedShape fused) {
   math_ = MathSwitches::fromEnvironment();
   pipes_ = makePassPipelines(ctx_, layout_, float_rules_, math_, false, owned_pipelines_);
   // The fused tick keeps the positions in shared memory; its shape suits the device.
-  const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
-  uint32_t fused_workgroup = fused.workgroup ? fused.workgroup : cpu_device ? SIM_WG_FUSED_CPU : SIM_WG_FUSED;
-  fused_workgroup = std::min(fused_workgroup, uint32_t(SIM_WG_FUSED));
-  fused_substeps_ = fused.substeps_per_dispatch ? fused.substeps_per_dispatch
-                    : cpu_device                ? SIM_FUSED_SUBSTEPS_CPU
-                                                : SIM_MAX_SUBSTEPS;
-  fused_max_cell_spacings_ = fused.max_cell_spacings != 0.0f ? fused.max_cell_spacings
-                             : cpu_device                    ? SIM_FUSED_CPU_MAX_CELL_SPACINGS
-                                                             : -1.0f;
-  if (ctx_.properties().limits.maxComputeSharedMemorySize >= 16u * SIM_FUSED_MAX_PARTICLES)
+  const FusedShape shape = resolveFusedShape(ctx_, fused);
+  const uint32_t fused_workgroup = shape.workgroup;
+  fused_substeps_ = shape.substeps_per_dispatch;
+  fused_max_cell_spacings_ = shape.max_cell_spacings;
+  if (fusedTickSupported(ctx_))
     pipes_.tick_fused = makeComputePipeline(ctx_, "tick_fused.comp", layout_, float_rules_, math_, sizeof(FusedPush), 1,
                                             fused_workgroup, true, owned_pipelines_);
   for (uint32_t s = 0; s < 3; ++s)
@@ -251,6 +246,26 @@ PassTimes GpuSolver::passTimes() const {
 }
 
 Arithmetic GpuSolver::arithmetic() const { return arithmeticOf(float_rules_, math_); }
+
+FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested) {
+  const bool cpu_device = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  FusedShape shape;
+  shape.workgroup = std::min<uint32_t>(requested.workgroup ? requested.workgroup
+                                       : cpu_device        ? SIM_WG_FUSED_CPU
+                                                           : SIM_WG_FUSED,
+                                       SIM_WG_FUSED);
+  shape.substeps_per_dispatch = requested.substeps_per_dispatch ? requested.substeps_per_dispatch
+                                : cpu_device                    ? SIM_FUSED_SUBSTEPS_CPU
+                                                                : SIM_MAX_SUBSTEPS;
+  shape.max_cell_spacings = requested.max_cell_spacings != 0.0f ? requested.max_cell_spacings
+                            : cpu_device                        ? SIM_FUSED_CPU_MAX_CELL_SPACINGS
+                                                                : -1.0f;
+  return shape;
+}
+
+bool fusedTickSupported(const VulkanContext& ctx) {
+  return ctx.properties().limits.maxComputeSharedMemorySize >= 16u * SIM_FUSED_MAX_PARTICLES;
+}
 
 float structuralSpacing(const SheetTopology& topo) {
   float spacing = std::numeric_limits<float>::max();

@@ -27,6 +27,12 @@ struct FusedShape {
   float max_cell_spacings = 0.0f;     ///< largest hash cell (in grid spacings) with collision on; < 0: any
 };
 
+/// The fused tick's shape on this device: what `requested` sets, the device's kind's values for the rest.
+FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested = {});
+
+/// True when the device has the shared memory the fused tick keeps its positions in.
+bool fusedTickSupported(const VulkanContext& ctx);
+
 /// The grid spacing of a topology: its shortest structural rest length.
 float structuralSpacing(const SheetTopology& topo);
 
