@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backend/backend.h"
+#include "cli/cli.h"
 #include "core/fleet.h"
 #include "core/output.h"
 #include "core/simulation.h"
@@ -39,8 +40,6 @@
 
 namespace tender {
 namespace {
-
-constexpr int kExitBadInput = 2;
 
 /// Command-line options.
 struct BenchOptions {
@@ -68,11 +67,6 @@ struct Size {
   uint32_t cols = 0, rows = 0;
   std::string text() const { return std::to_string(cols) + "x" + std::to_string(rows); }
 };
-
-int fail(const std::string& message) {
-  std::fprintf(stderr, "tender-bench: error: %s\n", message.c_str());
-  return kExitBadInput;
-}
 
 std::vector<std::string> split(const std::string& s, char sep) {
   std::vector<std::string> out;
@@ -327,11 +321,7 @@ nlohmann::json runBatchCase(const BenchOptions& o, const Size& size, const std::
   auto skip = skipper(r, label, progress);
   SimParams p;
   if (auto err = caseParams(o, size, backend, p)) return skip(*err);
-  uint64_t memory = availableMemoryBytes();
-  if (backend != "cpu")
-    if (const uint64_t device_bytes = gpuMemoryBytes(o.device)) memory = std::min(memory, device_bytes);
-  if (estimateSheetBytes(p, backend) * sheets > memory)
-    return skip("a batch of " + std::to_string(sheets) + " sheets needs more memory than this machine has");
+  if (auto err = batchMemoryError(p, backend, sheets, o.device)) return skip(*err);
   BackendOptions bo = backendOptionsFor(backend, p);
   bo.device = o.device;
   std::unique_ptr<SheetBatch> batch;
@@ -485,6 +475,7 @@ int main(int argc, char** argv) {
   using namespace tender;
   BenchOptions o;
   o.backends = vulkanBuilt() ? "cpu,gpu" : "cpu";
+  setProgramName("tender-bench");
   CLI::App app{"tender-bench: how the solvers scale with the size of the sheet."};
   app.set_version_flag("--version", std::string("tender-bench ") + TENDER_VERSION);
   app.add_option("--sizes", o.sizes, "grid sizes, WxH comma-separated")->capture_default_str();
@@ -510,11 +501,12 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) { // --help, --version
-    return app.exit(e);
+    return finishOutput(app.exit(e));
   } catch (const CLI::ParseError& e) {
     return fail(e.what());
   }
 
+  if (auto err = emptyValue(app)) return fail(*err);
   // Validate everything before running anything: options, outputs, the device.
   if (!std::isfinite(o.max_seconds)) return fail("--max-seconds: not a number");
   if (auto err = parseWhole(max_cpu_particles, 0, uint64_t(1) << 40, o.max_cpu_particles))
@@ -524,7 +516,7 @@ int main(int argc, char** argv) {
     if (auto err = outputs.add(path)) return fail(*err);
   for (const std::string& item : batches.empty() ? std::vector<std::string>{} : split(batches, ',')) {
     uint64_t b = 0;
-    if (auto err = parseWhole(item, 1, 65535, b)) return fail("--batch '" + item + "': " + *err);
+    if (auto err = parseWhole(item, 1, kMaxBatchSheets, b)) return fail("--batch '" + item + "': " + *err);
     o.batches.push_back(uint32_t(b));
   }
   uint32_t cpu_threads = 0;
@@ -654,5 +646,5 @@ int main(int argc, char** argv) {
   if (!o.csv.empty())
     if (auto err = outputs.stage(o.csv, csvText(out["results"]))) return fail(*err);
   if (auto err = outputs.commit()) return fail(*err);
-  return 0;
+  return finishOutput(0); // the tables must reach standard output
 }

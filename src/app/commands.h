@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "backend/backend.h"
+#include "cli/cli.h"
 #include "core/params.h"
 #include "core/script.h"
 #include "core/solver.h"
@@ -15,8 +16,6 @@ namespace render {
 struct HeadlessOptions;
 } // namespace render
 
-/// Exit status of every bad-input error (with one line on stderr).
-constexpr int kExitBadInput = 2;
 /// Exit status of tender-demo started by `tender` (kLaunchedVariable set) when no window can be
 /// opened: `tender` then renders a picture instead, as with no display at all.
 constexpr int kExitNoWindow = 3;
@@ -83,9 +82,6 @@ struct DemoOptions {
   float ui_scale = 0.0f; ///< 0 = the window's content scale
   uint32_t width = 1280, height = 720;
 };
-
-/// Prints "tender: error: <message>" and returns kExitBadInput.
-int fail(const std::string& message);
 
 /// The input script of `path` checked against the sheet of `params` (an empty path: no events);
 /// nullopt and `error` on failure.

@@ -11,6 +11,7 @@
 
 #include "commands.h"
 #include "core/passes.h"
+#include "core/sheet.h"
 #include "core/simulation.h"
 #include "core/stats.h"
 
@@ -239,6 +240,20 @@ int runDiff(const CommonOptions& common, const DiffOptions& o) {
       return fail("TENDER_TEST_PLANT_ULP: particle " + std::to_string(p->particle) + " is not on the sheet");
     BackendOptions* cpu = ob.backend == "cpu" ? &ob : oa.backend == "cpu" ? &oa : nullptr;
     if (!cpu) return fail("TENDER_TEST_PLANT_ULP needs a cpu side");
+    // A pass the run never reaches would plant nothing and the sides would compare identical.
+    if (p->tick >= o.ticks)
+      return fail("TENDER_TEST_PLANT_ULP: tick " + std::to_string(p->tick) + " is not run (--ticks " +
+                  std::to_string(o.ticks) + ")");
+    shaderio::SimUniforms u{}; // what passIndex reads of a physics tick's uniforms
+    u.substeps = common.params.substeps;
+    u.iterations = common.params.iterations;
+    u.color_count = buildSheet(common.params).colorCount();
+    u.flags = common.params.collision ? SIM_FLAG_COLLISION : 0u;
+    if (!passIndex(u, p->pass))
+      return fail("TENDER_TEST_PLANT_ULP: no pass '" + describePass(p->pass) + "' in a tick of " +
+                  std::to_string(shaderio::substepCount(u.substeps)) + " substeps, " + std::to_string(u.iterations) +
+                  " iterations of " + std::to_string(u.color_count) + " colours, collision " +
+                  ((u.flags & SIM_FLAG_COLLISION) ? "on" : "off"));
     cpu->plant = p;
   }
   a.label = o.a == o.b ? "a:" + o.a : o.a;

@@ -100,6 +100,7 @@ int runDemo(const CommonOptions& common, const DemoOptions& o) {
   std::optional<InputScript> replay = scriptFor(o.replay, common.params, error);
   if (!replay) return fail(error);
   OutputSet record;
+  if (auto err = record.addInput(o.replay)) return fail(*err);
   if (auto err = record.add(o.record)) return fail(*err);
   CommonOptions session = common;
   session.script = o.replay;

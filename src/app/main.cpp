@@ -1,4 +1,5 @@
-// tender: receipt paper physics. The interactive demo, and headless `sim`, `render`, `diff`, `devices`.
+// tender: receipt paper physics. The interactive demo, and the headless commands `sim`, `render`, `diff`,
+// `sweep`, `sweep-merge`, `devices` and `presets` (each in its own file).
 #include <cstdio>
 
 #include <CLI/CLI.hpp>
@@ -12,28 +13,13 @@
 
 namespace tender {
 
-int fail(const std::string& message) {
-  std::fprintf(stderr, "tender: error: %s\n", message.c_str());
-  return kExitBadInput;
-}
-
-BackendOptions CommonOptions::backendOptions() const {
-  BackendOptions b = backendOptionsFor(backend, params);
-  b.device = device;
-  b.validation = validation;
-  return b;
-}
-
-std::optional<InputScript> scriptFor(const std::string& path, const SimParams& params, std::string& error) {
-  if (path.empty()) return InputScript{};
-  return loadScriptFor(path, params.particleCount(), error);
-}
-
 namespace {
 
 void addCommon(CLI::App& app, CommonOptions& o, bool with_backend) {
-  CLI::Option* preset =
-      app.add_option("--preset", o.preset, "tender, crumple, tender-low or crumple-low")->capture_default_str();
+  std::string names;
+  const auto all = presetNames();
+  for (size_t k = 0; k < all.size(); ++k) names += (k == 0 ? "" : k + 1 == all.size() ? " or " : ", ") + all[k];
+  CLI::Option* preset = app.add_option("--preset", o.preset, names)->capture_default_str();
   app.add_option("--preset-file", o.preset_file, "a preset as JSON (see `tender presets --dump NAME`)")
       ->excludes(preset);
   app.add_option("--set", o.sets, "override a parameter: key=value (repeatable; see the key list below)");
@@ -92,7 +78,7 @@ int main(int argc, char** argv) {
   app.add_option("--replay", demo.replay, "play an input script back");
   app.add_option("--vsync", demo.vsync, "on or off")->transform(CLI::Transformer({{"on", "1"}, {"off", "0"}}));
   app.add_option("--ui-scale", demo.ui_scale, "HUD scale (default: the window's content scale)")
-      ->check(CLI::Range(0.25f, 8.0f));
+      ->check(finiteRange(0.25, 8.0));
   app.add_option("--width", demo.width, "window width")->check(CLI::Range(64u, 16384u));
   app.add_option("--height", demo.height, "window height")->check(CLI::Range(64u, 16384u));
 
@@ -160,7 +146,7 @@ int main(int argc, char** argv) {
 
   SweepMergeOptions merge;
   CLI::App* merge_cmd = app.add_subcommand("sweep-merge", "join the shards of a sweep (tender sweep --shard) into one");
-  merge_cmd->add_option("dirs", merge.dirs, "the shards' folders")->required();
+  merge_cmd->add_option("dirs", merge.dirs, "the shards' folders");
   merge_cmd->add_option("--out", merge.out, "folder of the whole sweep's sheets.jsonl and sweep.json")->required();
   merge_cmd->footer("The folders must hold shards of one sweep that together have every sheet exactly once;\n"
                     "otherwise one line names what differs or the missing or doubled sheets (exit status 2).");
@@ -175,31 +161,38 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) { // --help, --version
-    return app.exit(e);
+    return finishOutput(app.exit(e));
   } catch (const CLI::ParseError& e) {
     return fail(e.what());
   }
-  if (*devices_cmd) return runDevices(common);
-  if (*presets_cmd) return runPresets(dump_preset);
-  if (*merge_cmd) return runSweepMerge(merge);
-  if (*diff_cmd) common.backend = "cpu"; // each side is checked for its own backend
-  if (auto err = resolve(common)) return fail(*err);
-  if (auto err = parseWhole(sim_ticks, 0, kMaxTicks, sim.ticks)) return fail("--ticks: " + *err);
-  if (!frames_every.empty())
-    if (auto err = parseWhole(frames_every, 1, kMaxTicks, sim.frames_every)) return fail("--frames-every: " + *err);
-  if (auto err = parseWhole(render_ticks, 0, kMaxTicks, render.ticks)) return fail("--ticks: " + *err);
-  render.ticks_given = render_ticks_opt->count() > 0;
-  if (*diff_cmd)
-    if (auto err = parseWhole(diff_ticks, 1, kMaxTicks, diff.ticks)) return fail("--ticks: " + *err);
-  // A write beyond the file-size limit fails like any other write error (exit 2, no fragment).
-  ignoreFileSizeSignal();
-  try {
+  if (auto err = emptyValue(app)) return fail(*err);
+  // Everything a command prints must reach standard output: a lost line is an error (exit 2).
+  const auto command = [&]() -> int {
+    if (*devices_cmd) return runDevices(common);
+    if (*presets_cmd) return runPresets(dump_preset);
+    if (*merge_cmd) return runSweepMerge(merge);
+    if (*diff_cmd) common.backend = "cpu"; // each side is checked for its own backend
+    if (auto err = resolve(common)) return fail(*err);
+    if (auto err = parseWhole(sim_ticks, 0, kMaxTicks, sim.ticks)) return fail("--ticks: " + *err);
+    if (!frames_every.empty())
+      if (auto err = parseWhole(frames_every, 1, kMaxTicks, sim.frames_every)) return fail("--frames-every: " + *err);
+    if (auto err = parseWhole(render_ticks, 0, kMaxTicks, render.ticks)) return fail("--ticks: " + *err);
+    render.ticks_given = render_ticks_opt->count() > 0;
+    if (*diff_cmd)
+      if (auto err = parseWhole(diff_ticks, 1, kMaxTicks, diff.ticks)) return fail("--ticks: " + *err);
+    // A write beyond the file-size limit fails like any other write error (exit 2, no fragment).
+    ignoreFileSizeSignal();
     if (*sim_cmd) return runSim(common, sim);
     if (*render_cmd) return runRender(common, render);
     if (*diff_cmd) return runDiff(common, diff);
     if (*sweep_cmd) return runSweep(common, sweep);
     return runDemo(common, demo);
-  } catch (const std::exception& e) { // a Vulkan error at run time, out of memory
+  };
+  try {
+    return finishOutput(command());
+  } catch (const std::bad_alloc&) {
+    return fail("out of memory");
+  } catch (const std::exception& e) { // a Vulkan error at run time
     return fail(e.what());
   }
 }

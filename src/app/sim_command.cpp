@@ -28,6 +28,9 @@ struct MeshPlan {
   std::vector<uint64_t> frame_ticks; ///< the ticks the frames are taken at (animation, sequence)
 };
 
+/// How many frames are taken at 0, K, 2K, ... and the last tick.
+uint64_t frameCount(uint64_t ticks, uint64_t every) { return ticks / every + 1 + (ticks % every != 0 ? 1 : 0); }
+
 /// The ticks a frame is taken at: 0, K, 2K, ... and the last tick.
 std::vector<uint64_t> frameTicks(uint64_t ticks, uint64_t every) {
   std::vector<uint64_t> t;
@@ -46,8 +49,7 @@ std::optional<std::string> planMesh(const SimOptions& o, MeshPlan& plan) {
   if (folder) {
     if (!o.frames_every)
       return "--out '" + o.out + "' is a folder: name a file, or add --frames-every K for a sequence";
-    const uint64_t count = o.ticks / o.frames_every + 2;
-    if (count > kMaxSequenceFrames + 1)
+    if (frameCount(o.ticks, o.frames_every) > kMaxSequenceFrames)
       return "--frames-every " + std::to_string(o.frames_every) + " over " + std::to_string(o.ticks) +
              " ticks makes more than " + std::to_string(kMaxSequenceFrames) + " files";
     plan.kind = MeshPlan::Sequence;
@@ -72,7 +74,7 @@ std::optional<std::string> planMesh(const SimOptions& o, MeshPlan& plan) {
     plan.kind = MeshPlan::Gltf;
     return std::nullopt;
   }
-  if (o.ticks / o.frames_every + 2 > kMaxAnimationFrames + 1)
+  if (frameCount(o.ticks, o.frames_every) > kMaxAnimationFrames)
     return "--frames-every " + std::to_string(o.frames_every) + " over " + std::to_string(o.ticks) +
            " ticks makes more than " + std::to_string(kMaxAnimationFrames) +
            " frames for one animated file (write a sequence: --out DIR/)";
@@ -88,6 +90,8 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   MeshPlan plan;
   if (auto err = planMesh(o, plan)) return fail(*err);
   OutputSet outputs;
+  if (auto err = outputs.addInput(common.script)) return fail(*err);
+  if (auto err = outputs.addInput(common.preset_file)) return fail(*err);
   if (auto err = outputs.add(o.stats)) return fail(*err);
   if (plan.kind == MeshPlan::Sequence) {
     for (const std::string& path : plan.frames)
@@ -137,7 +141,12 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   if (auto err = takeFrame(0)) return fail(*err);
   // A bar on a terminal once the run has taken a second; nothing otherwise.
   Progress progress("tender sim", "tick", o.ticks, 1.0);
+  catchInterrupts(); // Ctrl-C or SIGTERM: the run stops between ticks, writes nothing and says so
   for (uint64_t t = 0; t < o.ticks; ++t) {
+    if (interrupted()) {
+      progress.clear();
+      return fail(interruptMessage() + "; nothing written");
+    }
     auto t0 = std::chrono::steady_clock::now();
     bool ran = sim.tick();
     if (ran) solver.finish();
@@ -180,6 +189,7 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
     if (!bytes) return fail(error);
     if (auto err = outputs.stage(o.out, *bytes)) return fail(*err);
   }
+  if (interrupted()) return fail(interruptMessage() + "; nothing written");
   if (auto err = outputs.commit()) return fail(*err);
   return 0;
 }

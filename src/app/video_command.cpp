@@ -29,10 +29,6 @@ using u128 = unsigned __int128;
 /// Most frames of one video (46 hours at 60 fps).
 constexpr uint64_t kMaxFrames = 10000000;
 
-// Set by SIGINT, SIGTERM or SIGHUP: the run stops after the frame at hand, removing its file.
-volatile std::sig_atomic_t interrupted = 0;
-extern "C" void onInterrupt(int) { interrupted = 1; }
-
 struct Rational {
   uint64_t num = 0, den = 1;
 };
@@ -239,7 +235,8 @@ int runVideo(const CommonOptions& common, const RenderOptions& o) {
 
   // A failed ffmpeg closes its end of the pipe: that is an error to report, not a signal.
   std::signal(SIGPIPE, SIG_IGN);
-  for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, onInterrupt);
+  // SIGINT, SIGTERM or SIGHUP: the run stops after the frame at hand, removing its file.
+  catchInterrupts();
   const std::string rate = std::to_string(fps.num) + "/" + std::to_string(fps.den);
   const std::string size = std::to_string(o.width) + "x" + std::to_string(o.height);
   std::optional<std::string> render_error;
@@ -261,7 +258,7 @@ int runVideo(const CommonOptions& common, const RenderOptions& o) {
     seq.frames = uint64_t(frames);
     seq.ticks_before = ticksBefore;
     seq.sink = [&](const render::Picture& picture, uint64_t frame) -> std::optional<std::string> {
-      if (interrupted) {
+      if (interrupted()) {
         render_error = "interrupted; no video written";
         return render_error;
       }

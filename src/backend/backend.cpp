@@ -1,5 +1,6 @@
 #include "backend.h"
 
+#include <algorithm>
 #include <exception>
 
 #include "cpu/cpu_batch.h"
@@ -96,6 +97,28 @@ uint64_t gpuMemoryBytes([[maybe_unused]] int device) {
 #else
   return 0;
 #endif
+}
+
+BatchFit batchFit(const SimParams& p, const std::string& backend, int device) {
+  BatchFit f;
+  const std::string kind = backend == "cpu" ? "cpu" : "gpu";
+  f.per_sheet = std::max<uint64_t>(1, estimateSheetBytes(p, kind));
+  uint64_t memory = availableMemoryBytes();
+  if (kind == "gpu")
+    if (const uint64_t device_bytes = gpuMemoryBytes(device)) memory = std::min(memory, device_bytes);
+  f.budget = memory / 10 * 9;
+  f.fit = f.budget / f.per_sheet;
+  return f;
+}
+
+std::optional<std::string> batchMemoryError(const SimParams& p, const std::string& backend, uint64_t sheets,
+                                            int device) {
+  const BatchFit f = batchFit(p, backend, device);
+  if (sheets <= f.fit) return std::nullopt;
+  const uint64_t need = sheets > UINT64_MAX / f.per_sheet ? UINT64_MAX : sheets * f.per_sheet;
+  return "a batch of " + std::to_string(sheets) + " " + std::to_string(p.cols) + "x" + std::to_string(p.rows) +
+         " sheets needs about " + std::to_string(need >> 20) + " MiB on the " + (backend == "cpu" ? "cpu" : "gpu") +
+         " backend; " + std::to_string(f.budget >> 20) + " MiB are available";
 }
 
 std::optional<std::string> createBatch(const BackendOptions& o, uint32_t sheets, std::unique_ptr<SheetBatch>& out) {

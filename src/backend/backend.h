@@ -60,6 +60,22 @@ std::optional<std::string> createBackend(const BackendOptions& options, Backend&
 /// takes); 0 when it is unknown (no such device, or no Vulkan).
 uint64_t gpuMemoryBytes(int device);
 
+/// Most sheets of one batch: a GPU dispatch's workgroup count limit.
+constexpr uint32_t kMaxBatchSheets = 65535;
+
+/// How many sheets of `p` fit a batch on a backend ("cpu" or a GPU backend): the memory available
+/// (and on a GPU backend the device's, `device` as gpuMemoryBytes takes it) with a tenth to spare.
+struct BatchFit {
+  uint64_t per_sheet = 1; ///< bytes of one sheet (estimateSheetBytes)
+  uint64_t budget = 0;    ///< bytes the batch may take
+  uint64_t fit = 0;       ///< sheets that fit the budget
+};
+BatchFit batchFit(const SimParams& p, const std::string& backend, int device);
+/// "a batch of N WxH sheets needs about X MiB on the B backend; Y MiB are available" when
+/// `sheets` sheets do not fit; nullopt when they do.
+std::optional<std::string> batchMemoryError(const SimParams& p, const std::string& backend, uint64_t sheets,
+                                            int device);
+
 /// Builds the batch of a fleet of `sheets` sheets ("cpu" or "gpu"; `threads` and `simd` for the
 /// CPU's workers and kernels); on failure returns one line and leaves `out` empty.
 std::optional<std::string> createBatch(const BackendOptions& options, uint32_t sheets,

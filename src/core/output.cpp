@@ -4,11 +4,15 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+
+#include "input_file.h"
 
 namespace tender {
 namespace {
@@ -48,12 +52,50 @@ mode_t fileMode() {
   return 0666 & ~mask;
 }
 
+// This host's name as it appears in temporary file names: at most 16 letters, digits and '_'.
+const std::string& hostTag() {
+  static const std::string tag = [] {
+    char name[256] = {};
+    if (gethostname(name, sizeof(name) - 1) != 0 || !name[0]) return std::string("host");
+    std::string t;
+    for (const char* c = name; *c && t.size() < 16; ++c) t += std::isalnum(static_cast<unsigned char>(*c)) ? *c : '_';
+    return t;
+  }();
+  return tag;
+}
+
+// The process that wrote a temporary file named `.NAME.tmp.HOST-PID.XXXXXX`, when HOST is this
+// host; 0 otherwise.
+pid_t writerOf(const std::string& name) {
+  const std::string host = ".tmp." + hostTag() + "-";
+  const size_t at = name.rfind(host);
+  if (name.empty() || name[0] != '.' || at == std::string::npos || name.size() < at + host.size() + 8) return 0;
+  const std::string rest = name.substr(at + host.size()); // PID.XXXXXX
+  const size_t dot = rest.find('.');
+  if (dot == std::string::npos || dot == 0 || rest.size() - dot != 7) return 0;
+  pid_t pid = 0;
+  for (size_t k = 0; k < dot; ++k) {
+    if (!std::isdigit(static_cast<unsigned char>(rest[k])) || pid > 99999999) return 0;
+    pid = pid * 10 + (rest[k] - '0');
+  }
+  return pid;
+}
+
+// Removes the temporary files in `folder` of processes of this host that no longer run.
+void removeStaleTemps(const std::string& folder) {
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const pid_t pid = writerOf(it->path().filename().string());
+    if (pid > 0 && kill(pid, 0) != 0 && errno == ESRCH && it->is_regular_file(ec)) fs::remove(it->path(), ec);
+  }
+}
+
 // Creates the temporary file of `path` beside it, with the mode a new file gets; its descriptor,
 // or -1 (errno set).
 int makeTemp(const std::string& path, std::string& temp) {
   std::string name = ".";
   name += fs::path(path).filename().string();
-  name += ".tmp.XXXXXX";
+  name += ".tmp." + hostTag() + "-" + std::to_string(getpid()) + ".XXXXXX";
   temp = (fs::path(folderOf(path)) / name).string();
   const int fd = mkstemp(temp.data());
   if (fd < 0) return -1;
@@ -91,16 +133,30 @@ OutputSet::~OutputSet() {
     if (!p.temp.empty()) std::remove(p.temp.c_str());
 }
 
+std::optional<std::string> OutputSet::addInput(const std::string& path) {
+  if (path.empty()) return std::nullopt;
+  for (const std::string& out : paths_)
+    if (sameFile(path, out)) return "'" + out + "' is both an input and an output (the same file)";
+  inputs_.push_back(path);
+  return std::nullopt;
+}
+
 std::optional<std::string> OutputSet::add(const std::string& path) {
   if (path.empty()) return std::nullopt;
   if (auto err = checkOutputPath(path)) return err;
-  std::error_code ec;
-  const fs::path canonical = fs::weakly_canonical(path, ec);
-  for (const std::string& other : paths_) {
-    const fs::path o = fs::weakly_canonical(other, ec);
-    if (o == canonical && !isSpecial(path))
-      return "two outputs name the same file '" + path + "'" + (other != path ? " ('" + other + "')" : "");
+  for (const std::string& in : inputs_)
+    if (sameFile(path, in)) return "'" + path + "' is both an input and an output (the same file)";
+  const std::string folder = folderOf(path);
+  if (std::find(cleaned_.begin(), cleaned_.end(), folder) == cleaned_.end()) {
+    removeStaleTemps(folder);
+    cleaned_.push_back(folder);
   }
+  std::error_code ec;
+  const std::string canonical = fs::weakly_canonical(path, ec).string();
+  if (auto other = canonical_.find(canonical); other != canonical_.end() && !isSpecial(path))
+    return "two outputs name the same file '" + path + "'" +
+           (other->second != path ? " ('" + other->second + "')" : "");
+  canonical_.emplace(canonical, path);
   paths_.push_back(path);
   return std::nullopt;
 }

@@ -6,6 +6,7 @@
 /// are written in place, with the same checks.
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,7 +23,9 @@ using PathWriter = std::function<std::optional<std::string>(const std::string& p
 std::optional<std::string> checkOutputPath(const std::string& path);
 
 /// A set of output files committed together: stage() writes each to a temporary file, commit()
-/// renames them all into place; files staged but not committed are removed.
+/// renames them all into place; files staged but not committed are removed. A temporary file is
+/// named `.NAME.tmp.HOST-PID.XXXXXX`: the first output added in a folder removes the temporary
+/// files there that a process of this host which no longer runs left behind (killed mid-write).
 class OutputSet {
 public:
   OutputSet() = default;
@@ -33,6 +36,9 @@ public:
   /// Registers an output before the run: checks the path (checkOutputPath) and that no other
   /// output of the set names the same file. An empty path is ignored.
   std::optional<std::string> add(const std::string& path);
+  /// Registers an input the run reads (an empty path is ignored): no output of the set may be the
+  /// same file, so that a run never replaces what it reads.
+  std::optional<std::string> addInput(const std::string& path);
   /// Writes one registered output to its temporary file; returns the error on failure.
   std::optional<std::string> stage(const std::string& path, const FileWriter& write);
   /// As stage(), with the bytes given.
@@ -48,7 +54,9 @@ private:
   struct Pending {
     std::string path, temp;
   };
-  std::vector<std::string> paths_;
+  std::vector<std::string> paths_, inputs_;
+  std::map<std::string, std::string> canonical_; ///< each output's canonical path: the path as added
+  std::vector<std::string> cleaned_;             ///< folders whose stale temporary files are removed
   std::vector<Pending> staged_;
 };
 

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "input_file.h"
 #include "sim_config.h"
 
 namespace tender {
@@ -76,7 +77,7 @@ Param uintParam(const char* key, uint32_t SimParams::*m, uint32_t lo, uint32_t h
           [m](const SimParams& p) { return std::to_string(p.*m); }};
 }
 Param boolParam(const char* key, bool SimParams::*m, const char* help) {
-  return {{key, help},
+  return {{key, help, 0.0, 0.0, false, true},
           [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); },
           [m](const SimParams& p) { return std::string(p.*m ? "on" : "off"); }};
 }
@@ -287,67 +288,132 @@ std::string presetJson(const SimParams& p) {
   return j.dump(2) + "\n";
 }
 
-std::optional<std::string> loadPresetFile(const std::string& path, SimParams& out) {
-  std::string text;
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return path + ": cannot read: " + std::strerror(errno);
-  char buf[65536];
-  size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof(buf), f)) > 0) {
-    text.append(buf, n);
-    if (text.size() > (64u << 20)) {
-      std::fclose(f);
-      return path + ": too large for a preset file";
-    }
+std::optional<std::string> spellTyped(const std::string& key, ValueType type, const std::string& text,
+                                      std::string& out) {
+  const auto info = paramInfo(key);
+  if (!info) return "unknown parameter '" + key + "' (see --help for the keys)";
+  const bool numeric = info->lo != info->hi;
+  std::string expected;
+  if (info->on_off)
+    expected = "true or false";
+  else if (!numeric)
+    expected = "a name";
+  else if (info->whole)
+    expected = "a whole number";
+  else
+    expected = "a number";
+  bool fits = false;
+  switch (type) {
+  case ValueType::Text:
+    fits = true;
+    break;
+  case ValueType::Bool:
+    fits = info->on_off;
+    break;
+  case ValueType::Whole:
+    fits = numeric;
+    break;
+  case ValueType::Number:
+    fits = numeric && !info->whole;
+    break;
   }
-  const bool failed = std::ferror(f);
-  const int saved = errno;
-  std::fclose(f);
-  if (failed) return path + ": cannot read: " + std::strerror(saved);
+  if (!fits) return key + ": expected " + expected + ", got " + text;
+  out = type == ValueType::Bool ? (text == "true" ? "on" : "off") : text;
+  return std::nullopt;
+}
 
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
+namespace {
+
+/// Reads a preset file's JSON: one object of scalar values, each key once, numbers as written.
+class PresetReader : public nlohmann::json_sax<nlohmann::json> {
+public:
+  struct Entry {
+    std::string key;
+    ValueType type = ValueType::Text;
+    std::string text;
+  };
+  std::vector<Entry> entries;
+  std::string error;
+
+  bool null() override { return refuse("null"); }
+  bool boolean(bool v) override { return value(ValueType::Bool, v ? "true" : "false"); }
+  bool number_integer(number_integer_t v) override { return value(ValueType::Whole, std::to_string(v)); }
+  bool number_unsigned(number_unsigned_t v) override { return value(ValueType::Whole, std::to_string(v)); }
+  bool number_float(number_float_t, const string_t& s) override {
+    // An integer too large for 64 bits is still a whole number, as written.
+    const bool digits = !s.empty() && s.find_first_not_of("-0123456789") == std::string::npos;
+    return value(digits ? ValueType::Whole : ValueType::Number, s);
+  }
+  bool string(string_t& v) override { return value(ValueType::Text, v); }
+  bool binary(binary_t&) override { return refuse("binary data"); }
+  bool start_object(std::size_t) override {
+    if (depth_++ == 0) return true;
+    return refuse("an object");
+  }
+  bool end_object() override { return --depth_, true; }
+  bool start_array(std::size_t) override { return depth_ == 0 ? top("an array") : refuse("an array"); }
+  bool end_array() override { return true; }
+  bool key(string_t& k) override {
+    for (const Entry& e : entries)
+      if (e.key == k) return fail(k + ": given twice");
+    key_ = k;
+    return true;
+  }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override {
     std::string why = e.what();
     if (auto close = why.find("] "); why.rfind("[json.exception", 0) == 0 && close != std::string::npos)
       why = why.substr(close + 2);
-    for (char& c : why)
-      if (c == '\n' || c == '\r') c = ' ';
-    return path + ": malformed JSON: " + why;
+    return fail("malformed JSON: " + why);
   }
-  if (!j.is_object()) return path + ": expected a JSON object of parameters (as `tender presets --dump NAME` prints)";
+
+private:
+  bool value(ValueType type, const std::string& text) {
+    if (depth_ == 0) return top("a single value");
+    entries.push_back({key_, type, text});
+    return true;
+  }
+  bool refuse(const std::string& what) {
+    if (depth_ == 0) return top(what);
+    return fail(key_ + ": expected a number, a string or true/false, got " + what);
+  }
+  bool top(const std::string&) {
+    return fail("expected a JSON object of parameters (as `tender presets --dump NAME` prints)");
+  }
+  bool fail(const std::string& why) {
+    if (error.empty()) error = why;
+    return false;
+  }
+  int depth_ = 0;
+  std::string key_;
+};
+
+} // namespace
+
+std::optional<std::string> loadPresetFile(const std::string& path, SimParams& out) {
+  std::string text;
+  if (auto why = readInputFile(path, kMaxPresetFileBytes, text)) return path + ": cannot read: " + *why;
+  if (text.find('\0') != std::string::npos) return path + ": holds a NUL byte (a preset file is JSON text)";
+  PresetReader reader;
+  if (!nlohmann::json::sax_parse(text, &reader) || !reader.error.empty())
+    return path + ": " + (reader.error.empty() ? std::string("malformed JSON") : reader.error);
 
   std::string base = "tender";
-  if (auto it = j.find("preset"); it != j.end()) {
-    if (!it->is_string()) return path + ": preset: expected the name of a preset";
-    base = it->get<std::string>();
-  }
+  for (const auto& e : reader.entries)
+    if (e.key == "preset") {
+      if (e.type != ValueType::Text) return path + ": preset: expected the name of a preset";
+      base = e.text;
+    }
   std::optional<SimParams> p = presetParams(base);
   if (!p) {
     std::string names;
     for (auto& name : presetNames()) names += (names.empty() ? "" : ", ") + name;
     return path + ": unknown preset '" + base + "' (one of " + names + ")";
   }
-  for (auto& [key, value] : j.items()) {
-    if (key == "preset") continue;
+  for (const auto& e : reader.entries) {
+    if (e.key == "preset") continue;
     std::string spelled;
-    if (value.is_string()) {
-      spelled = value.get<std::string>();
-    } else if (value.is_boolean()) {
-      spelled = value.get<bool>() ? "on" : "off";
-    } else if (value.is_number_unsigned()) {
-      spelled = std::to_string(value.get<uint64_t>());
-    } else if (value.is_number_integer()) {
-      spelled = std::to_string(value.get<int64_t>());
-    } else if (value.is_number_float()) {
-      char num[64];
-      auto [ptr, ec] = std::to_chars(num, num + sizeof(num), value.get<double>());
-      spelled = ec == std::errc() ? std::string(num, ptr) : std::string("?");
-    } else {
-      return path + ": " + key + ": expected a number, a string or true/false, got " + value.dump();
-    }
-    if (auto err = applyOverride(*p, key + "=" + spelled)) return path + ": " + *err;
+    if (auto err = spellTyped(e.key, e.type, e.text, spelled)) return path + ": " + *err;
+    if (auto err = applyOverride(*p, e.key + "=" + spelled)) return path + ": " + *err;
   }
   out = *p;
   return std::nullopt;

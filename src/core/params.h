@@ -92,6 +92,7 @@ struct ParamInfo {
   std::string help;
   double lo = 0.0, hi = 0.0; ///< accepted range of a number (lo == hi: not a number)
   bool whole = false;        ///< a whole number (else a float, if a number)
+  bool on_off = false;       ///< on/off (else, when not a number, one of some names)
 };
 /// All keys accepted by `--set`.
 const std::vector<ParamInfo>& paramKeys();
@@ -100,6 +101,19 @@ std::optional<ParamInfo> paramInfo(const std::string& key);
 
 /// Parses a decimal whole number in [lo, hi] (digits only: no sign, no hex); returns an error.
 std::optional<std::string> parseWhole(const std::string& s, uint64_t lo, uint64_t hi, uint64_t& out);
+
+/// The type of a value given as data rather than as `--set` text: a preset file's JSON value or a
+/// Python value.
+enum class ValueType { Bool, Whole, Number, Text };
+/// A typed value spelled as `--set` takes it, by one rule for preset files and Python: true/false
+/// only for on/off keys, whole numbers for number keys, other numbers (8.0, 1e3) for the keys that
+/// are not whole, text for any key (read as `--set` reads it). `text` is the value as written
+/// ("true", "8", "8.0", "on"). Returns "<key>: expected ..., got <text>" when the type does not fit
+/// the key, or the unknown key's error.
+std::optional<std::string> spellTyped(const std::string& key, ValueType type, const std::string& text,
+                                      std::string& out);
+/// Largest preset file (every key of one is about 1.5 KB).
+constexpr uint64_t kMaxPresetFileBytes = 1u << 20;
 
 /// Applies one `key=value` override; returns an error message on failure.
 std::optional<std::string> applyOverride(SimParams& p, const std::string& assignment);

@@ -1,13 +1,12 @@
 #include "script.h"
 
-#include <sys/stat.h>
-
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <sstream>
+
+#include "input_file.h"
 
 namespace tender {
 namespace {
@@ -117,23 +116,8 @@ std::optional<InputScript> parseScript(const std::string& text, std::string& err
 
 std::optional<InputScript> loadScript(const std::string& path, std::string& error) {
   std::string text;
-  struct stat st {};
-  if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
-    error = "cannot read script '" + path + "': it is a folder";
-    return std::nullopt;
-  }
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) {
-    error = "cannot read script '" + path + "': " + std::strerror(errno);
-    return std::nullopt;
-  }
-  char buf[65536];
-  for (size_t got; (got = std::fread(buf, 1, sizeof(buf), f)) > 0;) text.append(buf, got);
-  const bool failed = std::ferror(f) != 0;
-  const int saved = errno;
-  std::fclose(f);
-  if (failed) {
-    error = "cannot read script '" + path + "': " + std::strerror(saved);
+  if (auto why = readInputFile(path, kMaxScriptBytes, text)) {
+    error = "cannot read script '" + path + "': " + *why;
     return std::nullopt;
   }
   auto s = parseScript(text, error);

@@ -25,6 +25,8 @@ namespace tender {
 /// Largest magnitude of a world coordinate an input may name (script, drag, replay): scripts
 /// naming more are refused, and a grab target beyond it is clamped, so the state stays finite.
 constexpr float kMaxCoordinate = 1.0e6f;
+/// Largest script file (a recorded hour of moves at 60 Hz is about 10 MB).
+constexpr uint64_t kMaxScriptBytes = 256ull << 20;
 /// Largest tick a script line may name (decimal digits only).
 constexpr uint64_t kMaxTick = 1000000000000ull;
 

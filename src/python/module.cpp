@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -40,30 +41,77 @@ bool needsRebuild(const std::string& key) {
   return std::any_of(std::begin(keys), std::end(keys), [&](const char* k) { return key == k; });
 }
 
-/// A Python value spelled as `--set` takes it: True/False as on/off, numbers as their shortest
-/// decimal, strings as they are.
+/// The name of a Python value's type ("float", "NoneType").
+std::string typeName(const py::handle& value) {
+  return py::str(py::type::of(value).attr("__name__")).cast<std::string>();
+}
+
+/// A Python value spelled as `--set` takes it, by the rule of preset files (spellTyped): True/False
+/// for on/off keys, int for numbers, float for numbers that are not whole, str for any key; a
+/// NumPy scalar as its Python value. A type the key does not take raises TypeError.
 std::string spell(const std::string& key, const py::handle& value) {
-  if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "on" : "off";
-  if (py::isinstance<py::int_>(value)) return py::str(value).cast<std::string>();
-  if (py::isinstance<py::float_>(value)) return py::repr(value).cast<std::string>();
-  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
-  // A NumPy scalar (numpy.float32, numpy.int64, numpy.bool_): its Python value.
-  if (py::hasattr(value, "item") && py::hasattr(value, "dtype")) {
+  std::optional<std::string> err;
+  std::string out;
+  if (py::isinstance<py::bool_>(value)) {
+    err = spellTyped(key, ValueType::Bool, value.cast<bool>() ? "true" : "false", out);
+  } else if (py::isinstance<py::int_>(value)) {
+    err = spellTyped(key, ValueType::Whole, py::str(value).cast<std::string>(), out);
+  } else if (py::isinstance<py::float_>(value)) {
+    err = spellTyped(key, ValueType::Number, py::repr(value).cast<std::string>(), out);
+  } else if (py::isinstance<py::str>(value)) {
+    err = spellTyped(key, ValueType::Text, value.cast<std::string>(), out);
+  } else if (py::hasattr(value, "item") && py::hasattr(value, "dtype")) {
     py::object item = value.attr("item")();
     if (py::isinstance<py::bool_>(item) || py::isinstance<py::int_>(item) || py::isinstance<py::float_>(item))
       return spell(key, item);
+    err = key + ": expected a bool, an int, a float or a str, got " + typeName(value);
+  } else {
+    err = key + ": expected a bool, an int, a float or a str, got " + typeName(value);
   }
-  throw py::value_error(key + ": expected a bool, an int, a float or a str, got " +
-                        py::str(py::type::of(value).attr("__name__")).cast<std::string>());
+  if (!err) return out;
+  if (!paramInfo(key)) throw py::key_error(*err);
+  throw py::type_error(*err);
 }
 
-/// Applies key=value to `p`: an unknown key raises KeyError, a bad value ValueError (the CLI's messages).
+/// Applies key=value to `p`: an unknown key raises KeyError, a value of a type the key does not
+/// take TypeError, a bad value ValueError (the CLI's messages).
 void applyKey(SimParams& p, const std::string& key, const py::handle& value) {
   const std::string assignment = key + "=" + spell(key, value);
   auto err = applyOverride(p, assignment);
   if (!err) return;
   if (key.empty() || !paramInfo(key)) throw py::key_error(*err);
   throw py::value_error(*err);
+}
+
+/// The keys of a dict of parameters: str, or TypeError naming `what`.
+std::string keyOf(const py::handle& key, const std::string& what) {
+  if (!py::isinstance<py::str>(key))
+    throw py::type_error(what + ": keys are parameter names (str), got " + typeName(key));
+  return key.cast<std::string>();
+}
+
+/// True or False (or a NumPy bool), else TypeError: None or a float is not taken as a truth value.
+bool truthValue(const py::handle& value, const char* what) {
+  if (py::isinstance<py::bool_>(value)) return value.cast<bool>();
+  if (py::hasattr(value, "dtype") && py::hasattr(value, "item")) {
+    py::object item = value.attr("item")();
+    if (py::isinstance<py::bool_>(item)) return item.cast<bool>();
+  }
+  throw py::type_error(std::string(what) + ": expected True or False, got " + typeName(value));
+}
+
+/// Writes through an OutputSet; a path that cannot be written raises OSError (as open() does),
+/// an empty one ValueError.
+void writeOutput(const std::string& path, const std::function<std::optional<std::string>(OutputSet&)>& stage) {
+  if (path.empty()) throw py::value_error("an output path is empty");
+  OutputSet outputs;
+  std::optional<std::string> err = outputs.add(path);
+  if (!err) err = stage(outputs);
+  if (!err) err = outputs.commit();
+  if (err) {
+    PyErr_SetString(PyExc_OSError, err->c_str());
+    throw py::error_already_set();
+  }
 }
 
 std::string unknownPreset(const std::string& name) {
@@ -111,7 +159,7 @@ public:
                const py::kwargs& params) {
     auto p = presetParams(preset);
     if (!p) throw py::value_error(unknownPreset(preset));
-    for (auto item : params) applyKey(*p, item.first.cast<std::string>(), item.second);
+    for (auto item : params) applyKey(*p, keyOf(item.first, "params"), item.second);
     if (backend != "cpu" && backend != "gpu") throw py::value_error("unknown backend '" + backend + "' (cpu or gpu)");
     if (device && *device < 0) throw py::value_error("device: expected an index >= 0 (see tender.devices())");
     if (auto err = validate(*p, backend)) throw py::value_error(*err);
@@ -206,15 +254,11 @@ public:
   void save(const std::string& path) {
     auto format = meshFormatFor(path);
     if (!format) throw py::value_error("'" + path + "': unknown extension (.ply, .glb or .gltf)");
-    OutputSet outputs;
-    if (auto err = outputs.add(path)) throw py::value_error(*err);
-    backend_.solver->computeNormals();
-    SimState s;
-    backend_.solver->readback(s);
-    std::optional<std::string> err;
-    if (*format == MeshFormat::Ply) {
-      err = outputs.stage(path, [&](std::FILE* f) { return writePly(f, s); });
-    } else {
+    writeOutput(path, [&](OutputSet& outputs) -> std::optional<std::string> {
+      backend_.solver->computeNormals();
+      SimState s;
+      backend_.solver->readback(s);
+      if (*format == MeshFormat::Ply) return outputs.stage(path, [&](std::FILE* f) { return writePly(f, s); });
       MeshScene scene;
       scene.uv = sim_->topology().uv;
       auto png = textures_.find(sim_->params().preset);
@@ -224,18 +268,16 @@ public:
       std::string error;
       auto bytes = encodeGltf(scene, {meshFrame(s, 0.0)}, *format == MeshFormat::Glb, error);
       if (!bytes) throw std::runtime_error(error);
-      err = outputs.stage(path, *bytes);
-    }
-    if (!err) err = outputs.commit();
-    if (err) throw std::runtime_error(*err);
+      return outputs.stage(path, *bytes);
+    });
   }
 
   bool wind() const { return sim_->wind(); }
-  void setWind(bool on) { sim_->setWind(on); }
+  void setWind(const py::handle& on) { sim_->setWind(truthValue(on, "wind")); }
   bool pins() const { return sim_->pins(); }
-  void setPins(bool on) { sim_->setPins(on); }
+  void setPins(const py::handle& on) { sim_->setPins(truthValue(on, "pins")); }
   bool paused() const { return sim_->paused(); }
-  void setPaused(bool on) { sim_->setPaused(on); }
+  void setPaused(const py::handle& on) { sim_->setPaused(truthValue(on, "paused")); }
   std::string backendName() const { return backend_.solver->name(); }
   uint32_t particleCount() const { return sim_->topology().particleCount(); }
   int64_t grabbed() const { return sim_->grabbed() == SIM_NONE ? -1 : int64_t(sim_->grabbed()); }
@@ -282,23 +324,34 @@ public:
           const std::optional<std::vector<std::string>>& scripts, const py::kwargs& params) {
     auto base = presetParams(preset);
     if (!base) throw py::value_error(unknownPreset(preset));
-    for (auto item : params) applyKey(*base, item.first.cast<std::string>(), item.second);
+    for (auto item : params) applyKey(*base, keyOf(item.first, "params"), item.second);
     if (backend != "cpu" && backend != "gpu") throw py::value_error("unknown backend '" + backend + "' (cpu or gpu)");
     if (device && *device < 0) throw py::value_error("device: expected an index >= 0 (see tender.devices())");
     // sheets: a count of sheets of the common parameters, or one dict of keys per sheet over them
     std::vector<FleetSheet> list;
-    if (py::isinstance<py::int_>(sheets)) {
-      const int64_t n = sheets.cast<int64_t>();
-      if (n < 1 || n > 65535) throw py::value_error("sheets: expected 1 to 65535, got " + std::to_string(n));
-      list.assign(size_t(n), FleetSheet{*base, {}});
-    } else {
-      for (const py::handle& item : py::iter(sheets)) {
-        if (!py::isinstance<py::dict>(item)) throw py::value_error("sheets: expected a count or a list of dicts");
+    if (py::isinstance<py::bool_>(sheets)) {
+      throw py::type_error("sheets: expected a count or a list of dicts, got bool");
+    } else if (py::isinstance<py::int_>(sheets)) {
+      // Compared as Python ints: any size is refused in words, never by a failed conversion.
+      if (sheets < py::int_(1) || sheets > py::int_(kMaxBatchSheets))
+        throw py::value_error("sheets: expected 1 to " + std::to_string(kMaxBatchSheets) + ", got " +
+                              py::str(sheets).cast<std::string>());
+      list.assign(sheets.cast<size_t>(), FleetSheet{*base, {}});
+    } else if (py::isinstance<py::sequence>(sheets) && !py::isinstance<py::str>(sheets)) {
+      size_t i = 0;
+      for (const py::handle& item : sheets) {
+        const std::string where = "sheets[" + std::to_string(i++) + "]";
+        if (!py::isinstance<py::dict>(item)) throw py::type_error(where + ": expected a dict, got " + typeName(item));
+        if (i > kMaxBatchSheets) break;
         FleetSheet s{*base, {}};
-        for (auto kv : item.cast<py::dict>()) applyKey(s.params, kv.first.cast<std::string>(), kv.second);
+        for (auto kv : item.cast<py::dict>()) applyKey(s.params, keyOf(kv.first, where), kv.second);
         list.push_back(std::move(s));
       }
-      if (list.empty() || list.size() > 65535) throw py::value_error("sheets: expected 1 to 65535 sheets");
+      if (list.empty() || py::len(sheets) > kMaxBatchSheets)
+        throw py::value_error("sheets: expected 1 to " + std::to_string(kMaxBatchSheets) + " sheets, got " +
+                              std::to_string(py::len(sheets)));
+    } else {
+      throw py::type_error("sheets: expected a count or a list of dicts, got " + typeName(sheets));
     }
     if (scripts) {
       if (scripts->size() != list.size())
@@ -319,6 +372,9 @@ public:
       if (auto err = batchMismatch(list[0].params, list[i].params))
         throw py::value_error("sheet " + std::to_string(i) + ": " + *err);
     }
+    // The whole batch must fit this machine's memory (and a GPU's), refused before anything is allocated.
+    if (auto err = batchMemoryError(list[0].params, backend, list.size(), device.value_or(-1)))
+      throw py::value_error(*err);
     BackendOptions options = backendOptionsFor(backend, list[0].params);
     options.device = device.value_or(-1);
     if (auto err = createBatch(options, uint32_t(list.size()), batch_)) throw std::runtime_error(*err);
@@ -439,7 +495,13 @@ py::list devices() {
 
 PYBIND11_MODULE(tender, m) {
   using namespace tender;
-  m.doc() = "Tender: a sheet of receipt paper to grab, crumple, fold, toss and tear.";
+  m.doc() = "Tender: a sheet of receipt paper to grab, crumple, fold, toss and tear.\n\n"
+            "Threads: every call holds the GIL from start to end, so calls from several threads on one object "
+            "or on several run one at a time and are safe; they do not run in parallel.";
+  // NumPy is imported here, on the importing thread: imported lazily by the first array, two
+  // threads could deadlock (one holding the GIL, waiting for the other's half-done import).
+  py::module_::import("numpy");
+  py::detail::npy_api::get();
   m.attr("__version__") = TENDER_VERSION;
   m.def("presets", &presetNames, "The names of the built-in presets.");
   m.def("devices", &devices,

@@ -77,4 +77,27 @@ changed=$(compare -metric AE -fuzz 3% "$tmp/before.png" "$tmp/dragged.png" null:
 echo "pixels changed by the drag: $changed"
 [ "${changed%.*}" -gt 2000 ] || fail "the sheet did not move ($changed pixels changed)"
 echo "recorded input:"; head -20 "$tmp/input.txt"
+
+# SIGTERM (as Ctrl-C) ends the session as a window close does: the recording and the summary are
+# written, then one error line and exit 2; the recording replays to the demo's state.
+start_demo --backend cpu --record "$tmp/term.txt" --width 640 --height 480
+sleep 3
+alive "start-up before SIGTERM"
+xdotool mousemove --sync 320 240 mousedown 1 mousemove --sync 300 260 mouseup 1
+sleep 0.5
+kill -TERM "$demo"
+wait "$demo"
+rc=$?
+demo=
+[ "$rc" -eq 2 ] || fail "SIGTERM: exit $rc"
+grep -q "^tender: error: interrupted (SIGTERM); the session is recorded in $tmp/term.txt$" "$tmp/demo.log" ||
+  fail "SIGTERM: no error line naming the recording"
+steps=$(sed -n 's/^tender-demo: \([0-9]*\) steps, state hash \([0-9a-f]*\)$/\1/p' "$tmp/demo.log")
+hash=$(sed -n 's/^tender-demo: \([0-9]*\) steps, state hash \([0-9a-f]*\)$/\2/p' "$tmp/demo.log")
+[ -n "$steps" ] && [ -n "$hash" ] || fail "SIGTERM: no summary"
+grep -q "steps: tender sim --script <this file> --ticks $steps ends at state hash $hash" "$tmp/term.txt" ||
+  fail "SIGTERM: the recording was not written"
+"$(dirname "$DEMO")/tender" sim --backend cpu --script "$tmp/term.txt" --ticks "$steps" | grep -q "state hash $hash" ||
+  fail "SIGTERM: the recording does not replay to the demo's state"
+echo "ok: SIGTERM ends the session with its recording ($steps steps) and summary"
 echo "PASS"

@@ -107,7 +107,7 @@ def test_bad_input_raises():
         tender.Simulation(backend="cpu", gravity=float("inf"))
     with pytest.raises(ValueError, match="^cols: "):
         tender.Simulation(backend="cpu", cols=-3)
-    with pytest.raises(ValueError):
+    with pytest.raises(TypeError, match="^cols: expected a bool, an int, a float or a str, got list"):
         tender.Simulation(backend="cpu", cols=[1])
     sim = tender.Simulation(preset="crumple-low", backend="cpu")
     with pytest.raises(ValueError, match="does not exist"):
@@ -152,7 +152,7 @@ def test_save_ply_and_glb(tmp_path):
     assert magic == b"glTF" and version == 2 and length == len(glb)
     assert json.loads((tmp_path / "a.gltf").read_text())["asset"]["version"] == "2.0"
     assert sorted(os.listdir(tmp_path)) == ["a.glb", "a.gltf", "a.ply"]  # no temporary left
-    with pytest.raises(ValueError, match="cannot write"):
+    with pytest.raises(OSError, match="cannot write .*does not exist"):
         sim.save(str(tmp_path / "missing" / "a.glb"))
 
 
@@ -254,3 +254,65 @@ def test_fleet_bad_input_raises():
         fleet.grab(2, 0)
     with pytest.raises(ValueError):
         fleet.grab(0, 64)
+
+
+def test_types_and_write_errors_raise_as_the_cli_says(tmp_path):
+    # A count too large for any integer type, a key that is not a name, a value of the wrong type
+    with pytest.raises(ValueError, match="^sheets: expected 1 to 65535, got 1208925819614629174706176$"):
+        tender.Fleet(2**80)
+    with pytest.raises(TypeError, match=r"^sheets\[0\]: keys are parameter names \(str\), got int$"):
+        tender.Fleet([{1: 1}])
+    with pytest.raises(TypeError, match=r"^sheets\[1\]: expected a dict, got int$"):
+        tender.Fleet([{}, 3])
+    with pytest.raises(TypeError, match="^sheets: expected a count or a list of dicts, got bool$"):
+        tender.Fleet(True)
+    # One rule with preset files: whole numbers for whole keys, True/False for on/off keys
+    with pytest.raises(TypeError, match="^cols: expected a whole number, got 8.0$"):
+        tender.Simulation(backend="cpu", cols=8.0)
+    with pytest.raises(TypeError, match="^wind: expected true or false, got 1$"):
+        tender.Simulation(backend="cpu", wind=1)
+    with pytest.raises(TypeError, match="^pins: expected a name, got true$"):
+        tender.Simulation(backend="cpu", pins=True)
+    assert tender.Simulation(backend="cpu", cols=8, rows=8, damping=1, wind="off").params["wind"] == "off"
+    sim = tender.Simulation(backend="cpu", cols=8, rows=8)
+    with pytest.raises(ValueError, match="^an output path is empty$"):
+        sim.save("")
+    with pytest.raises(OSError, match="^cannot write '/dev/full': No space left on device$"):
+        sim.save("/dev/full")
+    with pytest.raises(OSError, match="is a folder"):
+        sim.save(str(tmp_path))
+    # Truth values are True or False: NaN and None are refused, and nothing changes
+    wind, paused = sim.wind, sim.paused
+    with pytest.raises(TypeError, match="^paused: expected True or False, got float$"):
+        sim.paused = float("nan")
+    with pytest.raises(TypeError, match="^wind: expected True or False, got NoneType$"):
+        sim.wind = None
+    with pytest.raises(TypeError, match="^pins: expected True or False, got int$"):
+        sim.pins = 1
+    assert (sim.wind, sim.paused) == (wind, paused)
+    sim.paused = True
+    assert sim.paused
+
+
+def test_a_fleet_too_large_for_memory_is_refused_up_front():
+    # 60000 sheets of 64x64 need about 229 GB: refused in words before anything is allocated.
+    with pytest.raises(ValueError, match="^a batch of 60000 64x64 sheets needs about [0-9]+ MiB on the cpu backend; "):
+        tender.Fleet(60000, cols=64, rows=64)
+
+
+def test_threads_read_arrays_before_numpy_is_imported():
+    # Two threads reading positions first thing in a fresh interpreter (NumPy not yet imported by
+    # the script) finish: no deadlock between the GIL and NumPy's import.
+    code = """
+import threading, tender
+sims = [tender.Simulation(backend="cpu", cols=8, rows=8) for _ in range(2)]
+out = []
+threads = [threading.Thread(target=lambda s=s: out.append(s.positions.shape)) for s in sims]
+[t.start() for t in threads]
+[t.join() for t in threads]
+assert out == [(64, 3), (64, 3)], out
+print("ok")
+"""
+    for _ in range(3):
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr

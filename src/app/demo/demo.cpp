@@ -107,6 +107,10 @@ bool DemoApp::init() {
     return false;
   }
   sim_->setScript(*replay);
+  if (auto err = record_.addInput(options_.replay)) {
+    fail(*err);
+    return false;
+  }
   if (auto err = record_.add(options_.record)) {
     fail(*err);
     return false;
@@ -293,7 +297,10 @@ int DemoApp::run() {
   uint32_t fps_frames = 0;
   std::string device = ctx_->info().name;
 
-  while (!glfwWindowShouldClose(window_)) {
+  // Ctrl-C, SIGTERM or SIGHUP end the session as a window close does (the recording and the summary
+  // are written), then say so.
+  catchInterrupts();
+  while (!glfwWindowShouldClose(window_) && !interrupted()) {
     glfwPollEvents();
     int w = 0, h = 0;
     glfwGetFramebufferSize(window_, &w, &h);
@@ -377,6 +384,9 @@ int DemoApp::run() {
   }
   if (common_.validation && ctx_->validationMessages() > 0)
     return fail(std::to_string(ctx_->validationMessages()) + " validation messages");
+  if (interrupted())
+    return fail(interruptMessage() +
+                (options_.record.empty() ? "" : "; the session is recorded in " + options_.record));
   return 0;
 }
 

@@ -1,0 +1,39 @@
+#pragma once
+/// What every program of Tender (tender, tender-demo, tender-bench) does with an error, its standard
+/// output, an empty option value and an interrupt: one line `<program>: error: <message>` of
+/// printable text and exit status 2.
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace tender {
+
+/// Exit status of every error (bad input, a fault, an interrupt), with one line on stderr.
+constexpr int kExitBadInput = 2;
+
+/// The name error lines start with ("tender" unless set).
+void setProgramName(const char* name);
+/// `text` with every control character, DEL and byte that is not UTF-8 written as an escape (\n,
+/// \t, \xNN), so that it prints as one line of text whatever it held (a NUL included).
+std::string printable(const std::string& text);
+/// Prints "<program>: error: <message>" (printable) and returns kExitBadInput.
+int fail(const std::string& message);
+/// Flushes standard output; when anything written there was lost (a full disk, a closed pipe),
+/// prints "cannot write standard output: <why>" and returns kExitBadInput, else `status`.
+int finishOutput(int status);
+/// The first option of `app` or of its subcommands in use that was given an empty value, as
+/// "--video: the value is empty"; nullopt when none was.
+std::optional<std::string> emptyValue(const CLI::App& app);
+/// A check for CLI11: a finite number in [lo, hi] (CLI::Range lets NaN through).
+CLI::Validator finiteRange(double lo, double hi);
+
+/// From now on SIGINT, SIGTERM and SIGHUP set a flag (interrupted()) instead of ending the
+/// process, so that a long run can stop, remove its temporary files and say so.
+void catchInterrupts();
+/// True once one of those signals arrived.
+bool interrupted();
+/// "interrupted (SIGINT)": the signal that arrived.
+std::string interruptMessage();
+
+} // namespace tender
