@@ -12,7 +12,7 @@ BackendOptions CommonOptions::backendOptions() const {
 
 std::optional<InputScript> scriptFor(const std::string& path, const SimParams& params, std::string& error) {
   if (path.empty()) return InputScript{};
-  return loadScriptFor(path, params.particleCount(), error);
+  return loadScriptFor(path, params, error);
 }
 
 } // namespace tender

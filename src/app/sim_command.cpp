@@ -86,6 +86,7 @@ std::optional<std::string> planMesh(const SimOptions& o, MeshPlan& plan) {
 } // namespace
 
 int runSim(const CommonOptions& common, const SimOptions& o) {
+  catchInterrupts(); // Ctrl-C or SIGTERM: the run stops between ticks, writes nothing and says so
   // Every output is checked before the run, and written only when the run has succeeded.
   MeshPlan plan;
   if (auto err = planMesh(o, plan)) return fail(*err);
@@ -141,7 +142,6 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   if (auto err = takeFrame(0)) return fail(*err);
   // A bar on a terminal once the run has taken a second; nothing otherwise.
   Progress progress("tender sim", "tick", o.ticks, 1.0);
-  catchInterrupts(); // Ctrl-C or SIGTERM: the run stops between ticks, writes nothing and says so
   for (uint64_t t = 0; t < o.ticks; ++t) {
     if (interrupted()) {
       progress.clear();

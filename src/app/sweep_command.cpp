@@ -145,18 +145,22 @@ private:
 } // namespace
 
 int runSweep(const CommonOptions& common, const SweepOptions& o) {
+  catchInterrupts(); // Ctrl-C or SIGTERM: the sweep stops between ticks, writes nothing and says so
   Plan plan;
   if (auto err = makePlan(common, o, plan)) return fail(*err);
   const std::vector<uint64_t> indices = shardIndices(plan);
   if (auto err = chooseBatch(plan, indices.size(), common.device)) return fail(*err);
-  // Every sheet is checked before anything runs.
+  // Every sheet, and the script against it, is checked before anything runs. A fleet's sheets keep
+  // their layout: the script's set events may change only keys that do not rebuild the sheet.
+  std::string error;
+  auto script = common.script.empty() ? InputScript{} : loadScriptFor(common.script, common.params, error, true);
+  if (!script) return fail(error);
   for (uint64_t index : indices) {
     SweepSheet sheet;
     if (auto err = makeSheet(plan, index, sheet)) return fail(*err);
+    if (auto err = checkScript(*script, sheet.params, true))
+      return fail(common.script + ": sheet " + std::to_string(index) + ": " + *err);
   }
-  std::string error;
-  auto script = scriptFor(common.script, common.params, error);
-  if (!script) return fail(error);
   const auto script_hash = common.script.empty() ? std::nullopt : fileHash(common.script);
   const Json def = definition(plan, script_hash);
   if (!common.script.empty() && !script_hash) return fail("cannot read '" + common.script + "'");
@@ -175,7 +179,6 @@ int runSweep(const CommonOptions& common, const SweepOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   Progress progress("tender sweep", "sheet-tick", indices.size() * plan.ticks, 1.0);
   Runner runner(common, plan, *script, dir, o.ply, outputs, progress);
-  catchInterrupts(); // Ctrl-C or SIGTERM: the sweep stops between ticks, writes nothing and says so
   auto err = runner.run(indices);
   progress.clear();
   if (err) return fail(*err);

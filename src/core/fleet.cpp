@@ -5,7 +5,12 @@
 namespace tender {
 
 const std::vector<std::string>& topologyKeys() {
-  static const std::vector<std::string> keys = {"cols", "rows", "spacing", "shear", "bend", "tri_bend"};
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> k;
+    for (const ParamInfo& info : paramKeys())
+      if (info.scope == ParamScope::Topology) k.push_back(info.key);
+    return k;
+  }();
   return keys;
 }
 

@@ -11,7 +11,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "input_file.h"
 #include "sim_config.h"
 
 namespace tender {
@@ -81,6 +80,11 @@ Param boolParam(const char* key, bool SimParams::*m, const char* help) {
           [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); },
           [m](const SimParams& p) { return std::string(p.*m ? "on" : "off"); }};
 }
+/// `p` with the scope of its changes.
+Param scoped(Param p, ParamScope scope) {
+  p.info.scope = scope;
+  return p;
+}
 template <typename E>
 Param enumParam(const char* key, E SimParams::*m, std::vector<std::pair<std::string, E>> names, const char* help) {
   return {{key, help},
@@ -101,19 +105,23 @@ Param enumParam(const char* key, E SimParams::*m, std::vector<std::pair<std::str
 
 const std::vector<Param>& params() {
   static const std::vector<Param> table = {
-      uintParam("cols", &SimParams::cols, 1, kMaxSide, "particles across"),
-      uintParam("rows", &SimParams::rows, 1, kMaxSide, "particles down"),
-      floatParam("spacing", &SimParams::spacing, 1e-3f, 10.0f, "rest distance between neighbours"),
-      enumParam("pins", &SimParams::pins,
-                {{"top3", PinMode::Top3}, {"corners", PinMode::Corners}, {"none", PinMode::None}},
-                "pinned particles: top3, corners, none"),
-      floatParam("top_y", &SimParams::top_y, -1000.0f, 1000.0f, "y of the top edge (0: centre on y = 1)"),
-      floatParam("tilt", &SimParams::tilt, 0.0f, 90.0f, "degrees the sheet leans back from hanging (90: flat)"),
+      scoped(uintParam("cols", &SimParams::cols, 1, kMaxSide, "particles across"), ParamScope::Topology),
+      scoped(uintParam("rows", &SimParams::rows, 1, kMaxSide, "particles down"), ParamScope::Topology),
+      scoped(floatParam("spacing", &SimParams::spacing, 1e-3f, 10.0f, "rest distance between neighbours"),
+             ParamScope::Topology),
+      scoped(enumParam("pins", &SimParams::pins,
+                       {{"top3", PinMode::Top3}, {"corners", PinMode::Corners}, {"none", PinMode::None}},
+                       "pinned particles: top3, corners, none"),
+             ParamScope::Sheet),
+      scoped(floatParam("top_y", &SimParams::top_y, -1000.0f, 1000.0f, "y of the top edge (0: centre on y = 1)"),
+             ParamScope::Sheet),
+      scoped(floatParam("tilt", &SimParams::tilt, 0.0f, 90.0f, "degrees the sheet leans back from hanging (90: flat)"),
+             ParamScope::Sheet),
       floatParam("view_scale", &SimParams::view_scale, 1e-3f, 1e3f,
                  "size of the scene the camera frames and the ground covers (1: the tender sheet's)"),
-      boolParam("shear", &SimParams::shear, "diagonal constraints"),
-      boolParam("bend", &SimParams::bend, "skip-one bend constraints"),
-      boolParam("tri_bend", &SimParams::tri_bend, "bending across adjacent triangles"),
+      scoped(boolParam("shear", &SimParams::shear, "diagonal constraints"), ParamScope::Topology),
+      scoped(boolParam("bend", &SimParams::bend, "skip-one bend constraints"), ParamScope::Topology),
+      scoped(boolParam("tri_bend", &SimParams::tri_bend, "bending across adjacent triangles"), ParamScope::Topology),
       floatParam("tick_hz", &SimParams::tick_hz, 1.0f, 10000.0f, "fixed ticks per second"),
       uintParam("substeps", &SimParams::substeps, 1, SIM_MAX_SUBSTEPS, "substeps per tick"),
       uintParam("iterations", &SimParams::iterations, 1, 256, "constraint iterations per substep"),
@@ -148,8 +156,11 @@ const std::vector<Param>& params() {
                 {{"zero", ReleaseMode::ZeroVelocity}, {"drag", ReleaseMode::DragVelocity}},
                 "velocity on release: zero, drag"),
       floatParam("grab_radius", &SimParams::grab_radius, 0.0f, 100.0f, "pick radius around the ray"),
-      uintParam("threads", &SimParams::threads, 0, 255, "CPU solver threads, 0: one per core (same results)"),
-      boolParam("simd", &SimParams::simd, "CPU solver SIMD kernels; off: the plain scalar reference (same results)"),
+      scoped(uintParam("threads", &SimParams::threads, 0, 255, "CPU solver threads, 0: one per core (same results)"),
+             ParamScope::Solver),
+      scoped(boolParam("simd", &SimParams::simd,
+                       "CPU solver SIMD kernels; off: the plain scalar reference (same results)"),
+             ParamScope::Solver),
   };
   return table;
 }
@@ -253,6 +264,11 @@ std::optional<std::string> applyOverride(SimParams& p, const std::string& assign
   return "unknown parameter '" + key + "' (see --help for the keys)";
 }
 
+bool rebuildsSheet(const std::string& key) {
+  const auto info = paramInfo(key);
+  return info && (info->scope == ParamScope::Sheet || info->scope == ParamScope::Topology);
+}
+
 std::optional<ParamInfo> paramInfo(const std::string& key) {
   for (auto& param : params())
     if (param.info.key == key) return param.info;
@@ -286,137 +302,6 @@ std::string presetJson(const SimParams& p) {
     }
   }
   return j.dump(2) + "\n";
-}
-
-std::optional<std::string> spellTyped(const std::string& key, ValueType type, const std::string& text,
-                                      std::string& out) {
-  const auto info = paramInfo(key);
-  if (!info) return "unknown parameter '" + key + "' (see --help for the keys)";
-  const bool numeric = info->lo != info->hi;
-  std::string expected;
-  if (info->on_off)
-    expected = "true or false";
-  else if (!numeric)
-    expected = "a name";
-  else if (info->whole)
-    expected = "a whole number";
-  else
-    expected = "a number";
-  bool fits = false;
-  switch (type) {
-  case ValueType::Text:
-    fits = true;
-    break;
-  case ValueType::Bool:
-    fits = info->on_off;
-    break;
-  case ValueType::Whole:
-    fits = numeric;
-    break;
-  case ValueType::Number:
-    fits = numeric && !info->whole;
-    break;
-  }
-  if (!fits) return key + ": expected " + expected + ", got " + text;
-  out = type == ValueType::Bool ? (text == "true" ? "on" : "off") : text;
-  return std::nullopt;
-}
-
-namespace {
-
-/// Reads a preset file's JSON: one object of scalar values, each key once, numbers as written.
-class PresetReader : public nlohmann::json_sax<nlohmann::json> {
-public:
-  struct Entry {
-    std::string key;
-    ValueType type = ValueType::Text;
-    std::string text;
-  };
-  std::vector<Entry> entries;
-  std::string error;
-
-  bool null() override { return refuse("null"); }
-  bool boolean(bool v) override { return value(ValueType::Bool, v ? "true" : "false"); }
-  bool number_integer(number_integer_t v) override { return value(ValueType::Whole, std::to_string(v)); }
-  bool number_unsigned(number_unsigned_t v) override { return value(ValueType::Whole, std::to_string(v)); }
-  bool number_float(number_float_t, const string_t& s) override {
-    // An integer too large for 64 bits is still a whole number, as written.
-    const bool digits = !s.empty() && s.find_first_not_of("-0123456789") == std::string::npos;
-    return value(digits ? ValueType::Whole : ValueType::Number, s);
-  }
-  bool string(string_t& v) override { return value(ValueType::Text, v); }
-  bool binary(binary_t&) override { return refuse("binary data"); }
-  bool start_object(std::size_t) override {
-    if (depth_++ == 0) return true;
-    return refuse("an object");
-  }
-  bool end_object() override { return --depth_, true; }
-  bool start_array(std::size_t) override { return depth_ == 0 ? top("an array") : refuse("an array"); }
-  bool end_array() override { return true; }
-  bool key(string_t& k) override {
-    for (const Entry& e : entries)
-      if (e.key == k) return fail(k + ": given twice");
-    key_ = k;
-    return true;
-  }
-  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override {
-    std::string why = e.what();
-    if (auto close = why.find("] "); why.rfind("[json.exception", 0) == 0 && close != std::string::npos)
-      why = why.substr(close + 2);
-    return fail("malformed JSON: " + why);
-  }
-
-private:
-  bool value(ValueType type, const std::string& text) {
-    if (depth_ == 0) return top("a single value");
-    entries.push_back({key_, type, text});
-    return true;
-  }
-  bool refuse(const std::string& what) {
-    if (depth_ == 0) return top(what);
-    return fail(key_ + ": expected a number, a string or true/false, got " + what);
-  }
-  bool top(const std::string&) {
-    return fail("expected a JSON object of parameters (as `tender presets --dump NAME` prints)");
-  }
-  bool fail(const std::string& why) {
-    if (error.empty()) error = why;
-    return false;
-  }
-  int depth_ = 0;
-  std::string key_;
-};
-
-} // namespace
-
-std::optional<std::string> loadPresetFile(const std::string& path, SimParams& out) {
-  std::string text;
-  if (auto why = readInputFile(path, kMaxPresetFileBytes, text)) return path + ": cannot read: " + *why;
-  if (text.find('\0') != std::string::npos) return path + ": holds a NUL byte (a preset file is JSON text)";
-  PresetReader reader;
-  if (!nlohmann::json::sax_parse(text, &reader) || !reader.error.empty())
-    return path + ": " + (reader.error.empty() ? std::string("malformed JSON") : reader.error);
-
-  std::string base = "tender";
-  for (const auto& e : reader.entries)
-    if (e.key == "preset") {
-      if (e.type != ValueType::Text) return path + ": preset: expected the name of a preset";
-      base = e.text;
-    }
-  std::optional<SimParams> p = presetParams(base);
-  if (!p) {
-    std::string names;
-    for (auto& name : presetNames()) names += (names.empty() ? "" : ", ") + name;
-    return path + ": unknown preset '" + base + "' (one of " + names + ")";
-  }
-  for (const auto& e : reader.entries) {
-    if (e.key == "preset") continue;
-    std::string spelled;
-    if (auto err = spellTyped(e.key, e.type, e.text, spelled)) return path + ": " + *err;
-    if (auto err = applyOverride(*p, e.key + "=" + spelled)) return path + ": " + *err;
-  }
-  out = *p;
-  return std::nullopt;
 }
 
 SheetCounts sheetCounts(const SimParams& p) {
@@ -473,19 +358,24 @@ uint64_t availableMemoryBytes() {
   return pages > 0 && page > 0 ? uint64_t(pages) * uint64_t(page) / 2 : ~uint64_t(0);
 }
 
-std::optional<std::string> validate(const SimParams& p, const std::string& backend) {
+std::optional<std::string> checkRules(const SimParams& p) {
   uint64_t n = uint64_t(p.cols) * p.rows;
   if (n == 0) return "the grid has no particles";
   if (n > (1u << 24)) return "a grid of " + std::to_string(n) + " particles is too large (at most 16777216)";
+  if (p.substeps > SIM_MAX_SUBSTEPS) return "substeps is at most " + std::to_string(SIM_MAX_SUBSTEPS);
+  if (p.collision && p.collisionRadius() > p.cell_size)
+    return "collision radius (" + fmt(p.collisionRadius()) + ") must not exceed cell_size (" + fmt(p.cell_size) + ")";
+  return std::nullopt;
+}
+
+std::optional<std::string> validate(const SimParams& p, const std::string& backend) {
+  if (auto err = checkRules(p)) return err;
   // Refused up front, with room to spare (a tenth of the memory for everything else).
   const uint64_t need = estimateSheetBytes(p, backend), have = availableMemoryBytes();
   if (need > have / 10 * 9)
     return "a " + std::to_string(p.cols) + "x" + std::to_string(p.rows) + " sheet needs about " +
            std::to_string(need >> 20) + " MiB on the " + (backend == "cpu" ? "cpu" : "gpu") + " backend; " +
            std::to_string(have >> 20) + " MiB are available";
-  if (p.substeps > SIM_MAX_SUBSTEPS) return "substeps is at most " + std::to_string(SIM_MAX_SUBSTEPS);
-  if (p.collision && p.collisionRadius() > p.cell_size)
-    return "collision radius (" + fmt(p.collisionRadius()) + ") must not exceed cell_size (" + fmt(p.cell_size) + ")";
   return std::nullopt;
 }
 

@@ -86,6 +86,11 @@ std::vector<std::string> presetNames();
 /// Looks up a preset; nullopt when unknown.
 std::optional<SimParams> presetParams(const std::string& name);
 
+/// What a change of a parameter touches: the running sheet only, the sheet's layout (rebuilt at
+/// rest), its topology (the constraint graph: every sheet of a batch shares it; rebuilt too), or the
+/// CPU solver (its workers or kernels; the results do not change).
+enum class ParamScope : uint8_t { Live, Sheet, Topology, Solver };
+
 /// One documented, settable parameter.
 struct ParamInfo {
   std::string key;
@@ -93,7 +98,12 @@ struct ParamInfo {
   double lo = 0.0, hi = 0.0; ///< accepted range of a number (lo == hi: not a number)
   bool whole = false;        ///< a whole number (else a float, if a number)
   bool on_off = false;       ///< on/off (else, when not a number, one of some names)
+  ParamScope scope = ParamScope::Live;
 };
+/// True when setting `key` rebuilds the sheet at rest (its scope is Sheet or Topology): the keys
+/// that decide the sheet's layout, pins and constraints. (floor_y, which also places a new sheet
+/// above the floor, moves the floor under a running one.)
+bool rebuildsSheet(const std::string& key);
 /// All keys accepted by `--set`.
 const std::vector<ParamInfo>& paramKeys();
 /// The parameter of a key (its help and range); nullopt when unknown.
@@ -117,6 +127,9 @@ constexpr uint64_t kMaxPresetFileBytes = 1u << 20;
 
 /// Applies one `key=value` override; returns an error message on failure.
 std::optional<std::string> applyOverride(SimParams& p, const std::string& assignment);
+/// Checks the rules between parameters that hold on every machine: a grid of 1 to 2^24
+/// particles, the substep limit, a collision radius within the hash cell. Returns the rule broken.
+std::optional<std::string> checkRules(const SimParams& p);
 /// Checks ranges and cross-parameter rules (radius vs cell) and that the sheet fits this
 /// machine's memory on the given backend ("cpu", or a GPU backend: its buffers counted as host
 /// memory, as on a CPU device or a GPU with shared memory); returns an error message.

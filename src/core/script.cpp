@@ -104,6 +104,19 @@ std::optional<InputScript> parseScript(const std::string& text, std::string& err
       if (!readToggle(in, e.toggle)) return fail(verb + " needs on, off or toggle");
     } else if (verb == "reset") {
       e.kind = EventKind::Reset;
+    } else if (verb == "set") {
+      e.kind = EventKind::Set;
+      if (!(in >> e.key >> e.value)) return fail("set needs a key and a value");
+      if (e.key == "preset") {
+        if (!presetParams(e.value)) return fail("set preset: unknown preset '" + e.value + "'");
+      } else {
+        const auto info = paramInfo(e.key);
+        if (!info) return fail("set: unknown parameter '" + e.key + "'");
+        if (info->scope == ParamScope::Solver)
+          return fail("set " + e.key + ": it changes the solver, not the sheet (give it on the command line)");
+        SimParams p;
+        if (auto err = applyOverride(p, e.key + "=" + e.value)) return fail("set " + *err);
+      }
     } else {
       return fail("unknown event '" + verb + "'");
     }
@@ -125,21 +138,56 @@ std::optional<InputScript> loadScript(const std::string& path, std::string& erro
   return s;
 }
 
-std::optional<InputScript> loadScriptFor(const std::string& path, uint32_t particle_count, std::string& error) {
+std::optional<InputScript> loadScriptFor(const std::string& path, const SimParams& params, std::string& error,
+                                         bool fixed_layout) {
   auto s = loadScript(path, error);
   if (!s) return s;
-  if (auto err = checkScript(*s, particle_count)) {
+  if (auto err = checkScript(*s, params, fixed_layout)) {
     error = path + ": " + *err;
     return std::nullopt;
   }
   return s;
 }
 
-std::optional<std::string> checkScript(const InputScript& script, uint32_t particle_count) {
-  for (const ScriptEvent& e : script.events)
-    if (e.kind == EventKind::GrabParticle && e.particle >= particle_count)
-      return "tick " + std::to_string(e.tick) + ": particle " + std::to_string(e.particle) +
-             " does not exist (the sheet has " + std::to_string(particle_count) + ")";
+std::optional<std::string> applySettings(SimParams& params,
+                                         const std::vector<std::pair<std::string, std::string>>& settings) {
+  SimParams p = params;
+  for (const auto& [key, value] : settings) {
+    if (key == "preset") {
+      if (!presetParams(value)) return "unknown preset '" + value + "'";
+      p.preset = value;
+    } else if (auto err = applyOverride(p, key + "=" + value)) {
+      return err;
+    }
+  }
+  if (auto err = checkRules(p)) return err;
+  params = p;
+  return std::nullopt;
+}
+
+std::optional<std::string> checkScript(const InputScript& script, const SimParams& params, bool fixed_layout) {
+  SimParams p = params;
+  const auto& events = script.events;
+  for (size_t i = 0; i < events.size();) {
+    const ScriptEvent& e = events[i];
+    const std::string at = "tick " + std::to_string(e.tick) + ": ";
+    if (e.kind == EventKind::GrabParticle && e.particle >= p.particleCount())
+      return at + "particle " + std::to_string(e.particle) + " does not exist (the sheet has " +
+             std::to_string(p.particleCount()) + ")";
+    if (e.kind != EventKind::Set) {
+      ++i;
+      continue;
+    }
+    std::vector<std::pair<std::string, std::string>> settings; // this tick's set events in a row
+    for (; i < events.size() && events[i].kind == EventKind::Set && events[i].tick == e.tick; ++i) {
+      if (fixed_layout && rebuildsSheet(events[i].key))
+        return at + "set " + events[i].key +
+               ": the sheets of a fleet keep their layout (set only keys that do "
+               "not rebuild the sheet)";
+      settings.emplace_back(events[i].key, events[i].value);
+    }
+    if (auto err = applySettings(p, settings)) return at + "set: " + *err;
+  }
   return std::nullopt;
 }
 
@@ -171,6 +219,9 @@ std::string formatEvent(const ScriptEvent& e) {
     break;
   case EventKind::Reset:
     o << "reset";
+    break;
+  case EventKind::Set:
+    o << "set " << e.key << ' ' << e.value;
     break;
   }
   return o.str();

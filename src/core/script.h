@@ -11,14 +11,19 @@
 ///   <tick> pins on|off|toggle
 ///   <tick> pause on|off|toggle
 ///   <tick> reset
+///   <tick> set <key> <value>         a parameter, as `--set key=value` (or `set preset <name>`)
 ///
 /// Events of tick T apply just before tick T runs (ticks count from 0); lines must be in tick order.
+/// The `set` events of one tick in a row apply together (Simulation::set): keys that rebuild the
+/// sheet (rebuildsSheet) rebuild it at rest, the others change the running sheet.
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
+
+#include "params.h"
 
 namespace tender {
 
@@ -30,7 +35,7 @@ constexpr uint64_t kMaxScriptBytes = 256ull << 20;
 /// Largest tick a script line may name (decimal digits only).
 constexpr uint64_t kMaxTick = 1000000000000ull;
 
-enum class EventKind { GrabParticle, GrabRay, Move, Release, Wind, Pins, Pause, Reset };
+enum class EventKind { GrabParticle, GrabRay, Move, Release, Wind, Pins, Pause, Reset, Set };
 /// Value of on/off/toggle events.
 enum class Toggle { Off, On, Flip };
 
@@ -41,6 +46,7 @@ struct ScriptEvent {
   glm::vec3 a{0.0f};     ///< GrabRay origin, Move target
   glm::vec3 b{0.0f};     ///< GrabRay direction
   Toggle toggle = Toggle::Flip;
+  std::string key, value; ///< Set: a parameter ("preset": the preset's name) and its value as `--set` takes it
 };
 
 /// A parsed script, sorted by tick.
@@ -52,11 +58,19 @@ struct InputScript {
 std::optional<InputScript> parseScript(const std::string& text, std::string& error);
 /// Reads and parses a script file; errors name the file.
 std::optional<InputScript> loadScript(const std::string& path, std::string& error);
-/// Checks a script against a sheet: particle indices must exist. Returns an error message.
-std::optional<std::string> checkScript(const InputScript& script, uint32_t particle_count);
-/// Reads, parses and checks a script file against a sheet of `particle_count` particles (what
-/// every program does with a script it is given); errors name the file.
-std::optional<InputScript> loadScriptFor(const std::string& path, uint32_t particle_count, std::string& error);
+/// Checks a script against a sheet of `params`, following its `set` events: a grabbed particle must
+/// exist on the sheet as it is then, and each tick's `set` events must give parameters that pass
+/// checkRules(). With `fixed_layout` (a fleet's sheets, which share their layout) only keys that
+/// do not rebuild the sheet may be set. Returns an error message.
+std::optional<std::string> checkScript(const InputScript& script, const SimParams& params, bool fixed_layout = false);
+/// Reads, parses and checks a script file against a sheet of `params` (what every program does
+/// with a script it is given); errors name the file.
+std::optional<InputScript> loadScriptFor(const std::string& path, const SimParams& params, std::string& error,
+                                         bool fixed_layout = false);
+/// The parameters `params` become with the `set` assignments of one step applied in order;
+/// returns the first bad key or value, or the rule the result breaks (checkRules).
+std::optional<std::string> applySettings(SimParams& params,
+                                         const std::vector<std::pair<std::string, std::string>>& settings);
 /// Formats one event as a script line.
 std::string formatEvent(const ScriptEvent& e);
 

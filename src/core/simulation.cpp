@@ -1,5 +1,7 @@
 #include "simulation.h"
 
+#include <algorithm>
+
 #include <cmath>
 
 namespace tender {
@@ -73,6 +75,16 @@ void Simulation::rebuild(const SimParams& p) {
   accumulator_ = 0.0;
 }
 
+std::optional<std::string> Simulation::set(const std::vector<std::pair<std::string, std::string>>& settings) {
+  SimParams p = params_;
+  if (auto err = applySettings(p, settings)) return err;
+  if (std::any_of(settings.begin(), settings.end(), [](const auto& kv) { return rebuildsSheet(kv.first); }))
+    rebuild(p);
+  else
+    setLiveParams(p);
+  return std::nullopt;
+}
+
 void Simulation::setScript(InputScript script) {
   script_ = std::move(script);
   next_event_ = 0;
@@ -105,6 +117,9 @@ void Simulation::apply(const ScriptEvent& e) {
     break;
   case EventKind::Reset:
     reset();
+    break;
+  case EventKind::Set:
+    set({{e.key, e.value}}); // a script's bad settings were refused when it was checked
     break;
   }
 }
@@ -231,8 +246,22 @@ void Simulation::runResetFrame() {
 }
 
 void Simulation::applyDueEvents() {
-  while (next_event_ < script_.events.size() && script_.events[next_event_].tick <= frame_)
-    apply(script_.events[next_event_++]);
+  const auto& events = script_.events;
+  while (next_event_ < events.size() && events[next_event_].tick <= frame_) {
+    const ScriptEvent& e = events[next_event_];
+    if (e.kind != EventKind::Set) {
+      apply(e);
+      ++next_event_;
+      continue;
+    }
+    // The set events of one tick in a row apply together, as checkScript checked them.
+    std::vector<std::pair<std::string, std::string>> settings;
+    for (; next_event_ < events.size() && events[next_event_].kind == EventKind::Set &&
+           events[next_event_].tick == e.tick;
+         ++next_event_)
+      settings.emplace_back(events[next_event_].key, events[next_event_].value);
+    set(settings);
+  }
 }
 
 bool Simulation::tick() {

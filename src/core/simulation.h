@@ -32,6 +32,11 @@ public:
   void setLiveParams(const SimParams& p);
   /// Changes parameters and rebuilds the sheet (grid size, spacing, pins, constraint families).
   void rebuild(const SimParams& p);
+  /// Applies `--set` assignments together (one step's `set` events, a HUD edit, Python's set):
+  /// when one of the keys rebuilds the sheet (rebuildsSheet), the sheet is rebuilt at rest, else the
+  /// running sheet takes the new values. Returns the error, changing nothing, when a key or value
+  /// is bad or the result breaks checkRules().
+  std::optional<std::string> set(const std::vector<std::pair<std::string, std::string>>& settings);
 
   /// Attaches a script; its events apply as ticks reach them.
   void setScript(InputScript script);

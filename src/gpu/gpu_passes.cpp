@@ -1,4 +1,4 @@
-// Recording of the simulation passes: one tick reads like the algorithm of DESIGN.md §3.
+// Recording of the simulation passes: one tick reads like the algorithm of docs/ARCHITECTURE.md §3.
 #include <cassert>
 
 #include "gpu/barriers.h"

@@ -1,5 +1,5 @@
 #pragma once
-/// The passes of one substep of the per-colour path, in the order of DESIGN.md §3, recorded into a
+/// The passes of one substep of the per-colour path, in the order of docs/ARCHITECTURE.md §3, recorded into a
 /// PassSink: the GPU solver dispatches them for its sheet; a fleet dispatches each for every sheet
 /// of a batch, and its gate (SIM_GATE_* in sim_config.h) picks the sheets that run it, those that
 /// would run it alone.

@@ -24,6 +24,7 @@
 #include "core/simulation.h"
 #include "core/stats.h"
 #include "export/gltf.h"
+#include "python/convert.h"
 #ifdef TENDER_HAS_GPU
 #include "gpu/context.h"
 #endif
@@ -32,126 +33,6 @@ namespace py = pybind11;
 
 namespace tender {
 namespace {
-
-/// Keys that change the sheet (its grid, constraints or pins) or the solver (threads, SIMD): setting
-/// one rebuilds the sheet at rest. Every other key applies to the running sheet.
-bool needsRebuild(const std::string& key) {
-  static const char* keys[] = {"cols",  "rows", "spacing",  "pins",    "top_y",
-                               "shear", "bend", "tri_bend", "threads", "simd"};
-  return std::any_of(std::begin(keys), std::end(keys), [&](const char* k) { return key == k; });
-}
-
-/// The name of a Python value's type ("float", "NoneType").
-std::string typeName(const py::handle& value) {
-  return py::str(py::type::of(value).attr("__name__")).cast<std::string>();
-}
-
-/// A Python value spelled as `--set` takes it, by the rule of preset files (spellTyped): True/False
-/// for on/off keys, int for numbers, float for numbers that are not whole, str for any key; a
-/// NumPy scalar as its Python value. A type the key does not take raises TypeError.
-std::string spell(const std::string& key, const py::handle& value) {
-  std::optional<std::string> err;
-  std::string out;
-  if (py::isinstance<py::bool_>(value)) {
-    err = spellTyped(key, ValueType::Bool, value.cast<bool>() ? "true" : "false", out);
-  } else if (py::isinstance<py::int_>(value)) {
-    err = spellTyped(key, ValueType::Whole, py::str(value).cast<std::string>(), out);
-  } else if (py::isinstance<py::float_>(value)) {
-    err = spellTyped(key, ValueType::Number, py::repr(value).cast<std::string>(), out);
-  } else if (py::isinstance<py::str>(value)) {
-    err = spellTyped(key, ValueType::Text, value.cast<std::string>(), out);
-  } else if (py::hasattr(value, "item") && py::hasattr(value, "dtype")) {
-    py::object item = value.attr("item")();
-    if (py::isinstance<py::bool_>(item) || py::isinstance<py::int_>(item) || py::isinstance<py::float_>(item))
-      return spell(key, item);
-    err = key + ": expected a bool, an int, a float or a str, got " + typeName(value);
-  } else {
-    err = key + ": expected a bool, an int, a float or a str, got " + typeName(value);
-  }
-  if (!err) return out;
-  if (!paramInfo(key)) throw py::key_error(*err);
-  throw py::type_error(*err);
-}
-
-/// Applies key=value to `p`: an unknown key raises KeyError, a value of a type the key does not
-/// take TypeError, a bad value ValueError (the CLI's messages).
-void applyKey(SimParams& p, const std::string& key, const py::handle& value) {
-  const std::string assignment = key + "=" + spell(key, value);
-  auto err = applyOverride(p, assignment);
-  if (!err) return;
-  if (key.empty() || !paramInfo(key)) throw py::key_error(*err);
-  throw py::value_error(*err);
-}
-
-/// The keys of a dict of parameters: str, or TypeError naming `what`.
-std::string keyOf(const py::handle& key, const std::string& what) {
-  if (!py::isinstance<py::str>(key))
-    throw py::type_error(what + ": keys are parameter names (str), got " + typeName(key));
-  return key.cast<std::string>();
-}
-
-/// True or False (or a NumPy bool), else TypeError: None or a float is not taken as a truth value.
-bool truthValue(const py::handle& value, const char* what) {
-  if (py::isinstance<py::bool_>(value)) return value.cast<bool>();
-  if (py::hasattr(value, "dtype") && py::hasattr(value, "item")) {
-    py::object item = value.attr("item")();
-    if (py::isinstance<py::bool_>(item)) return item.cast<bool>();
-  }
-  throw py::type_error(std::string(what) + ": expected True or False, got " + typeName(value));
-}
-
-/// Writes through an OutputSet; a path that cannot be written raises OSError (as open() does),
-/// an empty one ValueError.
-void writeOutput(const std::string& path, const std::function<std::optional<std::string>(OutputSet&)>& stage) {
-  if (path.empty()) throw py::value_error("an output path is empty");
-  OutputSet outputs;
-  std::optional<std::string> err = outputs.add(path);
-  if (!err) err = stage(outputs);
-  if (!err) err = outputs.commit();
-  if (err) {
-    PyErr_SetString(PyExc_OSError, err->c_str());
-    throw py::error_already_set();
-  }
-}
-
-std::string unknownPreset(const std::string& name) {
-  std::string names;
-  for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
-  return "unknown preset '" + name + "' (one of " + names + ")";
-}
-
-glm::vec3 coordinates(double x, double y, double z, const char* what) {
-  const double v[3] = {x, y, z};
-  for (double d : v)
-    if (!(std::fabs(d) <= double(kMaxCoordinate)))
-      throw py::value_error(std::string(what) + ": " + std::to_string(d) + " is out of range [-" +
-                            std::to_string(int64_t(kMaxCoordinate)) + ", " + std::to_string(int64_t(kMaxCoordinate)) +
-                            "]");
-  return {float(x), float(y), float(z)};
-}
-
-glm::vec3 sequence3(const py::sequence& s, const char* what) {
-  if (py::len(s) != 3) throw py::value_error(std::string(what) + ": expected 3 numbers");
-  double v[3];
-  for (size_t k = 0; k < 3; ++k) {
-    try {
-      v[k] = s[k].cast<double>();
-    } catch (const py::cast_error&) {
-      throw py::value_error(std::string(what) + ": expected 3 numbers");
-    }
-  }
-  return coordinates(v[0], v[1], v[2], what);
-}
-
-/// An (N, 3) array of the xyz of `v`.
-template <typename T, typename V>
-py::array_t<T> xyzArray(const std::vector<V>& v, size_t n) {
-  py::array_t<T> a({py::ssize_t(n), py::ssize_t(3)});
-  auto m = a.template mutable_unchecked<2>();
-  for (size_t i = 0; i < n; ++i)
-    for (py::ssize_t k = 0; k < 3; ++k) m(py::ssize_t(i), k) = T(v[i][int(k)]);
-  return a;
-}
 
 class PySimulation {
 public:
@@ -204,10 +85,8 @@ public:
     if (auto err = validate(p, backend_name_)) throw py::value_error(*err);
     if (p.threads != sim_->params().threads || p.simd != sim_->params().simd) {
       build(p);
-    } else if (needsRebuild(key)) {
-      sim_->rebuild(p);
-    } else {
-      sim_->setLiveParams(p);
+    } else if (auto err = sim_->set({{key, spell(key, value)}})) { // as a script's set event
+      throw py::value_error(*err);
     }
   }
 
@@ -361,7 +240,7 @@ public:
         std::string error;
         auto script = parseScript(scripts->at(i), error);
         if (!script) throw py::value_error("scripts[" + std::to_string(i) + "]: " + error);
-        if (auto err = checkScript(*script, list[i].params.particleCount()))
+        if (auto err = checkScript(*script, list[i].params, true))
           throw py::value_error("scripts[" + std::to_string(i) + "]: " + *err);
         list[i].script = std::move(*script);
       }
@@ -500,8 +379,12 @@ PYBIND11_MODULE(tender, m) {
             "or on several run one at a time and are safe; they do not run in parallel.";
   // NumPy is imported here, on the importing thread: imported lazily by the first array, two
   // threads could deadlock (one holding the GIL, waiting for the other's half-done import).
-  py::module_::import("numpy");
-  py::detail::npy_api::get();
+  // Without NumPy the module still loads; asking for an array raises ImportError then.
+  try {
+    py::module_::import("numpy");
+    py::detail::npy_api::get();
+  } catch (const py::error_already_set&) {
+  }
   m.attr("__version__") = TENDER_VERSION;
   m.def("presets", &presetNames, "The names of the built-in presets.");
   m.def("devices", &devices,

@@ -191,7 +191,10 @@ mkdir -p "$tmp/frames"
 "$T" sim --backend cpu --set cols=16 --set rows=16 --ticks 50000 --frames-every 1 --out "$tmp/frames/" \
   >/dev/null 2>&1 &
 pid=$!
-sleep 2
+for _ in $(seq 300); do # killed once it has staged frames (within 30 s)
+  find "$tmp/frames" -name '.*.tmp.*' | grep -q . && break
+  sleep 0.1
+done
 kill -9 "$pid"
 wait "$pid" 2>/dev/null
 find "$tmp/frames" -name '.*.tmp.*' | grep -q . || fail "the killed run left no temporary file to clean (test setup)"

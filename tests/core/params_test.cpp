@@ -128,7 +128,7 @@ TEST(Script, AnEmptyFileHasNoEvents) {
   ASSERT_TRUE(f);
   std::fclose(f);
   std::string err;
-  auto s = loadScriptFor(path, 10, err);
+  auto s = loadScriptFor(path, *presetParams("tender"), err);
   ASSERT_TRUE(s) << err;
   EXPECT_TRUE(s->events.empty());
   std::remove(path.c_str());

@@ -94,6 +94,90 @@ TEST(Replay, ARecordedSessionReplaysBitwiseAtAnyFrameRate) {
   }
 }
 
+// The demo's parameter edits are set events: live edits (damping, iterations, tear factor) and a
+// rebuild (a new grid and tilt, grabbed afterwards) recorded as they happen replay bitwise, and
+// the replay ends with the session's parameters.
+TEST(Replay, RecordedParameterEditsReplayBitwise) {
+  const SimParams p = preset("tender", {"cols=16", "rows=24"});
+  LiveSession live(p);
+  auto edit = [&](std::vector<std::pair<std::string, std::string>> settings) {
+    const uint64_t tick = live.sim.frameCount();
+    ASSERT_FALSE(live.sim.set(settings));
+    for (auto& [key, value] : settings) {
+      ScriptEvent e;
+      e.tick = tick;
+      e.kind = EventKind::Set;
+      e.key = key;
+      e.value = value;
+      live.text += formatEvent(e) + "\n";
+    }
+  };
+  ScriptEvent grab;
+  grab.kind = EventKind::GrabParticle;
+  grab.particle = 383;
+  for (int frame = 0; frame < 150; ++frame) {
+    if (frame == 3) live.input(grab);
+    if (frame == 20) edit({{"damping", "0.95"}, {"iterations", "3"}});
+    if (frame == 40) edit({{"tear_factor", "1.2"}});
+    if (frame == 60) edit({{"cols", "12"}, {"rows", "20"}, {"tilt", "30"}});
+    if (frame == 61) {
+      grab.particle = 239; // the last particle of the new 12 x 20 sheet
+      live.input(grab);
+    }
+    if (frame == 90) {
+      ScriptEvent release;
+      release.kind = EventKind::Release;
+      live.input(release);
+    }
+    live.sim.advance(0.0164f);
+  }
+  ASSERT_EQ(live.sim.topology().particleCount(), 240u);
+  std::string error;
+  const auto script = parseScript(live.text, error);
+  ASSERT_TRUE(script) << error;
+  ASSERT_FALSE(checkScript(*script, p)) << "the recording is refused";
+  SimState want;
+  live.solver.readback(want);
+
+  CpuSolver replay_solver;
+  Simulation replay(p, replay_solver);
+  replay.setScript(*script);
+  for (uint64_t t = 0; t < live.sim.frameCount(); ++t) replay.tick();
+  SimState got;
+  replay_solver.readback(got);
+  EXPECT_TRUE(sameBytes(want.pos, got.pos));
+  EXPECT_TRUE(sameBytes(want.prev, got.prev));
+  EXPECT_EQ(paramValues(replay.params()), paramValues(live.sim.params()));
+
+  // Without the edits the run ends elsewhere: the edits are what the replay reproduced.
+  CpuSolver plain_solver;
+  Simulation plain(p, plain_solver);
+  plain.setScript(*parseScript("3 grab particle 383\n", error));
+  for (uint64_t t = 0; t < live.sim.frameCount(); ++t) plain.tick();
+  SimState other;
+  plain_solver.readback(other);
+  EXPECT_NE(other.pos.size(), got.pos.size());
+}
+
+// Set events are checked before a run: a bad value, a key of the solver, a rule broken by a
+// tick's settings together, a grab of a particle a rebuild removed, a layout change in a fleet.
+TEST(Script, SetEventsAreCheckedAgainstTheSheet) {
+  const SimParams p = preset("tender", {"cols=16", "rows=24"});
+  std::string error;
+  EXPECT_FALSE(parseScript("0 set damping 2\n", error));
+  EXPECT_FALSE(parseScript("0 set threads 2\n", error));
+  EXPECT_FALSE(parseScript("0 set nope 1\n", error));
+  EXPECT_FALSE(parseScript("0 set preset nope\n", error));
+  EXPECT_FALSE(parseScript("0 set damping\n", error));
+  // Together the two keep the radius within the cell; alone, the first breaks the rule.
+  EXPECT_FALSE(checkScript(*parseScript("5 set collision_factor 3\n5 set cell_size 1\n", error), p));
+  EXPECT_TRUE(checkScript(*parseScript("5 set collision_factor 3\n6 set cell_size 1\n", error), p));
+  EXPECT_TRUE(checkScript(*parseScript("5 set cols 4\n6 grab particle 200\n", error), p));
+  EXPECT_FALSE(checkScript(*parseScript("5 set cols 4\n6 grab particle 20\n", error), p));
+  EXPECT_TRUE(checkScript(*parseScript("5 set tilt 10\n", error), p, true));
+  EXPECT_FALSE(checkScript(*parseScript("5 set damping 0.9\n", error), p, true));
+}
+
 TEST(Replay, ResetRestoresThePins) {
   const SimParams p = preset("tender", {"cols=8", "rows=12"});
   CpuSolver solver;

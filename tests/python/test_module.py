@@ -316,3 +316,18 @@ print("ok")
     for _ in range(3):
         done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
         assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr
+
+
+def test_set_of_a_layout_key_rebuilds_the_sheet_as_a_script_does(tmp_path):
+    # tilt decides where the sheet is: setting it rebuilds the sheet at rest, as a fresh one
+    sim = tender.Simulation(backend="cpu", cols=8, rows=8)
+    sim.step(5)
+    sim.set("tilt", 45)
+    fresh = tender.Simulation(backend="cpu", cols=8, rows=8, tilt=45)
+    assert (sim.positions == fresh.positions).all()
+    # Python's set is a script's set event: `tender sim` with it at tick 5 ends in the same state
+    sim.step(15)
+    script = tmp_path / "tilt.txt"
+    script.write_text("5 set tilt 45\n")
+    assert cli_hash("--backend", "cpu", "--set", "cols=8", "--set", "rows=8", "--script", str(script),
+                    "--ticks", "20") == sim.state_hash()

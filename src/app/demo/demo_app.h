@@ -71,7 +71,10 @@ private:
   /// Moves the grab target to where the cursor last dragged it.
   void applyPendingMove();
   void handleActions(const demo::HudActions& a);
-  void switchParams(const SimParams& p, bool new_receipt);
+  /// Applies the parameters `p` as set events (script events, recorded): the keys that differ, and
+  /// with `rebuild` the grid's, so the sheet is rebuilt at rest; `new_receipt` (a preset switch)
+  /// also prints its receipt and frames its view.
+  void applyParams(const SimParams& p, bool rebuild, bool new_receipt);
   /// The camera's start view for a preset: the spec's (6, 4, 10) towards (0, 1, 0), or for a
   /// crumple sheet, which falls to the floor at y = -10, a view from further back that shows the
   /// floor and the shadow on it.

@@ -1,5 +1,6 @@
 // tender-demo input: mouse grab/orbit/zoom/pan, keys, HUD actions; every input that changes the
-// simulation goes through apply() as a script event, so it can be recorded and replayed.
+// simulation goes through apply() as a script event, or applyParams() as set events (the HUD's
+// parameter edits), so it can be recorded and replayed.
 #include <algorithm>
 #include <cstdio>
 
@@ -212,17 +213,46 @@ float DemoApp::aspect() const {
   return float(std::max(w, 1)) / float(std::max(h, 1));
 }
 
-void DemoApp::switchParams(const SimParams& p, bool new_receipt) {
-  ctx_->waitIdle();
-  input_.grabbing = false;
-  input_.pending_move.reset();
-  sim_->rebuild(p);
+void DemoApp::applyParams(const SimParams& p, bool rebuild, bool new_receipt) {
+  // The keys that differ from the sheet's (the solver's stay as they are), and with `rebuild` the
+  // grid's, which rebuild the sheet at rest: one step's set events, applied together and recorded.
+  std::vector<std::pair<std::string, std::string>> settings;
+  if (p.preset != sim_->params().preset) settings.emplace_back("preset", p.preset);
+  const auto now = paramValues(sim_->params()), next = paramValues(p);
+  for (size_t k = 0; k < next.size(); ++k) {
+    const std::string& key = next[k].first;
+    if (paramInfo(key)->scope == ParamScope::Solver) continue;
+    if (next[k].second != now[k].second || (rebuild && (key == "cols" || key == "rows"))) settings.push_back(next[k]);
+  }
+  if (settings.empty()) return;
+  const bool rebuilds =
+      std::any_of(settings.begin(), settings.end(), [](const auto& kv) { return rebuildsSheet(kv.first); });
+  if (rebuilds) {
+    ctx_->waitIdle();
+    input_.grabbing = false;
+    input_.pending_move.reset();
+  }
+  const uint64_t tick = sim_->frameCount();
+  if (auto err = sim_->set(settings)) {
+    std::fprintf(stderr, "tender-demo: %s\n", err->c_str());
+    return;
+  }
+  if (!options_.record.empty())
+    for (const auto& [key, value] : settings) {
+      ScriptEvent e;
+      e.tick = tick;
+      e.kind = EventKind::Set;
+      e.key = key;
+      e.value = value;
+      record_text_ += formatEvent(e) + "\n";
+    }
+  if (!rebuilds) return;
   if (new_receipt) {
     renderer_->setReceipt(render::rasterizeReceipt(render::receiptText(p.preset)));
     resetView();
     setFollow(followsByDefault(p));
   }
-  panel_params_ = p;
+  panel_params_ = sim_->params();
   attachPaper();
 }
 
@@ -235,20 +265,21 @@ void DemoApp::handleActions(const demo::HudActions& a) {
   if (a.reset) e.kind = EventKind::Reset, apply(e);
   if (a.reset_view) resetView();
   if (a.toggle_follow) setFollow(!follow_on_);
+  // Parameter edits are set events, recorded like every other input.
   if (a.preset) {
-    if (auto p = presetParams(*a.preset)) switchParams(*p, true);
+    if (auto p = presetParams(*a.preset)) applyParams(*p, true, true);
   } else if (a.rebuild) {
     if (auto err = validate(panel_params_, common_.backend))
       std::fprintf(stderr, "tender-demo: %s\n", err->c_str());
     else
-      switchParams(panel_params_, false);
+      applyParams(panel_params_, true, false);
   } else if (a.live_changed) {
     if (!validate(panel_params_, common_.backend)) {
       // Grid size edits wait for "Rebuild sheet"; everything else applies now.
       SimParams live = panel_params_;
       live.cols = sim_->params().cols;
       live.rows = sim_->params().rows;
-      sim_->setLiveParams(live);
+      applyParams(live, false, false);
     }
   }
 }
