@@ -1,7 +1,7 @@
 // Arithmetic with the same bits on every device, shared by GLSL and C++ (included by sim_types.h).
 //
 // Vulkan makes add, subtract and multiply correctly rounded (when not fused: every float operation
-// of the simulation's SPIR-V carries NoContraction, see src/gpu/spirv_rules.cpp), but lets `sqrt`
+// of the simulation's SPIR-V carries NoContraction, see shaders/spirv/spirv_rules.cpp), but lets `sqrt`
 // be off by about 3 ULP and `x / y` by 2.5 ULP, and leaves the order inside dot(), cross(),
 // length() and mix() to the implementation. So the simulation writes dot products out, and its
 // square roots and divisions are exactSqrt and exactDiv: the device's approximation, corrected to

@@ -33,7 +33,7 @@ struct SimUniforms {
 
   float restitution;      // normal velocity kept on floor contact
   float friction;         // tangential velocity removed on floor contact
-  float collision_radius; // repulsion distance (1.2 x spacing)
+  float collision_radius; // repulsion distance (collision_factor x spacing)
   float inv_cell;         // 1 / hash cell size
 
   float collision_stiffness; // fraction of the overlap corrected per substep

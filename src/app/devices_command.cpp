@@ -26,7 +26,7 @@ int runDevices(const CommonOptions&) {
                 d.name.c_str(), d.type.c_str(), VK_API_VERSION_MAJOR(d.api_version),
                 VK_API_VERSION_MINOR(d.api_version), VK_API_VERSION_PATCH(d.api_version), d.driver.c_str(),
                 double(d.memory_bytes) / (1024.0 * 1024.0 * 1024.0), d.usable ? "" : " [not usable: needs Vulkan 1.3]");
-    // What the simulation's shaders ask of its float arithmetic (src/gpu/spirv_rules.h)
+    // What the simulation's shaders ask of its float arithmetic (shaders/spirv/spirv_rules.h)
     const gpu::FloatRules rules = gpu::floatRulesFor(d.floats);
     std::printf("    float32 controls: round to nearest even %s, denormal preserve %s, flush %s -> denormals %s; "
                 "subgroup %u, shared memory %u KiB\n",

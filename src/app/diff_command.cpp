@@ -275,7 +275,7 @@ int runDiff(const CommonOptions& common, const DiffOptions& o) {
   Diff diff(common, *script, a, b);
   const auto tick = diff.firstDifferingTick(o.ticks);
   if (!tick) {
-    std::printf("identical: %" PRIu64 " ticks, state hash %016" PRIx64 "\n", o.ticks, hashPositions(a.state.pos));
+    std::printf("identical: %" PRIu64 " ticks, state hash %s\n", o.ticks, hashHex(hashPositions(a.state.pos)).c_str());
     return 0;
   }
   const shaderio::SimUniforms u = a.sim->lastUniforms();

@@ -6,10 +6,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "core/fleet.h"
+#include "core/input_file.h"
+#include "core/script.h"
 #include "core/stats.h"
 
 namespace tender::sweep {
@@ -278,11 +279,9 @@ std::optional<std::string> chooseBatch(Plan& plan, uint64_t shard_sheets, int de
 }
 
 std::optional<std::string> fileHash(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  uint64_t h = 0xcbf29ce484222325ull;
-  for (char c; in.get(c);) h = (h ^ uint8_t(c)) * 0x100000001b3ull;
-  return hashHex(h);
+  std::string text;
+  if (readInputFile(path, kMaxScriptBytes, text)) return std::nullopt;
+  return hashHex(fnv1a(text.data(), text.size()));
 }
 
 // The base parameters leave out the keys that change only how fast a sheet runs (the CPU's

@@ -11,12 +11,13 @@ const char* kindName(uint32_t kind) {
   return kind < 4 ? names[kind] : "?";
 }
 
-uint64_t hashPositions(const std::vector<glm::vec4>& pos) {
-  uint64_t h = 1469598103934665603ull;
-  auto bytes = reinterpret_cast<const unsigned char*>(pos.data());
-  for (size_t i = 0, n = pos.size() * sizeof(glm::vec4); i < n; ++i) h = (h ^ bytes[i]) * 1099511628211ull;
+uint64_t fnv1a(const void* data, size_t size, uint64_t h) {
+  auto bytes = static_cast<const unsigned char*>(data);
+  for (size_t i = 0; i < size; ++i) h = (h ^ bytes[i]) * 1099511628211ull;
   return h;
 }
+
+uint64_t hashPositions(const std::vector<glm::vec4>& pos) { return fnv1a(pos.data(), pos.size() * sizeof(glm::vec4)); }
 
 SheetStats computeStats(const SimState& s, float substep_dt) {
   SheetStats st;

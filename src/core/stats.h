@@ -25,6 +25,8 @@ struct SheetStats {
 
 /// Names of the constraint kinds, indexed by kind.
 const char* kindName(uint32_t kind);
+/// FNV-1a 64 of `size` bytes, continuing from `h` (the offset basis: a hash of nothing).
+uint64_t fnv1a(const void* data, size_t size, uint64_t h = 1469598103934665603ull);
 /// FNV-1a 64 of the bytes of the positions.
 uint64_t hashPositions(const std::vector<glm::vec4>& pos);
 /// Computes the summary of a read-back state.

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/shaderio.h"
 #include "grain.h"
+#include "shaderio.h"
 
 namespace tender {
 

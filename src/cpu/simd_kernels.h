@@ -6,7 +6,7 @@
 /// CpuOptions::simd is off.
 #include <cstdint>
 
-#include "core/shaderio.h"
+#include "shaderio.h"
 
 namespace tender {
 

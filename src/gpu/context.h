@@ -25,7 +25,7 @@
 
 #include <vulkan/vulkan.h>
 
-#include "gpu/spirv_rules.h"
+#include "spirv_rules.h"
 
 namespace tender::gpu {
 

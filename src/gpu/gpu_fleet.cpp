@@ -346,7 +346,7 @@ void GpuFleet::flush() {
     if (!q) continue;
     SimUniforms u = *q;
     q.reset();
-    if (sizes_.candidates_fit) u.flags |= SIM_FLAG_CANDIDATES; // as the solver keeps them
+    if (keepsCandidateLists(sizes_, candidates_allowed_)) u.flags |= SIM_FLAG_CANDIDATES; // as the solver does
     std::memcpy(inputs + uniforms_at + stride_[SIM_BIND_UNIFORMS] * i, &u, sizeof(u));
     const uint32_t substeps = u.reset_active ? 0u : substepCount(u.substeps);
     if (fits_fused && fusedTickTakes(u, spacing_, fused_max_cell_spacings_)) {

@@ -39,6 +39,8 @@ public:
   GpuFleet(std::unique_ptr<VulkanContext> ctx, uint32_t sheets);
   /// True when the per-colour passes run sheet by sheet (FleetPasses::PerSheet).
   bool passesPerSheet() const { return per_sheet_; }
+  /// Keeps (default) or drops the collision candidate lists, as GpuSolver::setCandidateLists.
+  void setCandidateLists(bool keep) { candidates_allowed_ = keep; }
   ~GpuFleet() override;
   GpuFleet(const GpuFleet&) = delete;
   GpuFleet& operator=(const GpuFleet&) = delete;
@@ -89,9 +91,10 @@ private:
 
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   PipelineSet owned_pipelines_;
-  ComputePipeline tick_batch_; ///< the fused tick of a fleet (null: the device has too little shared memory)
-  SimPipelines passes_;        ///< the per-colour passes of a fleet (SIM_BATCH_PASS)
-  bool per_sheet_ = false;     ///< FleetPasses::PerSheet
+  ComputePipeline tick_batch_;     ///< the fused tick of a fleet (null: the device has too little shared memory)
+  SimPipelines passes_;            ///< the per-colour passes of a fleet (SIM_BATCH_PASS)
+  bool per_sheet_ = false;         ///< FleetPasses::PerSheet
+  bool candidates_allowed_ = true; ///< setCandidateLists
   VkDescriptorSetLayout sheet_set_layout_ = VK_NULL_HANDLE; ///< PerSheet: a sheet's set, as the solver's
   VkPipelineLayout sheet_layout_ = VK_NULL_HANDLE;
   VkDescriptorPool sheet_pool_ = VK_NULL_HANDLE;

@@ -45,9 +45,9 @@ bool fusedTickFits(const SheetTopology& topo);
 /// spacings (< 0: any) when collision is on.
 bool fusedTickTakes(const shaderio::SimUniforms& u, float spacing, float max_cell_spacings);
 
-/// The Solver on Vulkan compute. Per substep: integrate, project (one dispatch per colour), hash
-/// count/scan/scatter/sort, collide, floor, tear mark, and the tear compaction as indirect
-/// dispatches (zero workgroups when nothing tore). Small sheets run every pass of a substep in one
+/// The Solver on Vulkan compute. A substep's passes (docs/ARCHITECTURE.md §3) are recorded by
+/// recordSubstep (substep_passes.h), the tear compaction and the hash passes as indirect dispatches
+/// (zero workgroups when nothing tore or the candidate lists stand in). Small sheets run every pass of a substep in one
 /// workgroup (tick_fused.comp): on a GPU the whole tick in one dispatch, on a CPU device one
 /// dispatch per substep (see FusedShape). The fused tick keeps collision candidate lists with a
 /// skin (SIM_CANDIDATE_* in sim_config.h) and rebuilds the hash only when a particle has travelled too
@@ -88,10 +88,10 @@ public:
   VkBuffer uvBuffer() const { return buf_[SIM_BIND_UV].buffer; }
   /// Live triangles: uvec4 (xyz vertices, w = triangle id); draw with counters' draw_args.
   VkBuffer triangleBuffer() const { return buf_[SIM_BIND_TRIANGLES].buffer; }
-  /// shaderio::Counters; draw_args (offset 32) is a VkDrawIndirectCommand of 3 x live triangles.
+  /// shaderio::Counters; draw_args is a VkDrawIndirectCommand of 3 x live triangles.
   VkBuffer counterBuffer() const { return buf_[SIM_BIND_COUNTERS].buffer; }
   /// Byte offset of draw_args in the counter buffer.
-  static constexpr VkDeviceSize kDrawArgsOffset = 32;
+  static constexpr VkDeviceSize kDrawArgsOffset = offsetof(shaderio::Counters, draw_args);
   /// Reads the spatial hash of the last substep (tests): bucket starts (T + 1) and particles (N).
   void readHash(std::vector<uint32_t>& cell_start, std::vector<uint32_t>& cell_particles);
   /// The buffer of a binding (SIM_BIND_*), for tests and tools.
@@ -107,7 +107,7 @@ public:
   /// their buffer fits the device (one SIM_CANDIDATE_STRIDE record per particle).
   void setCandidateLists(bool keep) { candidates_allowed_ = keep; }
   /// True when ticks keep collision candidate lists.
-  bool usesCandidateLists() const { return candidates_allowed_ && layout_sizes_.candidates_fit; }
+  bool usesCandidateLists() const { return keepsCandidateLists(layout_sizes_, candidates_allowed_); }
   /// True when a tick with these uniforms runs the fused tick: the sheet is small enough and, with
   /// collision on, the hash cell is within the shape's limit.
   bool usesFusedPath(const shaderio::SimUniforms& u) const;

@@ -23,6 +23,10 @@ struct SheetLayout {
   static SheetLayout of(const SheetTopology& topo, VkDeviceSize max_range);
 };
 
+/// True when ticks keep the collision candidate lists: they are allowed (GpuSolver and GpuFleet's
+/// setCandidateLists) and their buffer fits the device. The one rule both engines follow.
+inline bool keepsCandidateLists(const SheetLayout& layout, bool allowed) { return allowed && layout.candidates_fit; }
+
 /// One storage buffer of the sheet.
 struct BindingSpec {
   uint32_t binding = 0;

@@ -4,9 +4,9 @@
 #include <cstring>
 #include <string>
 
-#include "core/shaderio.h"
 #include "gpu/barriers.h"
 #include "gpu/shaders.h"
+#include "shaderio.h"
 
 namespace tender::gpu {
 

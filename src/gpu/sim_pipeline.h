@@ -9,7 +9,7 @@
 
 #include "core/solver.h"
 #include "gpu/context.h"
-#include "gpu/spirv_rules.h"
+#include "spirv_rules.h"
 
 namespace tender::gpu {
 

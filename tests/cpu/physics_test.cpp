@@ -15,13 +15,18 @@ namespace {
 struct CpuReference {
   static constexpr const char* kName = "reference";
   using Fixture = ::testing::Test;
-  static std::unique_ptr<Solver> make(Fixture&) { return std::make_unique<CpuSolver>(CpuOptions{1, 0, true, false}); }
+  static std::unique_ptr<Solver> make(Fixture&) {
+    return std::make_unique<CpuSolver>(
+        CpuOptions{.threads = 1, .min_chunk = 0, .candidate_lists = true, .simd = false});
+  }
 };
 /// SIMD kernels on two threads, every loop split (min_chunk 1).
 struct CpuSimdThreads {
   static constexpr const char* kName = "simd_2threads";
   using Fixture = ::testing::Test;
-  static std::unique_ptr<Solver> make(Fixture&) { return std::make_unique<CpuSolver>(CpuOptions{2, 1, true, true}); }
+  static std::unique_ptr<Solver> make(Fixture&) {
+    return std::make_unique<CpuSolver>(CpuOptions{.threads = 2, .min_chunk = 1, .candidate_lists = true, .simd = true});
+  }
 };
 
 } // namespace

@@ -50,8 +50,8 @@ TEST(CpuThreads, CrumpleTossAndAwkwardSizeAreIdentical) {
 TEST(CpuThreads, TunedChunkingIsIdenticalOnALargerSheet) {
   // Default chunk sizes: the loops of a 96 x 144 sheet are split the way real runs split them.
   const std::string yank = "0 grab particle 13823\n1 move 6 -4 8\n20 release\n";
-  SimState one = run("tender", {"cols=96", "rows=144"}, yank, 24, CpuOptions{1, 0});
-  SimState two = run("tender", {"cols=96", "rows=144"}, yank, 24, CpuOptions{2, 0});
+  SimState one = run("tender", {"cols=96", "rows=144"}, yank, 24, CpuOptions{.threads = 1, .min_chunk = 0});
+  SimState two = run("tender", {"cols=96", "rows=144"}, yank, 24, CpuOptions{.threads = 2, .min_chunk = 0});
   expectIdentical(one, two);
 }
 
@@ -61,7 +61,7 @@ TEST(CpuThreads, FullAdjacencyAndFourThreadsAreIdentical) {
   const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n30 release\n";
   SimState one = run("tender", {"tri_bend=on"}, yank, 50, kOne);
   EXPECT_GT(tornCount(one), 0u);
-  expectIdentical(one, run("tender", {"tri_bend=on"}, yank, 50, CpuOptions{4, 1}));
+  expectIdentical(one, run("tender", {"tri_bend=on"}, yank, 50, CpuOptions{.threads = 4, .min_chunk = 1}));
 }
 
 TEST(CpuThreads, ResetAndNoCollisionAreIdentical) {

@@ -86,6 +86,17 @@ TEST_P(GpuFleetPasses, ThePerColourFleetMatchesTheCpuReference) {
   expectFleetMatchesAlone(batch, alone, sheets, 20);
 }
 
+// Without the candidate lists (the switch the solver and the fleet both honour), every substep with
+// collision builds the hash, in a fleet as alone.
+TEST_P(GpuFleetPasses, WithoutCandidateListsSheetsMatchTheirRunsAlone) {
+  const std::vector<FleetSheet> sheets = mixedFleet(3, 48, 48);
+  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()), GetParam());
+  batch.setCandidateLists(false);
+  gpu::GpuSolver alone(ctx());
+  alone.setCandidateLists(false);
+  expectFleetMatchesAlone(batch, alone, sheets, 12);
+}
+
 TEST_P(GpuFleetPasses, LargeSheetsRecordTheDispatchesOfOneSheetPerPassOrPerSheet) {
   // Five sheets of one size: batched, the passes one of them records alone; sheet by sheet, five
   // times those

@@ -13,7 +13,7 @@
 #include "common/sim_helpers.h"
 #include "cpu/cpu_solver.h"
 #include "gpu/context.h"
-#include "gpu/spirv_rules.h"
+#include "spirv_rules.h"
 
 namespace tender::test {
 

@@ -12,7 +12,7 @@
 #include <unordered_set>
 
 #include "gpu/shaders.h"
-#include "gpu/spirv_rules.h"
+#include "spirv_rules.h"
 
 using namespace tender::gpu;
 

@@ -370,15 +370,11 @@ int DemoApp::run() {
               static_cast<unsigned long long>(sim_->physicsTicks()), sim_->grabCount());
   printCamera();
   // The script clock's steps: `tender sim --script <the recording> --ticks <steps>` ends in this state
-  std::printf("tender-demo: %llu steps, state hash %016llx\n", static_cast<unsigned long long>(sim_->frameCount()),
-              static_cast<unsigned long long>(hashPositions(state.pos)));
+  const std::string steps = std::to_string(sim_->frameCount()), hash = hashHex(hashPositions(state.pos));
+  std::printf("tender-demo: %s steps, state hash %s\n", steps.c_str(), hash.c_str());
   if (!options_.record.empty()) {
-    char end[160];
-    std::snprintf(
-        end, sizeof end, "# %llu steps: tender sim --script <this file> --ticks %llu ends at state hash %016llx\n",
-        static_cast<unsigned long long>(sim_->frameCount()), static_cast<unsigned long long>(sim_->frameCount()),
-        static_cast<unsigned long long>(hashPositions(state.pos)));
-    record_text_ += end;
+    record_text_ += "# " + steps + " steps: tender sim --script <this file> --ticks " + steps + " ends at state hash " +
+                    hash + "\n";
     if (auto err = record_.stage(options_.record, record_text_)) return fail(*err);
     if (auto err = record_.commit()) return fail(*err);
   }

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "core/params.h"
-#include "core/shaderio.h"
 #include "core/solver.h"
+#include "shaderio.h"
 
 struct ImFont;
 

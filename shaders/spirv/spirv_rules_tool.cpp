@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "gpu/spirv_rules.h"
+#include "spirv_rules.h"
 
 int main(int argc, char** argv) {
   const bool embed = argc == 4 && std::strcmp(argv[1], "--embed") == 0;

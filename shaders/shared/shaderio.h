@@ -1,5 +1,6 @@
 #pragma once
-/// C++ view of the GPU structs and per-constraint maths in shaders/shared/.
+/// C++ view of the GPU structs and per-element maths of the headers beside this one (C++ only:
+/// GLSL includes those headers directly).
 /// The same headers compile as GLSL; `using namespace glm` makes vec4, dot, length mean the same here.
 #include <cmath>
 #include <cstddef>

@@ -1,4 +1,4 @@
-#include "gpu/spirv_rules.h"
+#include "spirv_rules.h"
 
 #include <algorithm>
 #include <unordered_set>
