@@ -2,7 +2,8 @@
 # The demo's mouse and camera under Xvfb: a click on a HUD button never also grabs the sheet, even
 # when the cursor reaches the button in the same event batch as the click; and the camera follow
 # keeps a tossed crumple sheet in view (on by default there), while with it off (F) the camera
-# stays where it was. Exits 77 (skipped) without Xvfb or xdotool.
+# stays where it was; the HUD's parameter edits are recorded as set events and replay bitwise. Exits
+# 77 (skipped) without Xvfb or xdotool.
 set -u
 source "$(dirname "$0")/demo_lib.sh"
 
@@ -35,6 +36,39 @@ grabs=$(grep -c ' grab ray' "$tmp/clicks.txt")
 [ "$grabs" -eq 1 ] || fail "$grabs grabs: the HUD clicks grabbed the sheet (or the click on the sheet did not): $(cat "$tmp/clicks.txt")"
 grep -q " 1 grabs" "$tmp/demo.log" || fail "the demo counted other than one grab"
 echo "ok: three HUD clicks, no grab; one click on the sheet, one grab"
+
+# Parameter edits in the HUD are recorded as set events and replay bitwise: collision off and
+# damping typed in (live), then a grid of 24 columns (rebuilt). The panel opens from its title at
+# (473, 57); its rows sit 25 pixels apart from the preset's at y = 86.
+start_demo --backend cpu --ui-scale 1 --width 800 --height 600 --record "$tmp/hud.txt"
+sleep 3
+alive "start-up before the HUD edits"
+xdotool mousemove --sync 473 57 click 1
+sleep 0.5
+xdotool mousemove --sync 478 236 click 1 # collision
+sleep 0.3
+xdotool mousemove --sync 570 161 keydown ctrl click 1 keyup ctrl # damping: type a value
+sleep 0.3
+xdotool key ctrl+a type --delay 50 "0.97"
+xdotool key Return
+sleep 0.3
+xdotool mousemove --sync 518 261 click 1 # cols
+sleep 0.2
+xdotool key ctrl+a type --delay 50 "24"
+xdotool key Return
+sleep 0.3
+xdotool mousemove --sync 516 286 click 1 # Rebuild sheet
+sleep 1.5
+alive "HUD edits"
+stop_demo
+for line in "set collision off" "set damping 0.97" "set cols 24" "set rows 48"; do
+  grep -q " $line$" "$tmp/hud.txt" || fail "the recording has no '$line': $(cat "$tmp/hud.txt")"
+done
+steps=$(sed -n 's/^tender-demo: \([0-9]*\) steps, state hash \([0-9a-f]*\)$/\1/p' "$tmp/demo.log")
+hash=$(sed -n 's/^tender-demo: \([0-9]*\) steps, state hash \([0-9a-f]*\)$/\2/p' "$tmp/demo.log")
+"$(dirname "$DEMO")/tender" sim --backend cpu --script "$tmp/hud.txt" --ticks "${steps:-0}" | grep -q "state hash $hash$" ||
+  fail "the recording of the HUD edits does not replay to the demo's state $hash"
+echo "ok: HUD edits recorded as set events replay to the demo's state ($steps steps)"
 
 # A toss to the left, from tick 120: far out of the crumple start view (target 0, -1.8, 0).
 toss="$tmp/toss.txt"
