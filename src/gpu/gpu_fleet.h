@@ -20,6 +20,9 @@
 
 namespace tender::gpu {
 
+/// `v` rounded up to a multiple of `a`.
+inline VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
+
 /// How a fleet runs the per-colour passes of the sheets the fused tick does not take. Both give
 /// every sheet the bits of its run alone.
 enum class FleetPasses : uint8_t {
