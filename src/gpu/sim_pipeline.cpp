@@ -112,37 +112,24 @@ ComputePipeline makeComputePipeline(VulkanContext& ctx, std::string_view key, Vk
 SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
                                bool batched, PipelineSet& owned) {
   using namespace shaderio;
-  // Every pass: its shader, push constants and elements per invocation.
+  // Every kernel of the registry (sim_kernels.h): its shader, push constants, elements per
+  // invocation, and whether a fleet runs it batched.
   struct PipelineSpec {
     ComputePipeline SimPipelines::*member;
     const char* key;
     uint32_t push_size, per_invocation;
+    bool batched;
   };
-  constexpr uint32_t kSim = sizeof(SimPush), kScan = sizeof(ScanPush);
+  constexpr uint32_t kSIM = sizeof(SimPush), kSCAN = sizeof(ScanPush), kNONE = 0;
   static constexpr PipelineSpec kPasses[] = {
-      {&SimPipelines::air, "air.comp", kSim, 1},
-      {&SimPipelines::integrate, "integrate.comp", kSim, 1},
-      {&SimPipelines::project, "project.comp", kSim, 1},
-      {&SimPipelines::candidates_check, "candidates_check.comp", kSim, 1},
-      {&SimPipelines::candidates_decide, "candidates_decide.comp", kSim, 1},
-      {&SimPipelines::hash_count, "hash_count.comp", kSim, 1},
-      {&SimPipelines::scan, "scan.comp", kScan, SIM_SCAN_PER_THREAD},
-      {&SimPipelines::scan_add, "scan_add.comp", kScan, 1},
-      {&SimPipelines::hash_scatter, "hash_scatter.comp", kSim, 1},
-      {&SimPipelines::hash_sort, "hash_sort.comp", kSim, 1},
-      {&SimPipelines::collide, "collide.comp", kSim, 1},
-      {&SimPipelines::candidates_finish, "candidates_finish.comp", kSim, 1},
-      {&SimPipelines::floor, "floor.comp", kSim, 1},
-      {&SimPipelines::tear_mark, "tear_mark.comp", kSim, 1},
-      {&SimPipelines::tear_unsupported, "tear_unsupported.comp", 0, 1},
-      {&SimPipelines::tear_flags, "tear_flags.comp", 0, 1},
-      {&SimPipelines::tear_compact, "tear_compact.comp", 0, 1},
-      {&SimPipelines::normals, "normals.comp", kSim, 1},
-      {&SimPipelines::reset, "reset.comp", kSim, 1},
+#define SIM_KERNEL_SPEC(name, push, per_invocation, batched)                                                           \
+  {&SimPipelines::name, #name ".comp", k##push, per_invocation, batched != 0},
+      SIM_KERNELS(SIM_KERNEL_SPEC)
+#undef SIM_KERNEL_SPEC
   };
   SimPipelines pipes;
   for (const PipelineSpec& spec : kPasses) {
-    if (batched && spec.member == &SimPipelines::normals) continue;
+    if (batched && !spec.batched) continue;
     const std::string key = batched ? std::string(spec.key) + ".batch" : std::string(spec.key);
     pipes.*spec.member =
         makeComputePipeline(ctx, key, layout, rules, math, batched ? uint32_t(sizeof(BatchPassPush)) : spec.push_size,

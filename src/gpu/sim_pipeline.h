@@ -9,6 +9,7 @@
 
 #include "core/solver.h"
 #include "gpu/context.h"
+#include "sim_kernels.h"
 #include "spirv_rules.h"
 
 namespace tender::gpu {
@@ -41,11 +42,12 @@ struct ComputePipeline {
   uint32_t workgroup = 0; ///< elements one workgroup covers: local_size_x (from the SPIR-V) x elements per invocation
 };
 
-/// Every pipeline of the simulation (one file per shader in shaders/sim/).
+/// Every pipeline of the simulation (one file per shader in shaders/sim/): a member per kernel of
+/// the registry (SIM_KERNELS, sim_kernels.h), the fused tick and the picks.
 struct SimPipelines {
-  ComputePipeline air, integrate, project, candidates_check, candidates_decide, hash_count, scan, scan_add,
-      hash_scatter, hash_sort, collide, candidates_finish, floor, tear_mark, tear_unsupported, tear_flags, tear_compact,
-      normals, reset;
+#define SIM_KERNEL_MEMBER(name, push, per_invocation, batched) ComputePipeline name;
+  SIM_KERNELS(SIM_KERNEL_MEMBER)
+#undef SIM_KERNEL_MEMBER
   ComputePipeline tick_fused; ///< null when the device has under 32 KiB of shared memory
   std::array<ComputePipeline, 3> pick;
 };
