@@ -129,6 +129,7 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
       frames.push_back(std::move(f));
     } else {
       std::string err;
+      scene.uv = sim.topology().uv; // the sheet as it is now (a script's set may have rebuilt it)
       auto bytes = encodeGltf(scene, {f}, true, err);
       if (!bytes) return err;
       if (auto e = outputs.stage(plan.frames[next_frame], *bytes)) return e;
@@ -185,6 +186,7 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
     if (auto err = outputs.stage(o.out, [&](std::FILE* f) { return writePly(f, state); })) return fail(*err);
   if (plan.kind == MeshPlan::Gltf || plan.kind == MeshPlan::Animation) {
     if (plan.kind == MeshPlan::Gltf) frames = {meshFrame(state, 0.0)};
+    scene.uv = sim.topology().uv;
     auto bytes = encodeGltf(scene, frames, plan.binary, error);
     if (!bytes) return fail(error);
     if (auto err = outputs.stage(o.out, *bytes)) return fail(*err);

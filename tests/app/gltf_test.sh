@@ -152,6 +152,26 @@ for name in ("anim.glb", "anim.gltf"):
 print("read back:", len(seq[3][3]) // 3, "triangles at the end,", stats["torn"], "constraints torn")
 PY
 
+# A script's set event that rebuilds the sheet with another grid: the end state's texture
+# coordinates are those of the new sheet (the right column at u = 1, the bottom row at v = 1).
+printf '5 set cols 9\n5 set rows 7\n' >"$tmp/regrid.txt"
+"$T" sim --backend cpu --set cols=16 --set rows=24 --ticks 10 --script "$tmp/regrid.txt" --out "$tmp/regrid.glb" \
+  >/dev/null || fail "a regridded run's glTF"
+python3 - "$tmp/regrid.glb" <<'PY' && ok "a rebuilt sheet's glTF has its own texture coordinates" || fail "regrid UVs"
+import json, struct, sys
+data = open(sys.argv[1], "rb").read()
+jlen = struct.unpack_from("<I", data, 12)[0]
+doc = json.loads(data[20:20 + jlen])
+binary = data[20 + jlen + 8:]
+a = doc["accessors"][doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"]]
+v = doc["bufferViews"][a["bufferView"]]
+start = v.get("byteOffset", 0) + a.get("byteOffset", 0)
+uv = struct.unpack_from("<%df" % (2 * a["count"]), binary, start)
+assert a["count"] == 63, a["count"]
+us, vs = uv[0::2], uv[1::2]
+assert (min(us), max(us), min(vs), max(vs)) == (0.0, 1.0, 0.0, 1.0), (min(us), max(us), min(vs), max(vs))
+PY
+
 # Taking frames leaves the run as it is; the GPU backend (where there is a Vulkan device) writes
 # the CPU's bytes.
 "$T" "${run[@]}" | grep -o 'state hash [0-9a-f]*' >"$tmp/hash_plain"
