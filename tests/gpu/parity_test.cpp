@@ -404,9 +404,12 @@ void Parity::checkCandidateLists(const SimParams& p, bool fused, bool expect_ent
   const SheetTopology& topo = sim.topology();
   const uint32_t n = topo.particleCount();
   const shaderio::SimUniforms u = sim.makeUniforms();
+  // The search radius and the membership test as the shaders compute them (exact division, no
+  // contraction): every pair is in the lists or not by the same bits, with no band for rounding.
   const float r = u.collision_radius;
-  const float skin = std::min(SIM_CANDIDATE_SKIN * r, 0.99f * (1.0f / u.inv_cell - r));
-  const float search2 = (r + skin) * (r + skin);
+  const float search = r + shaderio::candidateSkin(r, u.inv_cell), search2 = search * search;
+  uint32_t search_bits;
+  std::memcpy(&search_bits, &search, 4);
   int whole_ticks_on_lists = 0, checked = 0;
   size_t entries = 0;
   const int ticks = 90;
@@ -417,6 +420,7 @@ void Parity::checkCandidateLists(const SimParams& p, bool fused, bool expect_ent
     if (state.x == 1u && state.y >= p.substeps) ++whole_ticks_on_lists;
     if (state.x != 1u || t % 15 != 0) continue;
     ++checked;
+    EXPECT_EQ(state.w, search_bits) << "the lists were built with another search radius";
     std::vector<uint32_t> lists(size_t(SIM_CANDIDATE_STRIDE) * n);
     std::vector<glm::vec4> base(n);
     gpu.context().download(gpu.buffer(SIM_BIND_CANDIDATES), lists.data(), 4ull * lists.size());
@@ -434,10 +438,10 @@ void Parity::checkCandidateLists(const SimParams& p, bool fused, bool expect_ent
           continue;
         }
         const glm::vec3 d = glm::vec3(base[i]) - glm::vec3(base[j]);
-        const float d2 = glm::dot(d, d);
-        // Pairs a rounding away from radius + skin may go either way
-        if (d2 < search2 * (1.0f - 1e-5f)) bad += got.count(j) ? 0 : 1;
-        if (d2 >= search2 * (1.0f + 1e-5f)) bad += got.count(j);
+        if (shaderio::dot3(d, d) < search2)
+          bad += got.count(j) ? 0 : 1;
+        else
+          bad += got.count(j);
       }
     }
     EXPECT_EQ(bad, 0u) << "tick " << t;
