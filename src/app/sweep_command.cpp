@@ -153,7 +153,7 @@ int runSweep(const CommonOptions& common, const SweepOptions& o) {
   // Every sheet, and the script against it, is checked before anything runs. A fleet's sheets keep
   // their layout: the script's set events may change only keys that do not rebuild the sheet.
   std::string error;
-  auto script = common.script.empty() ? InputScript{} : loadScriptFor(common.script, common.params, error, true);
+  auto script = common.script.empty() ? InputScript{} : loadScript(common.script, error);
   if (!script) return fail(error);
   for (uint64_t index : indices) {
     SweepSheet sheet;

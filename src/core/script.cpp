@@ -149,8 +149,20 @@ std::optional<InputScript> loadScriptFor(const std::string& path, const SimParam
   return s;
 }
 
-std::optional<std::string> applySettings(SimParams& params,
-                                         const std::vector<std::pair<std::string, std::string>>& settings) {
+bool rebuildsSheet(const Settings& settings) {
+  for (const auto& kv : settings)
+    if (rebuildsSheet(kv.first)) return true;
+  return false;
+}
+
+size_t takeSettings(const std::vector<ScriptEvent>& events, size_t i, Settings& out) {
+  const uint64_t tick = events[i].tick;
+  for (; i < events.size() && events[i].kind == EventKind::Set && events[i].tick == tick; ++i)
+    out.emplace_back(events[i].key, events[i].value);
+  return i;
+}
+
+std::optional<std::string> applySettings(SimParams& params, const Settings& settings) {
   SimParams p = params;
   for (const auto& [key, value] : settings) {
     if (key == "preset") {
@@ -178,14 +190,12 @@ std::optional<std::string> checkScript(const InputScript& script, const SimParam
       ++i;
       continue;
     }
-    std::vector<std::pair<std::string, std::string>> settings; // this tick's set events in a row
-    for (; i < events.size() && events[i].kind == EventKind::Set && events[i].tick == e.tick; ++i) {
-      if (fixed_layout && rebuildsSheet(events[i].key))
-        return at + "set " + events[i].key +
-               ": the sheets of a fleet keep their layout (set only keys that do "
-               "not rebuild the sheet)";
-      settings.emplace_back(events[i].key, events[i].value);
-    }
+    Settings settings; // this tick's set events in a row
+    i = takeSettings(events, i, settings);
+    for (const auto& [key, value] : settings)
+      if (fixed_layout && rebuildsSheet(key))
+        return at + "set " + key +
+               ": the sheets of a fleet keep their layout (set only keys that do not rebuild the sheet)";
     if (auto err = applySettings(p, settings)) return at + "set: " + *err;
   }
   return std::nullopt;

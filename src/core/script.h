@@ -67,10 +67,16 @@ std::optional<std::string> checkScript(const InputScript& script, const SimParam
 /// with a script it is given); errors name the file.
 std::optional<InputScript> loadScriptFor(const std::string& path, const SimParams& params, std::string& error,
                                          bool fixed_layout = false);
-/// The parameters `params` become with the `set` assignments of one step applied in order;
-/// returns the first bad key or value, or the rule the result breaks (checkRules).
-std::optional<std::string> applySettings(SimParams& params,
-                                         const std::vector<std::pair<std::string, std::string>>& settings);
+/// `set` assignments applied together: key (or "preset") and value, in order.
+using Settings = std::vector<std::pair<std::string, std::string>>;
+/// The parameters `params` become with the assignments of one step applied in order; returns the
+/// first bad key or value, or the rule the result breaks (checkRules).
+std::optional<std::string> applySettings(SimParams& params, const Settings& settings);
+/// True when one of the assignments rebuilds the sheet (rebuildsSheet).
+bool rebuildsSheet(const Settings& settings);
+/// The set events of one tick in a row from `events[i]` (a set event): appends them to `out` and
+/// returns the index after them.
+size_t takeSettings(const std::vector<ScriptEvent>& events, size_t i, Settings& out);
 /// Formats one event as a script line.
 std::string formatEvent(const ScriptEvent& e);
 

@@ -75,10 +75,10 @@ void Simulation::rebuild(const SimParams& p) {
   accumulator_ = 0.0;
 }
 
-std::optional<std::string> Simulation::set(const std::vector<std::pair<std::string, std::string>>& settings) {
+std::optional<std::string> Simulation::set(const Settings& settings) {
   SimParams p = params_;
   if (auto err = applySettings(p, settings)) return err;
-  if (std::any_of(settings.begin(), settings.end(), [](const auto& kv) { return rebuildsSheet(kv.first); }))
+  if (rebuildsSheet(settings))
     rebuild(p);
   else
     setLiveParams(p);
@@ -255,11 +255,8 @@ void Simulation::applyDueEvents() {
       continue;
     }
     // The set events of one tick in a row apply together, as checkScript checked them.
-    std::vector<std::pair<std::string, std::string>> settings;
-    for (; next_event_ < events.size() && events[next_event_].kind == EventKind::Set &&
-           events[next_event_].tick == e.tick;
-         ++next_event_)
-      settings.emplace_back(events[next_event_].key, events[next_event_].value);
+    Settings settings;
+    next_event_ = takeSettings(events, next_event_, settings);
     set(settings);
   }
 }

@@ -36,7 +36,7 @@ public:
   /// when one of the keys rebuilds the sheet (rebuildsSheet), the sheet is rebuilt at rest, else the
   /// running sheet takes the new values. Returns the error, changing nothing, when a key or value
   /// is bad or the result breaks checkRules().
-  std::optional<std::string> set(const std::vector<std::pair<std::string, std::string>>& settings);
+  std::optional<std::string> set(const Settings& settings);
 
   /// Attaches a script; its events apply as ticks reach them.
   void setScript(InputScript script);

@@ -216,7 +216,7 @@ float DemoApp::aspect() const {
 void DemoApp::applyParams(const SimParams& p, bool rebuild, bool new_receipt) {
   // The keys that differ from the sheet's (the solver's stay as they are), and with `rebuild` the
   // grid's, which rebuild the sheet at rest: one step's set events, applied together and recorded.
-  std::vector<std::pair<std::string, std::string>> settings;
+  Settings settings;
   if (p.preset != sim_->params().preset) settings.emplace_back("preset", p.preset);
   const auto now = paramValues(sim_->params()), next = paramValues(p);
   for (size_t k = 0; k < next.size(); ++k) {
@@ -225,8 +225,7 @@ void DemoApp::applyParams(const SimParams& p, bool rebuild, bool new_receipt) {
     if (next[k].second != now[k].second || (rebuild && (key == "cols" || key == "rows"))) settings.push_back(next[k]);
   }
   if (settings.empty()) return;
-  const bool rebuilds =
-      std::any_of(settings.begin(), settings.end(), [](const auto& kv) { return rebuildsSheet(kv.first); });
+  const bool rebuilds = rebuildsSheet(settings);
   if (rebuilds) {
     ctx_->waitIdle();
     input_.grabbing = false;
