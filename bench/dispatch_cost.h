@@ -2,7 +2,7 @@
 /// What one compute dispatch costs on a device, apart from any work: a chain of empty dispatches,
 /// each followed by the compute-to-compute pipeline barrier the solver puts between its passes,
 /// timed with timestamp queries. A per-colour tick is hundreds of such dispatches, the fused
-/// small-sheet tick a few, so this cost says how much the fused path saves on a device.
+/// small-sheet tick a few, so this cost says how much the fused tick saves on a device.
 #include <cstdint>
 #include <optional>
 #include <string>

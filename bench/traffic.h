@@ -19,7 +19,7 @@ namespace tender::bench {
 /// The data layout whose traffic is counted.
 enum class Layout {
   Cpu,      ///< CpuSolver: split constraint arrays, SoA positions in hash order
-  Gpu,      ///< GpuSolver, one dispatch per colour
+  Gpu,      ///< GpuSolver, the per-colour passes
   GpuFused, ///< GpuSolver, integration and projection in one workgroup (positions in shared memory)
 };
 

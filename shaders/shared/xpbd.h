@@ -3,6 +3,7 @@
 #ifndef SIM_XPBD_H
 #define SIM_XPBD_H
 #include "exact_math.h"
+#include "sim_passes.h"
 #include "sim_types.h"
 
 /// Position and previous position of one particle.
@@ -19,13 +20,6 @@ struct PairDelta {
 
 /// Substeps a tick runs: as many as asked, at most SIM_MAX_SUBSTEPS (the per-substep inputs).
 SIM_INLINE uint substepCount(uint substeps) { return min(substeps, uint(SIM_MAX_SUBSTEPS)); }
-
-/// Passes one substep runs, in this order: integrate; project, one pass per colour of each
-/// iteration; collide (with collision on); floor; tear (marking and compaction). A tick numbers
-/// its passes substep x this + the pass within the substep (`tender diff`, a tick cut short).
-SIM_INLINE uint passesPerSubstep(uint iterations, uint colors, bool collision) {
-  return 3u + iterations * colors + (collision ? 1u : 0u);
-}
 
 /// True when constraints may tear: a tear factor of 0 (or less) disables tearing.
 SIM_INLINE bool tearingOn(float tear_factor) { return tear_factor > 0.0f; }

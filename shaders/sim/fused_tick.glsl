@@ -1,7 +1,7 @@
 // The fused tick of small sheets (tick_fused.comp: one sheet; tick_batch.comp: one sheet of a
 // fleet per workgroup, SIM_BATCH). Small sheets: substeps p.first_substep .. + p.substeps of a tick (on a GPU the whole
 // tick, on a CPU device one substep) in one dispatch of one workgroup. Positions stay in shared memory from the first
-// substep to the last; a workgroup barrier replaces each dispatch and pipeline barrier of the separate passes. Every
+// substep to the last; a workgroup barrier replaces each dispatch and pipeline barrier of the per-colour passes. Every
 // substep runs the same per-particle and per-constraint maths, in the same order, as integrate, project, hash_*,
 // collide, floor and tear_*; the hash is built in the same buffers. Each invocation owns the particles lid, lid +
 // kInvocations, ... (integration, collision and floor of a particle run on one invocation, so the collision delta stays
@@ -28,8 +28,8 @@ void sync() {
   barrier();
 }
 
-// Diagnosis (`tender diff`): the tick stops after pass p.stop of the tick (passesPerSubstep's
-// numbering; SIM_NONE: it runs whole). Every invocation takes the same branch, after a barrier.
+// Diagnosis (`tender diff`): the tick stops after pass p.stop of the tick (the numbering of
+// SIM_STAGES, sim_passes.h; SIM_NONE: it runs whole). Every invocation takes the same branch, after a barrier.
 bool stopsAfter(uint pass) { return pass == p.stop; }
 
 // The positions go back to their buffer (at the end of the dispatch, or where the tick stops).
@@ -91,8 +91,13 @@ void main() {
   float dt2 = u.dt * u.dt;
   for (uint i = lid; i < n; i += kInvocations) s_pos[i] = pos[i];
   uint end = min(p.first_substep + p.substeps, substepCount(u.substeps));
+  // The number within a substep of each stage's first pass (SIM_STAGES)
   uint per_substep = passesPerSubstep(u.iterations, u.color_count, collision);
-  uint projects = u.iterations * u.color_count;
+  uint integrate_pass = stageFirstPass(SIM_STAGE_integrate, u.iterations, u.color_count, collision);
+  uint project_pass = stageFirstPass(SIM_STAGE_project, u.iterations, u.color_count, collision);
+  uint collide_pass = stageFirstPass(SIM_STAGE_collide, u.iterations, u.color_count, collision);
+  uint floor_pass = stageFirstPass(SIM_STAGE_floor, u.iterations, u.color_count, collision);
+  uint tear_pass = stageFirstPass(SIM_STAGE_tear, u.iterations, u.color_count, collision);
   for (uint s = p.first_substep; s < end; ++s) {
     uint first_pass = s * per_substep;
     // 1. The air (as air.comp), then Verlet integration (as integrate.comp)
@@ -109,7 +114,7 @@ void main() {
       prev[i] = st.previous;
     }
     sync();
-    if (stopsAfter(first_pass)) {
+    if (stopsAfter(first_pass + integrate_pass)) {
       storePositions(n);
       return;
     }
@@ -120,15 +125,9 @@ void main() {
     for (uint it = 0u; it < u.iterations; ++it)
       for (uint c = 0u; c < u.color_count; ++c) {
         uvec2 range = color_range[c];
-        for (uint t = lid; t < range.y; t += kInvocations) {
-          Constraint k = constraints[range.x + t];
-          vec4 pa = s_pos[k.a], pb = s_pos[k.b];
-          PairDelta d = solveDistance(pa, pb, k.rest, u.stiffness[k.kind_id & SIM_KIND_MASK]);
-          s_pos[k.a] = pa + vec4(d.da, 0.0f);
-          s_pos[k.b] = pb + vec4(d.db, 0.0f);
-        }
+        for (uint t = lid; t < range.y; t += kInvocations) projectConstraint(constraints[range.x + t]);
         sync();
-        if (stopsAfter(first_pass + 1u + it * u.color_count + c)) {
+        if (stopsAfter(first_pass + project_pass + it * u.color_count + c)) {
           storePositions(n);
           return;
         }
@@ -169,8 +168,7 @@ void main() {
     // 4. Each particle takes its repulsion (from the lists, or gathered here from the hash's
     // bucket-ordered copy of the positions) and meets the floor (as floor.comp). A tick that
     // stops after the collision keeps the repulsion in delta (as collide.comp) instead.
-    uint collide_pass = first_pass + 1u + projects;
-    bool stop_collide = collision && stopsAfter(collide_pass);
+    bool stop_collide = collision && stopsAfter(first_pass + collide_pass);
     for (uint i = lid; i < n; i += kInvocations) {
       vec4 q = s_pos[i];
       vec3 repel = vec3(0.0f);
@@ -186,8 +184,7 @@ void main() {
       prev[i] = st.previous;
     }
     sync();
-    uint floor_pass = collide_pass + (collision ? 1u : 0u);
-    if (stop_collide || stopsAfter(floor_pass)) {
+    if (stop_collide || stopsAfter(first_pass + floor_pass)) {
       storePositions(n);
       return;
     }
@@ -198,7 +195,7 @@ void main() {
     // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
     // substep it tore in removed it), and kinds that cannot tear skip the position loads.
     if (!tearing) {
-      if (stopsAfter(floor_pass + 1u)) {
+      if (stopsAfter(first_pass + tear_pass)) {
         storePositions(n);
         return;
       }
@@ -226,7 +223,7 @@ void main() {
       for (uint k = lid; k < slots; k += kInvocations) tearCompact(k);
       sync();
     }
-    if (stopsAfter(floor_pass + 1u)) {
+    if (stopsAfter(first_pass + tear_pass)) {
       storePositions(n);
       return;
     }

@@ -16,11 +16,11 @@ void main() {
   float radius = p.origin_radius.w;
   if (!(r.x <= radius * radius)) return;
   if (kStep == 0u) {
-    atomicMin(pick_d2, floatBitsToUint(r.x));
+    atomicMin(pick.d2, floatBitsToUint(r.x));
   } else if (kStep == 1u) {
-    if (floatBitsToUint(r.x) == pick_d2) atomicMin(pick_index, i);
-  } else if (i == pick_index) {
-    pick_t = r.y;
-    pick_pos = pos[i];
+    if (floatBitsToUint(r.x) == pick.d2) atomicMin(pick.index, i);
+  } else if (i == pick.index) {
+    pick.t = r.y;
+    pick.pos = pos[i];
   }
 }

@@ -162,13 +162,7 @@ layout(std430, set = 0, binding = SIM_BIND_TRIANGLES) SIM_COHERENT buffer Triang
 layout(std430, set = 0, binding = SIM_BIND_TRI_EDGES) readonly buffer TriEdgeBuffer { uvec2 tri_edges[]; };
 layout(std430, set = 0, binding = SIM_BIND_COUNTERS) SIM_COHERENT buffer CounterBuffer { Counters counters; };
 layout(std430, set = 0, binding = SIM_BIND_SCRATCH) SIM_COHERENT buffer ScratchBuffer { uint scratch[]; };
-layout(std430, set = 0, binding = SIM_BIND_PICK) SIM_COHERENT buffer PickBuffer {
-  uint pick_index;
-  float pick_t;
-  uint pick_d2;
-  uint pick_pad;
-  vec4 pick_pos;
-};
+layout(std430, set = 0, binding = SIM_BIND_PICK) SIM_COHERENT buffer PickBuffer { PickResult pick; };
 layout(std430, set = 0, binding = SIM_BIND_RESET_FROM) SIM_COHERENT buffer ResetFromBuffer { vec4 reset_from[]; };
 layout(std430, set = 0, binding = SIM_BIND_CELL_SCATTER) SIM_COHERENT buffer CellScatterBuffer { uint cell_scatter[]; };
 layout(std430, set = 0, binding = SIM_BIND_COMPACT_TMP) SIM_COHERENT buffer CompactTmpBuffer { uvec4 compact_tmp[]; };
@@ -220,7 +214,7 @@ uvec4 candidatesNextStateOf(uvec4 state, uint mode, bool overflow) {
   return candidatesNextState(state, mode, overflow, candidateSearchNow());
 }
 
-// The mode of this substep in the separate passes (candidates_check has run).
+// The mode of this substep in the per-colour passes (candidates_check has run).
 uint collideModeNow() { return collideModeOf(counters.candidate_state, counters.candidate_flags.x != 0u); }
 
 // Slots the tear compaction covers: constraints, triangles, and one end slot for the totals.

@@ -8,6 +8,8 @@
 #ifndef SIM_POSITION
 #define SIM_POSITION(j) pos[j]
 #endif
+// The bodies the CPU reference runs too
+#include "sim_bodies.h"
 
 // Spatial hash, step 1: the bucket of particle i (at p) and one more particle in that bucket.
 void hashCount(uint i, vec3 p) {
@@ -196,50 +198,6 @@ vec3 gatherParticle(uint i, vec3 pi, uint mode, out bool fits) {
   if (mode != SIM_COLLIDE_BUILD) return gatherRepulsion(i, pi, u.collision_radius, SIM_NONE, fits);
   candidate_base[i] = vec4(pi, 0.0f);
   return gatherRepulsion(i, pi, candidateSearchNow(), i * SIM_CANDIDATE_STRIDE, fits);
-}
-
-// Marks constraint c (ends at pa, pb; not torn yet) when stretched beyond the tear threshold and
-// counts it once; true for the first mark of the substep.
-bool markTear(Constraint c, vec4 pa, vec4 pb) {
-  if (!shouldTear(pa, pb, c.rest, c.kind_id & SIM_KIND_MASK, u.tear_factor, u.tear_kinds)) return false;
-  if (atomicExchange(torn[c.kind_id >> SIM_KIND_BITS], 1u) != 0u) return false; // a copy marked it first
-  atomicAdd(counters.torn_total, 1u);
-  return atomicAdd(counters.torn_new, 1u) == 0u;
-}
-
-// True when triangle t (original id) has lost an edge.
-bool triangleGone(uint t) {
-  uvec2 e = tri_edges[t];
-  return torn[e.x] != 0u || torn[e.y] != 0u;
-}
-
-// The air on particle i (SIM_FLAG_AIR): meanAir of airOnTriangle over its live triangles, each
-// at the positions (SIM_POSITION) and previous positions of the start of the substep.
-vec3 airOnParticle(uint i) {
-  vec3 sum = vec3(0.0f);
-  uint count = 0u;
-  for (uint k = 0u; k < 6u; ++k) {
-    uint t = particleTriangle(i, k, u.cols, u.rows);
-    if (t == SIM_NONE || triangleGone(t)) continue;
-    uvec3 c = gridTriangle(t, u.cols);
-    sum += airOnTriangle(vec3(SIM_POSITION(c.x)), vec3(SIM_POSITION(c.y)), vec3(SIM_POSITION(c.z)), vec3(prev[c.x]),
-                         vec3(prev[c.y]), vec3(prev[c.z]), u.air);
-    ++count;
-  }
-  return meanAir(sum, count);
-}
-
-// After the tear marks of a substep (and only when something tore): marks a shear or tri-bend
-// constraint that has lost its triangles (unsupported in xpbd.h). It reads the flags of structural
-// constraints only, which no longer change in this substep.
-void markUnsupported(Constraint c) {
-  uint kind = c.kind_id & SIM_KIND_MASK, id = c.kind_id >> SIM_KIND_BITS;
-  if ((kind != SIM_KIND_SHEAR && kind != SIM_KIND_TRIBEND) || torn[id] != 0u) return;
-  uvec2 t = supportTriangles(c.a, c.b, kind, u.cols);
-  if (!unsupported(kind, triangleGone(t.x), triangleGone(t.y))) return;
-  if (atomicExchange(torn[id], 1u) != 0u) return; // a copy marked it first
-  atomicAdd(counters.torn_total, 1u);
-  atomicAdd(counters.torn_new, 1u);
 }
 
 // Tear compaction, step 1: the keep flag of compaction slot k (a constraint slot or a triangle)

@@ -17,8 +17,7 @@ void main() {
   if (torn[c.kind_id >> SIM_KIND_BITS] != 0u) return;
   if (markTear(c, pos[c.a], pos[c.b])) {
     uint groups = (compactSlots() + SIM_WG_TEAR - 1u) / SIM_WG_TEAR;
-    uint gx = min(groups, SIM_MAX_GROUPS_X);
-    counters.compact_dispatch = uvec4(gx, (groups + gx - 1u) / gx, 1u, 0u);
+    counters.compact_dispatch = uvec4(groupGrid(groups), 1u, 0u);
 #ifdef SIM_BATCH_PASS
     // A fleet: the batch's compaction of this substep runs
     batchArmArgs(SIM_BATCH_ARGS_LIVE_COMPACT + p.substep, SIM_BATCH_ARGS_FULL_COMPACT);

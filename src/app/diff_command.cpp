@@ -203,7 +203,7 @@ public:
     while (hi - lo > 1) {
       const int64_t mid = lo + (hi - lo) / 2;
       replay(t, uint32_t(mid));
-      if (auto d = check(passAt(u, uint32_t(mid)).kind == PassKind::Collide)) {
+      if (auto d = check(passAt(u, uint32_t(mid)).kind == PassKind::collide)) {
         hi = mid;
         where = *d;
       } else {

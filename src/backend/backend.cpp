@@ -6,7 +6,7 @@
 #include "cpu/cpu_batch.h"
 #include "cpu/cpu_solver.h"
 #ifdef TENDER_HAS_GPU
-#include "gpu/gpu_fleet.h"
+#include "gpu/gpu_batch.h"
 #include "gpu/gpu_solver.h"
 #endif
 
@@ -106,7 +106,7 @@ BatchFit batchFit(const SimParams& p, const std::string& backend, int device) {
   uint64_t memory = availableMemoryBytes();
   if (kind == "gpu")
     if (const uint64_t device_bytes = gpuMemoryBytes(device)) memory = std::min(memory, device_bytes);
-  f.budget = memory / 10 * 9;
+  f.budget = memoryBudget(memory);
   f.fit = f.budget / f.per_sheet;
   return f;
 }
@@ -136,11 +136,11 @@ std::optional<std::string> createBatch(const BackendOptions& o, uint32_t sheets,
   try {
     std::unique_ptr<gpu::VulkanContext> ctx;
     if (o.context) {
-      out = std::make_unique<gpu::GpuFleet>(*o.context, sheets);
+      out = std::make_unique<gpu::GpuBatch>(*o.context, sheets);
     } else if (auto err = createContext(o, ctx)) {
       return err;
     } else {
-      out = std::make_unique<gpu::GpuFleet>(std::move(ctx), sheets);
+      out = std::make_unique<gpu::GpuBatch>(std::move(ctx), sheets);
     }
   } catch (const std::exception& e) {
     out.reset();

@@ -62,8 +62,8 @@ std::optional<std::string> parseBool(const std::string& s, bool& out) {
   return "'" + s + "' is not on/off";
 }
 
-// Limits of the sheet size: a 16384-wide grid or 2^24 particles at most.
-constexpr uint32_t kMaxSide = 16384;
+// A particle's grid place packs its row and column in 16 bits each (sim_elements.glsl).
+static_assert(kMaxSide < (1u << 16));
 
 Param floatParam(const char* key, float SimParams::*m, float lo, float hi, const char* help) {
   return {{key, help, lo, hi},
@@ -361,18 +361,21 @@ uint64_t availableMemoryBytes() {
 std::optional<std::string> checkRules(const SimParams& p) {
   uint64_t n = uint64_t(p.cols) * p.rows;
   if (n == 0) return "the grid has no particles";
-  if (n > (1u << 24)) return "a grid of " + std::to_string(n) + " particles is too large (at most 16777216)";
+  if (n > kMaxParticles)
+    return "a grid of " + std::to_string(n) + " particles is too large (at most " + std::to_string(kMaxParticles) + ")";
   if (p.substeps > SIM_MAX_SUBSTEPS) return "substeps is at most " + std::to_string(SIM_MAX_SUBSTEPS);
   if (p.collision && p.collisionRadius() > p.cell_size)
     return "collision radius (" + fmt(p.collisionRadius()) + ") must not exceed cell_size (" + fmt(p.cell_size) + ")";
   return std::nullopt;
 }
 
+uint64_t memoryBudget(uint64_t available) { return available / 10 * 9; }
+
 std::optional<std::string> validate(const SimParams& p, const std::string& backend) {
   if (auto err = checkRules(p)) return err;
   // Refused up front, with room to spare (a tenth of the memory for everything else).
   const uint64_t need = estimateSheetBytes(p, backend), have = availableMemoryBytes();
-  if (need > have / 10 * 9)
+  if (need > memoryBudget(have))
     return "a " + std::to_string(p.cols) + "x" + std::to_string(p.rows) + " sheet needs about " +
            std::to_string(need >> 20) + " MiB on the " + (backend == "cpu" ? "cpu" : "gpu") + " backend; " +
            std::to_string(have >> 20) + " MiB are available";

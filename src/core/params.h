@@ -124,6 +124,9 @@ std::optional<std::string> spellTyped(const std::string& key, ValueType type, co
                                       std::string& out);
 /// Largest preset file (every key of one is about 1.5 KB).
 constexpr uint64_t kMaxPresetFileBytes = 1u << 20;
+/// Limits of the sheet's size: particles across or down, and particles in all.
+constexpr uint32_t kMaxSide = 16384;
+constexpr uint32_t kMaxParticles = 1u << 24;
 
 /// Applies one `key=value` override; returns an error message on failure.
 std::optional<std::string> applyOverride(SimParams& p, const std::string& assignment);
@@ -158,5 +161,8 @@ SheetCounts sheetCounts(const SimParams& p);
 uint64_t estimateSheetBytes(const SimParams& p, const std::string& backend);
 /// Host memory this process may still use: MemAvailable, or half the physical memory.
 uint64_t availableMemoryBytes();
+/// What a run may plan on of `available` bytes: nine tenths, a tenth left for everything else
+/// (a sheet's check, a batch's size).
+uint64_t memoryBudget(uint64_t available);
 
 } // namespace tender

@@ -1,6 +1,9 @@
 #include "passes.h"
 
+#include <algorithm>
 #include <charconv>
+#include <iterator>
+#include <string_view>
 #include <vector>
 
 namespace tender {
@@ -14,6 +17,28 @@ bool collisionOn(const shaderio::SimUniforms& u) { return (u.flags & SIM_FLAG_CO
 uint32_t perSubstep(const shaderio::SimUniforms& u) {
   return passesPerSubstep(u.iterations, u.color_count, collisionOn(u));
 }
+
+uint32_t stagePassesOf(const shaderio::SimUniforms& u, uint32_t stage) {
+  return stagePasses(stage, u.iterations, u.color_count, collisionOn(u));
+}
+
+/// The names of the stages, in SIM_STAGES order.
+constexpr const char* kStageNames[] = {
+#define TENDER_STAGE_NAME(name, id, repeat, condition) #name,
+    SIM_STAGES(TENDER_STAGE_NAME)
+#undef TENDER_STAGE_NAME
+};
+static_assert(std::size(kStageNames) == SIM_STAGE_COUNT);
+/// Stages numbered once per colour of each iteration (a pass of one names its iteration and colour).
+constexpr bool kPerColour[] = {
+#define TENDER_STAGE_PER_COLOUR(name, id, repeat, condition) SIM_STAGE_REPEATS_##repeat,
+    SIM_STAGES(TENDER_STAGE_PER_COLOUR)
+#undef TENDER_STAGE_PER_COLOUR
+};
+bool perColour(PassKind kind) { return kind != PassKind::reset && kPerColour[uint32_t(kind)]; }
+#define TENDER_STAGE_ORDER(name, id, repeat, condition) static_assert(std::string_view(kStageNames[id]) == #name);
+SIM_STAGES(TENDER_STAGE_ORDER)
+#undef TENDER_STAGE_ORDER
 
 template <class T>
 bool parseNumber(const std::string& s, T& out) {
@@ -41,69 +66,46 @@ uint32_t passesPerTick(const shaderio::SimUniforms& u) {
 PassPoint passAt(const shaderio::SimUniforms& u, uint32_t index) {
   PassPoint p;
   if (u.reset_active) {
-    p.kind = PassKind::Reset;
+    p.kind = PassKind::reset;
     return p;
   }
-  const uint32_t per = perSubstep(u), projects = u.iterations * u.color_count;
-  p.substep = index / per;
-  uint32_t k = index % per;
-  if (k == 0) return p;
-  if (--k < projects) {
-    p.kind = PassKind::Project;
-    p.iteration = k / u.color_count;
-    p.color = k % u.color_count;
-    return p;
+  p.substep = index / perSubstep(u);
+  uint32_t k = index % perSubstep(u);
+  for (uint32_t stage = 0; stage < SIM_STAGE_COUNT; ++stage) {
+    const uint32_t passes = stagePassesOf(u, stage);
+    if (k >= passes) {
+      k -= passes;
+      continue;
+    }
+    p.kind = PassKind(stage);
+    if (perColour(p.kind)) {
+      p.iteration = k / u.color_count;
+      p.color = k % u.color_count;
+    }
+    break;
   }
-  k -= projects;
-  if (collisionOn(u) && k-- == 0) {
-    p.kind = PassKind::Collide;
-    return p;
-  }
-  p.kind = k == 0 ? PassKind::Floor : PassKind::Tear;
   return p;
 }
 
 std::optional<uint32_t> passIndex(const shaderio::SimUniforms& u, const PassPoint& p) {
-  if (u.reset_active) return p.kind == PassKind::Reset ? std::optional<uint32_t>(0u) : std::nullopt;
-  if (p.substep >= substepCount(u.substeps) || p.kind == PassKind::Reset) return std::nullopt;
-  const uint32_t base = p.substep * perSubstep(u), projects = u.iterations * u.color_count;
-  const uint32_t collide = collisionOn(u) ? 1u : 0u;
-  switch (p.kind) {
-  case PassKind::Integrate:
-    return base;
-  case PassKind::Project:
+  if (u.reset_active) return p.kind == PassKind::reset ? std::optional<uint32_t>(0u) : std::nullopt;
+  const uint32_t stage = uint32_t(p.kind);
+  if (p.substep >= substepCount(u.substeps) || stage >= SIM_STAGE_COUNT || stagePassesOf(u, stage) == 0)
+    return std::nullopt;
+  uint32_t within = 0;
+  if (perColour(p.kind)) {
     if (p.iteration >= u.iterations || p.color >= u.color_count) return std::nullopt;
-    return base + 1u + p.iteration * u.color_count + p.color;
-  case PassKind::Collide:
-    if (!collide) return std::nullopt;
-    return base + 1u + projects;
-  case PassKind::Floor:
-    return base + 1u + projects + collide;
-  case PassKind::Tear:
-    return base + 2u + projects + collide;
-  case PassKind::Reset:
-    break;
+    within = p.iteration * u.color_count + p.color;
   }
-  return std::nullopt;
+  return p.substep * perSubstep(u) + stageFirstPass(stage, u.iterations, u.color_count, collisionOn(u)) + within;
 }
 
 std::string describePass(const PassPoint& p) {
-  switch (p.kind) {
-  case PassKind::Reset:
-    return "reset";
-  case PassKind::Integrate:
-    return "substep " + std::to_string(p.substep) + ", integrate";
-  case PassKind::Project:
-    return "substep " + std::to_string(p.substep) + ", project (iteration " + std::to_string(p.iteration) +
-           ", colour " + std::to_string(p.color) + ")";
-  case PassKind::Collide:
-    return "substep " + std::to_string(p.substep) + ", collide";
-  case PassKind::Floor:
-    return "substep " + std::to_string(p.substep) + ", floor";
-  case PassKind::Tear:
-    return "substep " + std::to_string(p.substep) + ", tear";
-  }
-  return "?";
+  if (p.kind == PassKind::reset) return "reset";
+  std::string text = "substep " + std::to_string(p.substep) + ", " + kStageNames[uint32_t(p.kind)];
+  if (perColour(p.kind))
+    text += " (iteration " + std::to_string(p.iteration) + ", colour " + std::to_string(p.color) + ")";
+  return text;
 }
 
 std::optional<PlantedUlp> parsePlantedUlp(const std::string& text, std::string& error) {
@@ -115,21 +117,17 @@ std::optional<PlantedUlp> parsePlantedUlp(const std::string& text, std::string& 
     return std::nullopt;
   }
   const std::vector<std::string> pass = split(f[2], '.');
-  if (pass.size() == 3 && pass[0] == "project" && parseNumber(pass[1], plant.pass.iteration) &&
-      parseNumber(pass[2], plant.pass.color))
-    plant.pass.kind = PassKind::Project;
-  else if (f[2] == "integrate")
-    plant.pass.kind = PassKind::Integrate;
-  else if (f[2] == "collide")
-    plant.pass.kind = PassKind::Collide;
-  else if (f[2] == "floor")
-    plant.pass.kind = PassKind::Floor;
-  else if (f[2] == "tear")
-    plant.pass.kind = PassKind::Tear;
-  else {
-    error = "planted ULP '" + text + "': unknown pass '" + f[2] + "' (integrate, project.I.C, collide, floor, tear)";
+  const auto named = std::find(std::begin(kStageNames), std::end(kStageNames), pass[0]);
+  const bool per_colour = named != std::end(kStageNames) && perColour(PassKind(named - std::begin(kStageNames)));
+  if (named == std::end(kStageNames) || pass.size() != (per_colour ? 3u : 1u) ||
+      (per_colour && !(parseNumber(pass[1], plant.pass.iteration) && parseNumber(pass[2], plant.pass.color)))) {
+    std::string names;
+    for (uint32_t stage = 0; stage < SIM_STAGE_COUNT; ++stage)
+      names += std::string(stage ? ", " : "") + kStageNames[stage] + (kPerColour[stage] ? ".I.C" : "");
+    error = "planted ULP '" + text + "': unknown pass '" + f[2] + "' (" + names + ")";
     return std::nullopt;
   }
+  plant.pass.kind = PassKind(named - std::begin(kStageNames));
   return plant;
 }
 

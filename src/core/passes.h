@@ -1,7 +1,7 @@
 #pragma once
-/// The passes of a tick, numbered in the order both solvers run them (passesPerSubstep in
-/// shaders/shared/xpbd.h): what `tender diff` names when two backends part, and where a tick cut
-/// short stops.
+/// The passes of a tick, numbered in the order every solver runs them (the stages of SIM_STAGES,
+/// shaders/shared/sim_passes.h): what `tender diff` names when two backends part, and where a tick
+/// cut short stops.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -10,13 +10,19 @@
 
 namespace tender {
 
-enum class PassKind : uint8_t { Integrate, Project, Collide, Floor, Tear, Reset };
+/// A stage of a substep (SIM_STAGES, in its order), or the one pass of a reset frame.
+enum class PassKind : uint8_t {
+#define TENDER_PASS_KIND(name, id, repeat, condition) name = id,
+  SIM_STAGES(TENDER_PASS_KIND)
+#undef TENDER_PASS_KIND
+      reset
+};
 
 /// One pass of a tick.
 struct PassPoint {
   uint32_t substep = 0;
-  PassKind kind = PassKind::Integrate;
-  uint32_t iteration = 0, color = 0; ///< of a Project pass
+  PassKind kind = PassKind::integrate;
+  uint32_t iteration = 0, color = 0; ///< of a project pass
   bool operator==(const PassPoint&) const = default;
 };
 
@@ -36,8 +42,8 @@ struct PlantedUlp {
   PassPoint pass;        ///< after this pass
   uint32_t particle = 0; ///< its x coordinate moves to the next float up
 };
-/// Parses "TICK:SUBSTEP:PASS:PARTICLE", PASS one of integrate, project.I.C (iteration I, colour
-/// C), collide, floor, tear; nullopt and one line in `error` when malformed.
+/// Parses "TICK:SUBSTEP:PASS:PARTICLE", PASS a stage's name (project.I.C: iteration I, colour C);
+/// nullopt and one line in `error` when malformed.
 std::optional<PlantedUlp> parsePlantedUlp(const std::string& text, std::string& error);
 
 } // namespace tender

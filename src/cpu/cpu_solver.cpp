@@ -74,22 +74,9 @@ void CpuSolver::upload(const SheetTopology& topo) {
 
 void CpuSolver::airPass(const SimUniforms& u) {
   air_.resize(pos_.size());
-  const auto& edges = topo_->tri_edges;
+  SheetElements e = elements(u);
   pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
-    for (uint32_t i = begin; i < end; ++i) {
-      // airOnParticle in sim_elements.glsl
-      vec3 sum(0.0f);
-      uint32_t count = 0;
-      for (uint32_t k = 0; k < 6; ++k) {
-        const uint32_t t = particleTriangle(i, k, u.cols, u.rows);
-        if (t == SIM_NONE || torn_[edges[t].x] != 0u || torn_[edges[t].y] != 0u) continue;
-        const uvec3 c = gridTriangle(t, u.cols);
-        sum += airOnTriangle(vec3(pos_[c.x]), vec3(pos_[c.y]), vec3(pos_[c.z]), vec3(prev_[c.x]), vec3(prev_[c.y]),
-                             vec3(prev_[c.z]), u.air);
-        ++count;
-      }
-      air_[i] = vec4(meanAir(sum, count), 0.0f);
-    }
+    for (uint32_t i = begin; i < end; ++i) air_[i] = vec4(e.airOnParticle(i), 0.0f);
   });
 }
 
@@ -114,24 +101,21 @@ void CpuSolver::integrate(const SimUniforms& u, uint32_t s) {
   });
 }
 
-// Projects constraints [begin, end) of one colour: solveDistance on each (no two share a
-// particle), after the SIMD kernels have projected all but the last few.
-void CpuSolver::projectRange(const float stiffness[4], uint32_t begin, uint32_t end) {
-  vec4* p = pos_.data();
-  const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data();
+// Projects constraints [begin, end) of one colour (no two share a particle): the SIMD kernels
+// project all but the last few, the shaders' projectConstraint the rest.
+void CpuSolver::projectRange(SheetElements& e, const float stiffness[4], uint32_t begin, uint32_t end) {
+  const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
   const float* rest = con_rest_.data();
-  uint32_t k = simd_ ? simd::project(&p[0].x, ca, cb, rest, kind, stiffness, begin, end) : begin;
-  for (; k < end; ++k) {
-    const PairDelta d = solveDistance(p[ca[k]], p[cb[k]], rest[k], stiffness[kind[k]]);
-    p[ca[k]] += vec4(d.da, 0.0f);
-    p[cb[k]] += vec4(d.db, 0.0f);
-  }
+  uint32_t k =
+      simd_ ? simd::project(reinterpret_cast<float*>(pos_.data()), ca, cb, rest, kind, stiffness, begin, end) : begin;
+  for (; k < end; ++k) e.projectConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]});
 }
 
 void CpuSolver::projectColors(const SimUniforms& u, uint32_t first, uint32_t count) {
   const float stiffness[4] = {u.stiffness.x, u.stiffness.y, u.stiffness.z, u.stiffness.w};
   const uint32_t colors = uint32_t(colors_.size());
   if (colors == 0) return;
+  SheetElements e = elements(u);
   uint32_t largest = 0;
   for (const ColorRange& range : colors_) largest = std::max(largest, range.count);
   const uint32_t chunks = pool_->chunksFor(largest, grain_(kGrainConstraints));
@@ -142,7 +126,7 @@ void CpuSolver::projectColors(const SimUniforms& u, uint32_t first, uint32_t cou
       const ColorRange& range = colors_[(first + done + phase) % colors];
       const uint32_t begin = WorkerPool::chunkBound(range.count, chunks, chunk);
       const uint32_t end = WorkerPool::chunkBound(range.count, chunks, chunk + 1);
-      projectRange(stiffness, range.first + begin, range.first + end);
+      projectRange(e, stiffness, range.first + begin, range.first + end);
     });
 }
 
@@ -162,16 +146,13 @@ void CpuSolver::floorPass(const SimUniforms& u) {
 
 // Marks the live constraints among array slots [begin, end) of the split arrays that shouldTear;
 // returns how many tore. The SIMD length test picks out the few that can tear, 64 at most at a time.
-uint32_t CpuSolver::markTearsRange(const SimUniforms& u, uint32_t begin, uint32_t end) {
+void CpuSolver::markTearsRange(SheetElements& e, uint32_t begin, uint32_t end) {
+  const SimUniforms& u = e.u;
   const vec4* p = pos_.data();
   const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
   const float* rest = con_rest_.data();
-  uint32_t torn = 0;
   auto check = [&](uint32_t k) {
-    if (shouldTear(p[ca[k]], p[cb[k]], rest[k], kind[k], u.tear_factor, u.tear_kinds)) {
-      torn_[id[k]] = 1u;
-      ++torn;
-    }
+    e.markTear(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]}, p[ca[k]], p[cb[k]]);
   };
   for (const ColorRange& range : colors_) {
     const uint32_t first = std::max(begin, range.first), last = std::min(end, range.first + range.count);
@@ -183,39 +164,30 @@ uint32_t CpuSolver::markTearsRange(const SimUniforms& u, uint32_t begin, uint32_
           check(k + uint32_t(__builtin_ctzll(over)));
     for (; k < last; ++k) check(k);
   }
-  return torn;
 }
 
 uint32_t CpuSolver::markTears(const SimUniforms& u) {
+  counters_.torn_new = 0; // a new substep: nothing torn in it yet
   if (!tearingOn(u.tear_factor)) return 0;
-  std::atomic<uint32_t> torn{0};
-  pool_->parallelFor(uint32_t(constraints_.size()), grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
-    if (uint32_t t = markTearsRange(u, begin, end)) torn.fetch_add(t, std::memory_order_relaxed);
-  });
-  return torn.load();
+  SheetElements e = elements(u);
+  pool_->parallelFor(uint32_t(constraints_.size()), grain_(kGrainConstraints),
+                     [&](uint32_t begin, uint32_t end) { markTearsRange(e, begin, end); });
+  return counters_.torn_new;
 }
 
-uint32_t CpuSolver::markUnsupported() {
-  const auto& edges = topo_->tri_edges;
-  const uint32_t cols = topo_->cols;
-  auto gone = [&](uint32_t t) { return torn_[edges[t].x] != 0u || torn_[edges[t].y] != 0u; };
-  // Reads the flags of structural constraints only and writes those of shear and tri-bend ones
-  std::atomic<uint32_t> torn{0};
+uint32_t CpuSolver::markUnsupported(const SimUniforms& u) {
+  const uint32_t before = counters_.torn_new;
+  SheetElements e = elements(u);
   pool_->parallelFor(uint32_t(constraints_.size()), grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
-    uint32_t count = 0;
     for (const ColorRange& range : colors_)
-      for (uint32_t k = std::max(begin, range.first); k < std::min(end, range.first + range.count); ++k) {
-        const uint32_t kind = con_kind_[k];
-        if ((kind != SIM_KIND_SHEAR && kind != SIM_KIND_TRIBEND) || torn_[con_id_[k]] != 0u) continue;
-        const uvec2 t = supportTriangles(con_a_[k], con_b_[k], kind, cols);
-        if (unsupported(kind, gone(t.x), gone(t.y))) {
-          torn_[con_id_[k]] = 1u;
-          ++count;
-        }
-      }
-    if (count) torn.fetch_add(count, std::memory_order_relaxed);
+      for (uint32_t k = std::max(begin, range.first); k < std::min(end, range.first + range.count); ++k)
+        e.markUnsupported(constraints_[k]);
   });
-  return torn.load();
+  return counters_.torn_new - before;
+}
+
+SheetElements CpuSolver::elements(const SimUniforms& u) {
+  return SheetElements{u, pos_.data(), prev_.data(), torn_.data(), topo_->tri_edges.data(), counters_};
 }
 
 void CpuSolver::compact() {
@@ -271,7 +243,6 @@ void CpuSolver::tick(const SimUniforms& u) {
     return;
   }
   const bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
-  const uint32_t projects = u.iterations * uint32_t(colors_.size());
   std::optional<uint32_t> plant_at;
   if (plant_ && plant_->tick == tick) plant_at = passIndex(u, plant_->pass);
   const uint32_t plant = plant_at.value_or(SIM_NONE);
@@ -285,34 +256,48 @@ void CpuSolver::tick(const SimUniforms& u) {
     }
     return stop == pass - 1;
   };
-  uint32_t passes = 0;
-  for (uint32_t s = 0; s < substepCount(u.substeps); ++s) {
-    integrate(u, s); // damped Verlet, gravity, wind; pins and the grab hold
-    if (passed(1)) return;
-    // Gauss-Seidel over the colours, in runs that end where the tick stops or a change is planted
-    for (uint32_t done = 0; done < projects;) {
-      uint32_t run = projects - done;
-      for (uint32_t cut : {stop, plant})
-        if (cut >= pass && cut - pass < run) run = cut - pass + 1;
-      projectColors(u, done, run);
-      done += run;
-      if (passed(run)) return;
+  // The stages of each substep in their order (SIM_STAGES), a stage of several passes (one per
+  // colour of each iteration) in runs that end where the tick stops or a change is planted
+  for (uint32_t s = 0; s < substepCount(u.substeps); ++s)
+    for (uint32_t stage = 0; stage < SIM_STAGE_COUNT; ++stage) {
+      const uint32_t passes = stagePasses(stage, u.iterations, uint32_t(colors_.size()), collision);
+      for (uint32_t done = 0; done < passes;) {
+        uint32_t run = passes - done;
+        for (uint32_t cut : {stop, plant})
+          if (cut >= pass && cut - pass < run) run = cut - pass + 1;
+        runStage(PassKind(stage), u, s, done, run);
+        done += run;
+        if (passed(run)) return;
+      }
     }
-    if (collision) {
-      collide(u); // repulsion of unconnected neighbours (Jacobi)
-      if (passed(1)) return;
-    }
+  passes_per_tick_ = passesPerTick(u);
+}
+
+void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint32_t first, uint32_t count) {
+  switch (stage) {
+  case PassKind::integrate:
+    integrate(u, s); // the air, then damped Verlet, gravity, wind; pins and the grab hold
+    break;
+  case PassKind::project:
+    projectColors(u, first, count); // Gauss-Seidel over the colours
+    break;
+  case PassKind::collide:
+    collide(u); // repulsion of unconnected neighbours (Jacobi)
+    break;
+  case PassKind::floor:
     floorPass(u); // apply the repulsion, then the ground contact
-    if (passed(1)) return;
+    break;
+  case PassKind::tear:
     // Tear, let go of what stood on the triangles lost, compact the colours and triangles
     if (markTears(u) > 0) {
-      markUnsupported();
+      markUnsupported(u);
       compact();
     }
-    if (passed(1)) return;
-    passes += 1 + projects + (collision ? 2 : 0) + 2;
+    break;
+  case PassKind::reset:
+    resetPass(u);
+    break;
   }
-  passes_per_tick_ = passes;
 }
 
 void CpuSolver::beginReset() {

@@ -1,18 +1,23 @@
 #pragma once
-/// The CPU reference solver: every pass of one tick over flat arrays, in float32, in the same
-/// order as the GPU solver, calling the same per-element maths (shaders/shared/xpbd.h).
-/// Parallel loops (the constraints of one colour, per-particle passes, the collision gather) are
-/// split over a small thread pool; every element is computed exactly as in one thread, so the
-/// results are bitwise identical whatever the thread count. The projection, the tear test and the
-/// collision gather also have SIMD kernels (simd_kernels.h) with the very bits of the scalar loops
-/// here; CpuOptions::simd = false runs the scalar reference alone.
+/// The CPU reference solver: every pass of one tick over flat arrays, in float32, in the order of
+/// the pass table (SIM_STAGES, shaders/shared/sim_passes.h) as the GPU solver. It runs the
+/// shaders' own per-element bodies where they are written in the shared dialect (the projection,
+/// the air and the tear marks: sim_bodies.h, through SheetElements) and the same per-element maths
+/// elsewhere (xpbd.h, collision.h): the collision gather and the tear compaction are its own loops
+/// (a serial stable compaction where the GPU scans), with the same bits. Parallel loops (the
+/// constraints of one colour, per-particle passes, the collision gather) are split over a small
+/// thread pool; every element is computed exactly as in one thread, so the results are bitwise
+/// identical whatever the thread count. The projection, the tear test and the collision gather
+/// also have SIMD kernels (simd_kernels.h) with the very bits of the scalar bodies;
+/// CpuOptions::simd = false runs the scalar reference alone.
 #include <memory>
 #include <optional>
 #include <vector>
 
-#include "collision.h"
 #include "core/passes.h"
 #include "core/solver.h"
+#include "cpu_collision.h"
+#include "sheet_elements.h"
 
 namespace tender {
 
@@ -65,6 +70,9 @@ public:
   bool usesSimd() const { return simd_; }
 
   // The passes of one substep, public so tests can drive them one by one.
+  /// Passes [first, first + count) of stage `stage` (SIM_STAGES) of substep `substep`: what a
+  /// tick runs for that stage (count > 1 only for a stage numbered once per colour).
+  void runStage(PassKind stage, const shaderio::SimUniforms& u, uint32_t substep, uint32_t first, uint32_t count);
   /// Verlet integration with gravity, wind, damping (and, with SIM_FLAG_AIR, the air on each
   /// particle, from airPass first); pins and the grab hold their particles.
   void integrate(const shaderio::SimUniforms& u, uint32_t substep);
@@ -85,7 +93,7 @@ public:
   uint32_t markTears(const shaderio::SimUniforms& u);
   /// After a tear: marks the shear and tri-bend constraints whose triangles are gone (unsupported
   /// in xpbd.h); returns how many.
-  uint32_t markUnsupported();
+  uint32_t markUnsupported(const shaderio::SimUniforms& u);
   /// Stable compaction of the colour ranges and of the triangles that lost an edge.
   void compact();
   /// One frame of the animated reset.
@@ -105,8 +113,10 @@ public:
   glm::uvec4 candidateState() const { return collision_.candidateState(); }
 
 private:
-  void projectRange(const float stiffness[4], uint32_t begin, uint32_t end);
-  uint32_t markTearsRange(const shaderio::SimUniforms& u, uint32_t begin, uint32_t end);
+  void projectRange(shaderio::SheetElements& e, const float stiffness[4], uint32_t begin, uint32_t end);
+  void markTearsRange(shaderio::SheetElements& e, uint32_t begin, uint32_t end);
+  /// The sheet as the shaders' element bodies read it (sim_bodies.h).
+  shaderio::SheetElements elements(const shaderio::SimUniforms& u);
   void splitConstraints();
 
   CpuOptions options_;
@@ -126,6 +136,7 @@ private:
   std::vector<uint32_t> torn_;
   std::vector<glm::uvec4> triangles_;
   uint32_t triangle_count_ = 0;
+  shaderio::Counters counters_{}; ///< the tear counts the element bodies keep (torn_new: this substep)
   uint32_t passes_per_tick_ = 0;
   uint32_t stop_after_ = SIM_NONE; // stopNextTickAfter
   uint64_t ticks_ = 0;             // ticks since upload (the clock of plant_)

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "collision.h"
+#include "cpu_collision.h"
 #if defined(TENDER_CPU_AVX)
 #include "kernels_avx.h"
 #endif

@@ -26,7 +26,7 @@ constexpr VkBufferUsageFlags kStorageUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT 
 
 void GpuSolver::destroySheet() {
   VkDevice dev = ctx_.device();
-  for (Slot& s : slots_) {
+  for (InFlight& s : in_flight_) {
     VkCommandBuffer cmds[2] = {s.tick, s.reset};
     if (s.tick) vkFreeCommandBuffers(dev, ctx_.commandPool(), 2, cmds);
     s.tick = s.reset = VK_NULL_HANDLE;
@@ -40,7 +40,7 @@ void GpuSolver::destroySheet() {
   descriptor_pool_ = VK_NULL_HANDLE;
   set_ = VK_NULL_HANDLE;
   for (Buffer& b : buf_) ctx_.destroyBuffer(b);
-  last_tick_slot_ = -1;
+  last_tick_ = -1;
   uploaded_ = false;
 }
 
@@ -52,13 +52,14 @@ void GpuSolver::upload(const SheetTopology& topo) {
   spacing_ = structuralSpacing(topo);
   const VkDeviceSize max_range = ctx_.properties().limits.maxStorageBufferRange;
   layout_sizes_ = SheetLayout::of(topo, max_range);
-  hash_slots_.clear();
+  hash_grids_.clear();
   hash_grids_uploaded_.clear();
 
-  // The uniforms (host-visible, one slot per tick in flight and one static), then the table.
+  // The uniforms (host-visible, a copy per tick in flight and one static), then the table.
   const VkDeviceSize align = ctx_.properties().limits.minUniformBufferOffsetAlignment;
   uniform_stride_ = (sizeof(SimUniforms) + align - 1) / align * align;
-  buf_[SIM_BIND_UNIFORMS] = ctx_.createHostBuffer(uniform_stride_ * (kSlots + 1), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  buf_[SIM_BIND_UNIFORMS] =
+      ctx_.createHostBuffer(uniform_stride_ * (kInFlight + 1), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   StartData start;
   const std::vector<BindingSpec> table = sheetBindings(topo_, layout_sizes_, start, true);
   // A sheet whose arrays exceed what the device binds is refused with one line, before allocating.
@@ -69,9 +70,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
                                "); this Vulkan device binds at most " + std::to_string(max_range >> 20) +
                                " MiB (try a smaller sheet or --backend cpu)");
   for (const BindingSpec& b : table) buf_[b.binding] = ctx_.createDeviceBuffer(b.bytes, kStorageUsage);
-  std::vector<Buffer> staging;
-  ctx_.submitOnce([&](VkCommandBuffer cmd) { stageBindings(cmd, table, false, staging); });
-  for (Buffer& b : staging) ctx_.destroyBuffer(b);
+  uploadStart(ctx_, place(), table);
 
   // One descriptor set over every buffer.
   descriptor_pool_ = createSheetSetPool(dev, 1);
@@ -82,76 +81,39 @@ void GpuSolver::upload(const SheetTopology& topo) {
   writeSheetSet(dev, set_, where);
   writeStaticUniforms();
 
-  // Command buffers: per slot a tick (recorded on first use) and a reset; one normals buffer.
+  // Command buffers: per tick in flight a tick (recorded on first use) and a reset; one normals buffer.
   VkCommandBufferAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
   ai.commandPool = ctx_.commandPool();
   ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   ai.commandBufferCount = 1;
-  for (uint32_t s = 0; s < kSlots; ++s) {
-    VK_CHECK(vkAllocateCommandBuffers(dev, &ai, &slots_[s].tick));
-    VK_CHECK(vkAllocateCommandBuffers(dev, &ai, &slots_[s].reset));
-    recordReset(slots_[s], s);
+  for (uint32_t s = 0; s < kInFlight; ++s) {
+    VK_CHECK(vkAllocateCommandBuffers(dev, &ai, &in_flight_[s].tick));
+    VK_CHECK(vkAllocateCommandBuffers(dev, &ai, &in_flight_[s].reset));
+    recordReset(in_flight_[s], s);
   }
   VK_CHECK(vkAllocateCommandBuffers(dev, &ai, &normals_cmd_));
   recordNormals();
   uploaded_ = true;
 }
 
-void GpuSolver::stageBindings(VkCommandBuffer cmd, const std::vector<BindingSpec>& table, bool restored_only,
-                              std::vector<Buffer>& staging) {
-  // Zeros first, then the start contents over them.
-  for (const BindingSpec& b : table)
-    if (!restored_only || b.restored) vkCmdFillBuffer(cmd, buf_[b.binding].buffer, 0, VK_WHOLE_SIZE, 0);
-  memoryBarrier(cmd, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-                VK_ACCESS_2_TRANSFER_WRITE_BIT);
-  for (const BindingSpec& b : table) {
-    if ((restored_only && !b.restored) || !b.data || b.data_bytes == 0) continue;
-    Buffer s = ctx_.createHostBuffer(b.data_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-    std::memcpy(s.mapped, b.data, size_t(b.data_bytes));
-    VkBufferCopy region{0, b.data_offset, b.data_bytes};
-    vkCmdCopyBuffer(cmd, s.buffer, buf_[b.binding].buffer, 1, &region);
-    staging.push_back(s);
+SheetPlace GpuSolver::place() const {
+  SheetPlace where;
+  for (uint32_t b = 0; b < kBindingCount; ++b) {
+    where.buffer[b] = buf_[b].buffer;
+    where.size[b] = VK_WHOLE_SIZE;
   }
+  return where;
 }
 
 void GpuSolver::beginReset() {
   finish();
-  StartData start;
-  const std::vector<BindingSpec> table = sheetBindings(topo_, layout_sizes_, start, false);
-  std::vector<Buffer> staging;
-  ctx_.submitOnce([&](VkCommandBuffer cmd) {
-    // The reset animates from where the sheet is now; what tearing changed is restored.
-    VkBufferCopy region{0, 0, 16ull * topo_.particleCount()};
-    if (region.size) vkCmdCopyBuffer(cmd, buf_[SIM_BIND_POS].buffer, buf_[SIM_BIND_RESET_FROM].buffer, 1, &region);
-    stageBindings(cmd, table, true, staging);
-  });
-  for (Buffer& b : staging) ctx_.destroyBuffer(b);
+  beginSheetReset(ctx_, place(), topo_, layout_sizes_);
 }
 
 void GpuSolver::readback(SimState& out) {
   finish();
-  StartData start;
-  const std::vector<BindingSpec> table = sheetBindings(topo_, layout_sizes_, start, false);
-  // Every read-back binding into one staging buffer, one after the other.
-  std::array<VkDeviceSize, kBindingCount> offset{};
-  VkDeviceSize total = 0;
-  for (const BindingSpec& b : table)
-    if (b.read_back) {
-      offset[b.binding] = total;
-      total += b.bytes;
-    }
-  Buffer staging = ctx_.createHostBuffer(total, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-  ctx_.submitOnce([&](VkCommandBuffer cmd) {
-    for (const BindingSpec& b : table)
-      if (b.read_back && b.bytes > 0) {
-        VkBufferCopy region{0, offset[b.binding], b.bytes};
-        vkCmdCopyBuffer(cmd, buf_[b.binding].buffer, staging.buffer, 1, &region);
-      }
-  });
-  assembleState(
-      topo_, [&](uint32_t binding) { return static_cast<const char*>(staging.mapped) + offset[binding]; }, out);
-  ctx_.destroyBuffer(staging);
+  readSheetState(ctx_, place(), topo_, layout_sizes_, out);
 }
 
 void GpuSolver::readDeltas(std::vector<glm::vec4>& out) {

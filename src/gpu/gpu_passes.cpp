@@ -1,4 +1,5 @@
-// Recording of the simulation passes: one tick reads like the algorithm of docs/ARCHITECTURE.md §3.
+// Recording of a tick: the fused tick's dispatches, or the substeps of the pass table
+// (recordSubstep); the reset and normals command buffers.
 #include <cassert>
 
 #include "gpu/barriers.h"
@@ -8,8 +9,8 @@ namespace tender::gpu {
 
 using namespace shaderio;
 
-void GpuSolver::bindSet(VkCommandBuffer cmd, uint32_t uniform_slot) {
-  uint32_t offset = uint32_t(uniform_slot * uniform_stride_);
+void GpuSolver::bindSet(VkCommandBuffer cmd, uint32_t uniform_index) {
+  uint32_t offset = uint32_t(uniform_index * uniform_stride_);
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 1, &offset);
   bound_ = VK_NULL_HANDLE;
 }
@@ -17,16 +18,16 @@ void GpuSolver::bindSet(VkCommandBuffer cmd, uint32_t uniform_slot) {
 void GpuSolver::dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
                          uint32_t push_size) {
   const SheetPassTarget target{cmd, layout_, buf_[SIM_BIND_HASH_ARGS].buffer, 0, buf_[SIM_BIND_COUNTERS].buffer, 0};
-  if (recordSheetPass(target, bound_, hash_slots_, p, grid, count, push, push_size)) ++recorded_dispatches_;
+  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size)) ++recorded_dispatches_;
 }
 
-void GpuSolver::timestamp(VkCommandBuffer cmd, Slot& slot, PassCategory c) {
-  if (!slot.queries) return;
+void GpuSolver::timestamp(VkCommandBuffer cmd, InFlight& flight, PassCategory c) {
+  if (!flight.queries) return;
   // Query k closes interval k - 1, which belongs to category c.
-  const uint32_t q = uint32_t(slot.categories.size()) + 1;
+  const uint32_t q = uint32_t(flight.categories.size()) + 1;
   if (q >= query_capacity_) return;
-  vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, q);
-  slot.categories.push_back(uint8_t(c));
+  vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, flight.queries, q);
+  flight.categories.push_back(uint8_t(c));
 }
 
 void GpuSolver::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
@@ -39,18 +40,18 @@ void GpuSolver::barrier() { computeToCompute(recording_->tick); }
 
 void GpuSolver::mark(PassCategory c) { timestamp(recording_->tick, *recording_, c); }
 
-void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
-  VkCommandBuffer cmd = slot.tick;
+void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& key) {
+  VkCommandBuffer cmd = flight.tick;
   VK_CHECK(vkResetCommandBuffer(cmd, 0));
   VkCommandBufferBeginInfo bi{};
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
   const uint32_t n = topo_.particleCount();
   recorded_dispatches_ = 0;
-  slot.categories.clear();
-  if (slot.queries) {
-    vkCmdResetQueryPool(cmd, slot.queries, 0, query_capacity_);
-    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, 0);
+  flight.categories.clear();
+  if (flight.queries) {
+    vkCmdResetQueryPool(cmd, flight.queries, 0, query_capacity_);
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, flight.queries, 0);
   }
   anyToCompute(cmd); // earlier submissions (previous tick, copies, the renderer) are done
   bindSet(cmd, index);
@@ -63,31 +64,31 @@ void GpuSolver::recordTick(Slot& slot, uint32_t index, const RecordKey& key) {
       dispatch(cmd, pipes_.tick_fused, Grid::Workgroup, 1, FusedPush{n, s, count, key.stop});
       if (key.stop != SIM_NONE && key.stop < (s + count) * per) break;
     }
-    timestamp(cmd, slot, kFused);
+    timestamp(cmd, flight, kFused);
   } else {
     uint32_t pass = 0;
     const SubstepPlan plan{key.iterations, key.collision, key.air, key.stop};
-    recording_ = &slot;
+    recording_ = &flight;
     for (uint32_t s = 0; s < key.substeps; ++s)
       if (recordSubstep(*this, pipes_, topo_, layout_sizes_, plan, s, pass)) break;
     recording_ = nullptr;
   }
   computeToAll(cmd); // the renderer and copies see this tick
   VK_CHECK(vkEndCommandBuffer(cmd));
-  slot.recorded = key;
-  // The full grids of the hash passes, which candidates_decide copies to the live slots
-  if (hash_slots_.grids() != hash_grids_uploaded_) {
+  flight.recorded = key;
+  // The full grids of the hash passes, which candidates_decide copies to the live arguments
+  if (hash_grids_.grids() != hash_grids_uploaded_) {
     ctx_.submitOnce([&](VkCommandBuffer up) {
       vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * SIM_HASH_DISPATCHES,
-                        16 * hash_slots_.grids().size(), hash_slots_.grids().data());
+                        16 * hash_grids_.grids().size(), hash_grids_.grids().data());
     });
-    hash_grids_uploaded_ = hash_slots_.grids();
+    hash_grids_uploaded_ = hash_grids_.grids();
   }
-  slot.dispatches = recorded_dispatches_;
+  flight.dispatches = recorded_dispatches_;
 }
 
-void GpuSolver::recordReset(Slot& slot, uint32_t index) {
-  VkCommandBuffer cmd = slot.reset;
+void GpuSolver::recordReset(InFlight& flight, uint32_t index) {
+  VkCommandBuffer cmd = flight.reset;
   VkCommandBufferBeginInfo bi{};
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
@@ -106,7 +107,7 @@ void GpuSolver::recordNormals() {
   VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
   if (normals_queries_) vkCmdResetQueryPool(cmd, normals_queries_, 0, 2);
   anyToCompute(cmd);
-  bindSet(cmd, kStaticSlot);
+  bindSet(cmd, kStaticUniforms);
   if (normals_queries_) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, normals_queries_, 0);
   const uint32_t n = topo_.particleCount();
   dispatch(cmd, pipes_.normals, Grid::Threads, n, SimPush{0, n, 0, 0});

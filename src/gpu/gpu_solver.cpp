@@ -29,7 +29,7 @@ GpuSolver::~GpuSolver() {
   VkDevice dev = ctx_.device();
   vkDeviceWaitIdle(dev);
   destroySheet();
-  for (Slot& s : slots_) {
+  for (InFlight& s : in_flight_) {
     if (s.fence) vkDestroyFence(dev, s.fence, nullptr);
     if (s.queries) vkDestroyQueryPool(dev, s.queries, nullptr);
   }
@@ -43,7 +43,7 @@ GpuSolver::~GpuSolver() {
 
 void GpuSolver::createPipelines(FusedShape fused) {
   VkDevice dev = ctx_.device();
-  // One set layout: the uniforms (dynamic offset per tick slot) and every storage array.
+  // One set layout: the uniforms (dynamic offset per tick in flight) and every storage array.
   set_layout_ = createSheetSetLayout(dev);
   VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, uint32_t(sizeof(PickPush))};
   VkPipelineLayoutCreateInfo pli{};
@@ -73,14 +73,14 @@ void GpuSolver::createPipelines(FusedShape fused) {
     pipes_.pick[s] = makeComputePipeline(ctx_, "pick.comp", layout_, float_rules_, math_, sizeof(PickPush), 1, s, false,
                                          owned_pipelines_);
 
-  // Per-slot fences and timestamp pools (chain of timestamps at pass boundaries).
-  query_capacity_ = 2 + 6 * SIM_MAX_SUBSTEPS;
+  // Per tick in flight: fences and timestamp pools (chain of timestamps at pass boundaries).
+  query_capacity_ = 2 + marksPerSubstep() * SIM_MAX_SUBSTEPS;
   VkFenceCreateInfo fci{};
   fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
   VkQueryPoolCreateInfo qci{};
   qci.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
   qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
-  for (Slot& s : slots_) {
+  for (InFlight& s : in_flight_) {
     VK_CHECK(vkCreateFence(dev, &fci, nullptr, &s.fence));
     if (ctx_.timestampsSupported()) {
       qci.queryCount = query_capacity_;
@@ -106,56 +106,56 @@ void GpuSolver::writeStaticUniforms() {
   u.hash_mask = topo_.hash_size - 1;
   u.color_count = topo_.colorCount();
   u.grab_index = SIM_NONE;
-  std::memcpy(static_cast<char*>(buf_[SIM_BIND_UNIFORMS].mapped) + kStaticSlot * uniform_stride_, &u, sizeof(u));
+  std::memcpy(static_cast<char*>(buf_[SIM_BIND_UNIFORMS].mapped) + kStaticUniforms * uniform_stride_, &u, sizeof(u));
 }
 
-void GpuSolver::waitSlot(Slot& slot) const {
-  if (!slot.pending) return;
-  VK_CHECK(vkWaitForFences(ctx_.device(), 1, &slot.fence, VK_TRUE, UINT64_MAX));
-  if (slot.timed) collectTimes(slot);
-  slot.pending = slot.timed = false;
+void GpuSolver::waitFor(InFlight& flight) const {
+  if (!flight.pending) return;
+  VK_CHECK(vkWaitForFences(ctx_.device(), 1, &flight.fence, VK_TRUE, UINT64_MAX));
+  if (flight.timed) collectTimes(flight);
+  flight.pending = flight.timed = false;
 }
 
-void GpuSolver::collectTimes(const Slot& slot) const {
-  if (!slot.queries || slot.categories.empty()) return;
-  std::vector<uint64_t> ts(slot.categories.size() + 1);
-  VK_CHECK(vkGetQueryPoolResults(ctx_.device(), slot.queries, 0, uint32_t(ts.size()), ts.size() * sizeof(uint64_t),
+void GpuSolver::collectTimes(const InFlight& flight) const {
+  if (!flight.queries || flight.categories.empty()) return;
+  std::vector<uint64_t> ts(flight.categories.size() + 1);
+  VK_CHECK(vkGetQueryPoolResults(ctx_.device(), flight.queries, 0, uint32_t(ts.size()), ts.size() * sizeof(uint64_t),
                                  ts.data(), sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
   std::array<double, kCategoryCount> ms{};
-  for (size_t k = 0; k < slot.categories.size(); ++k)
-    ms[slot.categories[k]] += double(ts[k + 1] - ts[k]) * ctx_.timestampPeriod() * 1e-6;
+  for (size_t k = 0; k < flight.categories.size(); ++k)
+    ms[flight.categories[k]] += double(ts[k + 1] - ts[k]) * ctx_.timestampPeriod() * 1e-6;
   ms[kNormals] = last_ms_[kNormals];
   last_ms_ = ms;
 }
 
 void GpuSolver::tick(const SimUniforms& u) {
-  const uint32_t index = next_slot_;
-  next_slot_ = (next_slot_ + 1) % kSlots;
-  Slot& slot = slots_[index];
-  // The slot's previous tick has finished: its uniforms and command buffer may be reused.
-  waitSlot(slot);
+  const uint32_t index = next_in_flight_;
+  next_in_flight_ = (next_in_flight_ + 1) % kInFlight;
+  InFlight& flight = in_flight_[index];
+  // Its previous tick has finished: its uniforms and command buffer may be reused.
+  waitFor(flight);
   SimUniforms gpu_u = u;
   if (usesCandidateLists()) gpu_u.flags |= SIM_FLAG_CANDIDATES;
   std::memcpy(static_cast<char*>(buf_[SIM_BIND_UNIFORMS].mapped) + index * uniform_stride_, &gpu_u, sizeof(gpu_u));
   if (u.reset_active) {
-    ctx_.submit(slot.reset, slot.fence);
-    slot.pending = true;
+    ctx_.submit(flight.reset, flight.fence);
+    flight.pending = true;
     dispatches_per_tick_ = 1;
     return;
   }
   RecordKey key{substepCount(u.substeps), u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u,
                 usesFusedPath(u),         stop_after_,  (u.flags & SIM_FLAG_AIR) != 0u};
   stop_after_ = SIM_NONE;
-  if (slot.recorded != key) recordTick(slot, index, key);
-  ctx_.submit(slot.tick, slot.fence);
-  slot.pending = true;
-  slot.timed = true;
-  last_tick_slot_ = int(index);
-  dispatches_per_tick_ = slot.dispatches;
+  if (flight.recorded != key) recordTick(flight, index, key);
+  ctx_.submit(flight.tick, flight.fence);
+  flight.pending = true;
+  flight.timed = true;
+  last_tick_ = int(index);
+  dispatches_per_tick_ = flight.dispatches;
 }
 
 void GpuSolver::finish() {
-  for (Slot& s : slots_) waitSlot(s);
+  for (InFlight& s : in_flight_) waitFor(s);
   if (normals_pending_) {
     VK_CHECK(vkWaitForFences(ctx_.device(), 1, &normals_fence_, VK_TRUE, UINT64_MAX));
     normals_pending_ = false;
@@ -186,7 +186,7 @@ PickResult GpuSolver::pick(glm::vec3 o, glm::vec3 d, float radius) {
     init.d2 = 0x7F800000u; // +inf
     vkCmdUpdateBuffer(cmd, buf_[SIM_BIND_PICK].buffer, 0, sizeof(init), &init);
     transferToCompute(cmd);
-    bindSet(cmd, kStaticSlot);
+    bindSet(cmd, kStaticUniforms);
     for (int s = 0; s < 3; ++s) {
       dispatch(cmd, pipes_.pick[size_t(s)], Grid::Threads, push.count, push);
       computeToAll(cmd);
@@ -227,9 +227,9 @@ std::vector<glm::vec3> GpuSolver::particlePositions(const std::vector<uint32_t>&
 
 PassTimes GpuSolver::passTimes() const {
   // Collect the newest finished tick without waiting for one still running.
-  if (last_tick_slot_ >= 0) {
-    Slot& s = slots_[size_t(last_tick_slot_)];
-    if (s.pending && vkGetFenceStatus(ctx_.device(), s.fence) == VK_SUCCESS) waitSlot(s);
+  if (last_tick_ >= 0) {
+    InFlight& s = in_flight_[size_t(last_tick_)];
+    if (s.pending && vkGetFenceStatus(ctx_.device(), s.fence) == VK_SUCCESS) waitFor(s);
   }
   if (normals_pending_ && vkGetFenceStatus(ctx_.device(), normals_fence_) == VK_SUCCESS && normals_queries_) {
     uint64_t ts[2];

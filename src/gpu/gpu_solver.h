@@ -3,7 +3,7 @@
 /// One descriptor set holds every array (bindings in shaders/shared/sim_config.h); the tick's
 /// command buffers are recorded once and re-recorded only when substeps, iterations or the
 /// collision flag change; nothing is read back in the steady-state loop. Two ticks may be in
-/// flight: each has its own uniform slot, command buffer, fence and timestamp pool.
+/// flight: each has its own uniforms, command buffer, fence and timestamp pool.
 #include <array>
 #include <memory>
 #include <string>
@@ -45,8 +45,8 @@ bool fusedTickFits(const SheetTopology& topo);
 /// spacings (< 0: any) when collision is on.
 bool fusedTickTakes(const shaderio::SimUniforms& u, float spacing, float max_cell_spacings);
 
-/// The Solver on Vulkan compute. A substep's passes (docs/ARCHITECTURE.md §3) are recorded by
-/// recordSubstep (substep_passes.h), the tear compaction and the hash passes as indirect dispatches
+/// The Solver on Vulkan compute. A substep's passes (the pass table, sim_passes.h) are recorded
+/// by recordSubstep (substep_passes.h), the tear compaction and the hash passes as indirect dispatches
 /// (zero workgroups when nothing tore or the candidate lists stand in). Small sheets run every pass of a substep in one
 /// workgroup (tick_fused.comp): on a GPU the whole tick in one dispatch, on a CPU device one
 /// dispatch per substep (see FusedShape). The fused tick keeps collision candidate lists with a
@@ -115,10 +115,10 @@ public:
   void finish() override;
 
 private:
-  /// Tick command buffers in flight; each has its own uniform slot, fence and timestamp pool.
-  static constexpr uint32_t kSlots = 2;
-  /// Uniform slot of the normals and pick passes (static: written at upload).
-  static constexpr uint32_t kStaticSlot = kSlots;
+  /// Tick command buffers in flight; each has its own uniforms, fence and timestamp pool.
+  static constexpr uint32_t kInFlight = 2;
+  /// Uniforms of the normals and pick passes (static: written at upload).
+  static constexpr uint32_t kStaticUniforms = kInFlight;
   static constexpr uint32_t kBindingCount = kSheetBindingCount;
   struct RecordKey {
     uint32_t substeps = 0, iterations = 0;
@@ -128,7 +128,7 @@ private:
     bool air = false;         ///< the air pass runs before integration (SIM_FLAG_AIR)
     bool operator==(const RecordKey&) const = default;
   };
-  struct Slot {
+  struct InFlight {
     VkCommandBuffer tick = VK_NULL_HANDLE, reset = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
     VkQueryPool queries = VK_NULL_HANDLE;
@@ -139,33 +139,32 @@ private:
     uint32_t dispatches = 0;
   };
 
-  /// Records the start contents of the table's bindings (only those a reset restores).
-  void stageBindings(VkCommandBuffer cmd, const std::vector<BindingSpec>& table, bool restored_only,
-                     std::vector<Buffer>& staging);
+  /// Where the sheet's bindings live: whole buffers.
+  SheetPlace place() const;
   void createPipelines(FusedShape fused);
   void destroySheet();
   void writeStaticUniforms();
-  void recordTick(Slot& slot, uint32_t index, const RecordKey& key);
+  void recordTick(InFlight& flight, uint32_t index, const RecordKey& key);
   // PassSink: the passes of the per-colour path go to the tick being recorded (recording_)
   void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t substep,
             uint32_t gate, uint32_t gate_arg) override;
   void barrier() override;
   void mark(PassCategory c) override;
-  void recordReset(Slot& slot, uint32_t index);
+  void recordReset(InFlight& flight, uint32_t index);
   void recordNormals();
-  void bindSet(VkCommandBuffer cmd, uint32_t uniform_slot);
+  void bindSet(VkCommandBuffer cmd, uint32_t uniform_index);
   /// The one dispatch helper: binds the pipeline, checks and pushes the constants, and dispatches
   /// `count` elements (Threads), one workgroup (Workgroup), or the grid of an indirect argument
-  /// (Compaction, Hash: the next live hash-pass slot, whose full grid candidates_decide copies in).
+  /// (Compaction, Hash: the next hash dispatch's live arguments, whose full grid candidates_decide copies in).
   void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
                 uint32_t push_size);
   template <class Push>
   void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const Push& push) {
     dispatch(cmd, p, grid, count, &push, uint32_t(sizeof(Push)));
   }
-  void timestamp(VkCommandBuffer cmd, Slot& slot, PassCategory c);
-  void waitSlot(Slot& slot) const;
-  void collectTimes(const Slot& slot) const;
+  void timestamp(VkCommandBuffer cmd, InFlight& flight, PassCategory c);
+  void waitFor(InFlight& flight) const;
+  void collectTimes(const InFlight& flight) const;
 
   std::unique_ptr<VulkanContext> owned_ctx_;
   VulkanContext& ctx_;
@@ -177,17 +176,17 @@ private:
   VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   SimPipelines pipes_;
-  PipelineSet owned_pipelines_; ///< every pipeline created, for the destructor
-  Slot* recording_ = nullptr;   ///< the slot whose tick is being recorded
+  PipelineSet owned_pipelines_;   ///< every pipeline created, for the destructor
+  InFlight* recording_ = nullptr; ///< the tick in flight being recorded
 
   std::array<Buffer, kBindingCount> buf_{};
   Buffer small_readback_; ///< host-visible: pick result and particle positions
   VkDeviceSize uniform_stride_ = 0;
   SheetLayout layout_sizes_; ///< sizes the passes and the bindings share
 
-  mutable std::array<Slot, kSlots> slots_{};
-  uint32_t next_slot_ = 0;
-  int last_tick_slot_ = -1;
+  mutable std::array<InFlight, kInFlight> in_flight_{};
+  uint32_t next_in_flight_ = 0;
+  int last_tick_ = -1;
   VkCommandBuffer normals_cmd_ = VK_NULL_HANDLE;
   VkFence normals_fence_ = VK_NULL_HANDLE;
   VkQueryPool normals_queries_ = VK_NULL_HANDLE;
@@ -203,7 +202,7 @@ private:
   float fused_max_cell_spacings_ = -1.0f;       ///< largest hash cell of the fused tick (< 0: any)
   float spacing_ = 0.0f;                        ///< grid spacing: the shortest structural rest length
   bool candidates_allowed_ = true;              ///< setCandidateLists
-  HashSlots hash_slots_;                        ///< full grids of the hash passes, in recording order
+  HashGrids hash_grids_;                        ///< full grids of the hash passes, in recording order
   std::vector<glm::uvec4> hash_grids_uploaded_; ///< what SIM_BIND_HASH_ARGS holds of them
   uint32_t stop_after_ = SIM_NONE;              ///< stopNextTickAfter
   mutable std::array<double, kCategoryCount> last_ms_{};

@@ -104,7 +104,7 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
   const uint32_t n = topo.particleCount(), m = topo.constraintCount(), t = topo.triangleCount();
   const uint32_t cells = topo.hash_size;
   // The fused tick's scans meet their per-invocation totals in the SIM_WG_FUSED slots after the
-  // compaction slots (the separate passes' block sums, unused on that path).
+  // compaction slots (the per-colour passes' block sums, unused on that path).
   const uint32_t scratch = std::max(layout.hash_sums + scanSumsSize(cells), layout.tear_slots + SIM_WG_FUSED);
   const VkDeviceSize list_bytes = layout.candidates_fit ? 4ull * SIM_CANDIDATE_STRIDE * n : 16,
                      list_base = layout.candidates_fit ? 16ull * n : 16;

@@ -23,7 +23,10 @@ struct SheetLayout {
   static SheetLayout of(const SheetTopology& topo, VkDeviceSize max_range);
 };
 
-/// True when ticks keep the collision candidate lists: they are allowed (GpuSolver and GpuFleet's
+/// `v` rounded up to a multiple of `a`.
+inline VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
+
+/// True when ticks keep the collision candidate lists: they are allowed (GpuSolver and GpuBatch's
 /// setCandidateLists) and their buffer fits the device. The one rule both engines follow.
 inline bool keepsCandidateLists(const SheetLayout& layout, bool allowed) { return allowed && layout.candidates_fit; }
 
@@ -72,5 +75,33 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
 
 /// The state of a sheet from its read-back bindings: `bytes(binding)` points at the copy of each.
 void assembleState(const SheetTopology& topo, const std::function<const void*(uint32_t binding)>& bytes, SimState& out);
+
+class VulkanContext;
+struct Buffer;
+
+/// Where each binding of one sheet lives: a buffer, and the offset and size of the sheet's part of
+/// it (a sheet alone: whole buffers; a fleet's sheet: its slices). The transfers below serve both.
+struct SheetPlace {
+  std::array<VkBuffer, kSheetBindingCount> buffer{};
+  std::array<VkDeviceSize, kSheetBindingCount> offset{}, size{};
+};
+
+/// Records the start contents of a sheet's bindings into `place` (restored_only: only those a reset
+/// restores): zeros, then the table's data from one staging buffer, created here (destroy it once
+/// the submission has run).
+void recordStart(VulkanContext& ctx, VkCommandBuffer cmd, const SheetPlace& place,
+                 const std::vector<BindingSpec>& table, bool restored_only, Buffer& staging);
+
+/// Uploads a sheet's start contents (every binding of `table`), in one submission.
+void uploadStart(VulkanContext& ctx, const SheetPlace& place, const std::vector<BindingSpec>& table);
+
+/// The start of an animated reset, in one submission: the sheet's positions go to where the reset
+/// animates from (SIM_BIND_RESET_FROM), and what tearing changed is restored.
+void beginSheetReset(VulkanContext& ctx, const SheetPlace& place, const SheetTopology& topo, const SheetLayout& sizes);
+
+/// A sheet's state read back from `place`: every read-back binding into one staging buffer, in one
+/// submission.
+void readSheetState(VulkanContext& ctx, const SheetPlace& place, const SheetTopology& topo, const SheetLayout& sizes,
+                    SimState& out);
 
 } // namespace tender::gpu

@@ -112,7 +112,7 @@ ComputePipeline makeComputePipeline(VulkanContext& ctx, std::string_view key, Vk
 SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
                                bool batched, PipelineSet& owned) {
   using namespace shaderio;
-  // Every kernel of the registry (sim_kernels.h): its shader, push constants, elements per
+  // Every kernel of the registry (SIM_KERNELS, sim_passes.h): its shader, push constants, elements per
   // invocation, and whether a fleet runs it batched.
   struct PipelineSpec {
     ComputePipeline SimPipelines::*member;
@@ -205,8 +205,8 @@ void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitche
       vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.layout, 0, 1, &set, 0, nullptr);
       const uint32_t push[2] = {count, uint32_t(op)};
       vkCmdPushConstants(cmd, o.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, push);
-      const uint32_t groups = (count + 63u) / 64u, gx = std::min(groups, 65535u);
-      vkCmdDispatch(cmd, gx, (groups + gx - 1u) / gx, 1);
+      const glm::uvec2 grid = shaderio::groupGrid((count + 63u) / 64u);
+      vkCmdDispatch(cmd, grid.x, grid.y, 1);
       allToAllAndHost(cmd);
     });
     std::memcpy(cases.data() + first, o.buffer.mapped, count * sizeof(MathCase));

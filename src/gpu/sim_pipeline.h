@@ -9,7 +9,7 @@
 
 #include "core/solver.h"
 #include "gpu/context.h"
-#include "sim_kernels.h"
+#include "sim_passes.h"
 #include "spirv_rules.h"
 
 namespace tender::gpu {
@@ -43,7 +43,7 @@ struct ComputePipeline {
 };
 
 /// Every pipeline of the simulation (one file per shader in shaders/sim/): a member per kernel of
-/// the registry (SIM_KERNELS, sim_kernels.h), the fused tick and the picks.
+/// the registry (SIM_KERNELS, sim_passes.h), the fused tick and the picks.
 struct SimPipelines {
 #define SIM_KERNEL_MEMBER(name, push, per_invocation, batched) ComputePipeline name;
   SIM_KERNELS(SIM_KERNEL_MEMBER)

@@ -1,35 +1,34 @@
 #include "gpu/substep_passes.h"
 
 #include <algorithm>
+#include <iterator>
 
 namespace tender::gpu {
 
 using namespace shaderio;
 
 glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets) {
-  const uint32_t groups = (count + p.workgroup - 1) / p.workgroup;
-  const uint32_t gx = std::min<uint32_t>(groups, SIM_MAX_GROUPS_X);
-  return glm::uvec4(gx, gx ? (groups + gx - 1) / gx : 0u, sheets, 0u);
+  return glm::uvec4(groupGrid((count + p.workgroup - 1) / p.workgroup), sheets, 0u);
 }
 
-uint32_t HashSlots::record(Grid grid, glm::uvec4 full) {
+uint32_t HashGrids::record(Grid grid, glm::uvec4 full) {
   if (grid != Grid::Hash) {
     next_ = 0;
     return 0;
   }
-  const uint32_t slot = next_++;
-  if (slot >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
-  if (slot == grids_.size()) grids_.push_back(full);
-  if (grids_[slot] != full) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
-  return slot;
+  const uint32_t k = next_++;
+  if (k >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
+  if (k == grids_.size()) grids_.push_back(full);
+  if (grids_[k] != full) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
+  return k;
 }
 
-bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashSlots& slots, const ComputePipeline& p, Grid grid,
-                     uint32_t count, const void* push, uint32_t push_size) {
+bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& hash_grids, const ComputePipeline& p,
+                     Grid grid, uint32_t count, const void* push, uint32_t push_size) {
   if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
   if (grid == Grid::Threads && count == 0) return false;
   const glm::uvec4 full = fullGrid(p, count);
-  const uint32_t hash_slot = slots.record(grid, full);
+  const uint32_t hash_dispatch = hash_grids.record(grid, full);
   if (bound != p.pipeline) {
     vkCmdBindPipeline(t.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
     bound = p.pipeline;
@@ -47,13 +46,46 @@ bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashSlots& slo
     break;
   case Grid::Hash:
     // The live arguments candidates_decide copied from the full grids (or zero workgroups)
-    vkCmdDispatchIndirect(t.cmd, t.hash_args, t.hash_offset + 16ull * hash_slot);
+    vkCmdDispatchIndirect(t.cmd, t.hash_args, t.hash_offset + 16ull * hash_dispatch);
     break;
   }
   return true;
 }
 
 namespace {
+
+/// What a dispatch covers (SIM_DISPATCHES' elements column).
+enum class Elements : uint8_t { PARTICLES, COLOUR, CONSTRAINTS, ONE, HASH_ARGS, HASH_CELLS, TEAR_SLOTS, INDIRECT };
+/// When a sheet records a dispatch (SIM_DISPATCHES' needs column).
+enum class Needs : uint8_t { ALWAYS, AIR, CONSTRAINTS };
+
+/// One row of SIM_DISPATCHES.
+struct Dispatch {
+  uint32_t stage;
+  ComputePipeline SimPipelines::*kernel;
+  Elements elements;
+  Grid grid;
+  uint32_t gate;
+  Needs needs;
+  PassCategory category;
+};
+
+constexpr Dispatch kDispatches[] = {
+#define TENDER_DISPATCH(stage, kernel, elements, grid, gate, needs, category)                                          \
+  {SIM_STAGE_##stage, &SimPipelines::kernel, Elements::elements, Grid::grid,                                           \
+   SIM_GATE_##gate,   Needs::needs,          k##category},
+    SIM_DISPATCHES(TENDER_DISPATCH)
+#undef TENDER_DISPATCH
+};
+static_assert(std::is_sorted(std::begin(kDispatches), std::end(kDispatches),
+                             [](const Dispatch& a, const Dispatch& b) { return a.stage < b.stage; }),
+              "SIM_DISPATCHES lists the stages in SIM_STAGES order");
+
+/// True when the next row (of this stage) is of another category: a timestamp closes this one.
+constexpr bool closesCategory(size_t row) {
+  return row + 1 == std::size(kDispatches) || kDispatches[row + 1].stage != kDispatches[row].stage ||
+         kDispatches[row + 1].category != kDispatches[row].category;
+}
 
 template <class Push>
 void record(PassSink& sink, const ComputePipeline& p, Grid grid, uint32_t count, const Push& push, uint32_t s,
@@ -74,79 +106,73 @@ void recordScan(PassSink& sink, const SimPipelines& pipes, uint32_t mode, uint32
   sink.barrier();
 }
 
+/// Records one row of SIM_DISPATCHES for pass `k` of its stage, then a barrier.
+void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,
+                    const Dispatch& d, uint32_t s, uint32_t k) {
+  const ComputePipeline& p = pipes.*d.kernel;
+  const uint32_t n = topo.particleCount(), m = topo.constraintCount();
+  switch (d.elements) {
+  case Elements::PARTICLES:
+    record(sink, p, d.grid, n, SimPush{0, n, s, 0}, s, d.gate);
+    break;
+  case Elements::COLOUR: {
+    // Pass k: colour k % colours of iteration k / colours; an empty colour records nothing
+    const uint32_t c = k % topo.colorCount();
+    const ColorRange& range = topo.colors[c];
+    if (range.count == 0) return;
+    record(sink, p, d.grid, range.count, SimPush{range.first, range.count, s, c}, s, d.gate, k / topo.colorCount());
+    break;
+  }
+  case Elements::CONSTRAINTS:
+    record(sink, p, d.grid, m, SimPush{0, m, s, 0}, s, d.gate);
+    break;
+  case Elements::ONE:
+    record(sink, p, d.grid, 1, SimPush{0, n, s, 0}, s, d.gate);
+    break;
+  case Elements::HASH_ARGS:
+    record(sink, p, d.grid, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0}, s, d.gate);
+    break;
+  case Elements::HASH_CELLS:
+    recordScan(sink, pipes, SIM_SCAN_HASH, 0, topo.hash_size, sizes.hash_sums, d.grid, s, d.gate);
+    return;
+  case Elements::TEAR_SLOTS:
+    recordScan(sink, pipes, SIM_SCAN_SCRATCH, 0, sizes.tear_slots, sizes.tear_sums, d.grid, s, d.gate);
+    return;
+  case Elements::INDIRECT:
+    sink.pass(p, d.grid, 0, nullptr, 0, s, d.gate, 0);
+    break;
+  }
+  sink.barrier();
+}
+
 } // namespace
+
+uint32_t marksPerSubstep() {
+  uint32_t marks = 0;
+  for (size_t row = 0; row < std::size(kDispatches); ++row) marks += closesCategory(row) ? 1u : 0u;
+  return marks;
+}
 
 bool recordSubstep(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,
                    const SubstepPlan& plan, uint32_t s, uint32_t& pass) {
-  const uint32_t n = topo.particleCount(), m = topo.constraintCount();
-  const SimPush all{0, n, s, 0};
-  auto stops = [&] { return pass++ == plan.stop; };
-  // 1. The air on each particle (integration reads it), then Verlet integration
-  if (plan.air) {
-    record(sink, pipes.air, Grid::Threads, n, all, s, SIM_GATE_AIR);
-    sink.barrier();
-  }
-  record(sink, pipes.integrate, Grid::Threads, n, all, s, SIM_GATE_TICK);
-  sink.barrier();
-  sink.mark(kIntegrate);
-  if (stops()) return true;
-  // 2. Gauss-Seidel over colours; constraints beyond a colour's live count exit
-  for (uint32_t it = 0; it < plan.iterations; ++it)
-    for (uint32_t c = 0; c < topo.colorCount(); ++c) {
-      const ColorRange& range = topo.colors[c];
-      if (range.count > 0) {
-        record(sink, pipes.project, Grid::Threads, range.count, SimPush{range.first, range.count, s, c}, s,
-               SIM_GATE_ITERATION, it);
-        sink.barrier();
+  const bool has_constraints = topo.constraintCount() > 0;
+  // The stages in their order, each pass of a stage its dispatches in theirs (SIM_STAGES,
+  // SIM_DISPATCHES); the last pass of a stage closes its timestamp categories
+  for (uint32_t stage = 0; stage < SIM_STAGE_COUNT; ++stage) {
+    const uint32_t passes = stagePasses(stage, plan.iterations, topo.colorCount(), plan.collision);
+    for (uint32_t k = 0; k < passes; ++k) {
+      for (size_t row = 0; row < std::size(kDispatches); ++row) {
+        const Dispatch& d = kDispatches[row];
+        if (d.stage != stage) continue;
+        const bool needed = d.needs == Needs::ALWAYS || (d.needs == Needs::AIR && plan.air) ||
+                            (d.needs == Needs::CONSTRAINTS && has_constraints);
+        if (needed) recordDispatch(sink, pipes, topo, sizes, d, s, k);
+        if (k + 1 == passes && closesCategory(row)) sink.mark(d.category);
       }
-      if (stops()) return true;
+      if (pass++ == plan.stop) return true;
     }
-  sink.mark(kProject);
-  if (plan.collision) {
-    // 3. Candidate lists still good? Spatial hash: count, scan, scatter, order within bucket
-    // (each pass does nothing when the lists stand in for it); then gather repulsion and
-    // update the lists' state
-    record(sink, pipes.candidates_check, Grid::Threads, n, all, s, SIM_GATE_COLLISION);
-    sink.barrier();
-    record(sink, pipes.candidates_decide, Grid::Threads, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0}, s,
-           SIM_GATE_COLLISION);
-    sink.barrier();
-    record(sink, pipes.hash_count, Grid::Hash, n, all, s, SIM_GATE_HASH);
-    sink.barrier();
-    recordScan(sink, pipes, SIM_SCAN_HASH, 0, topo.hash_size, sizes.hash_sums, Grid::Hash, s, SIM_GATE_HASH);
-    record(sink, pipes.hash_scatter, Grid::Hash, n, all, s, SIM_GATE_HASH);
-    sink.barrier();
-    record(sink, pipes.hash_sort, Grid::Hash, n, all, s, SIM_GATE_HASH);
-    sink.barrier();
-    sink.mark(kHash);
-    record(sink, pipes.collide, Grid::Threads, n, all, s, SIM_GATE_COLLISION);
-    sink.barrier();
-    record(sink, pipes.candidates_finish, Grid::Threads, 1, all, s, SIM_GATE_COLLISION);
-    sink.barrier();
-    sink.mark(kCollide);
-    if (stops()) return true;
   }
-  // 4. Collision deltas and ground contact
-  record(sink, pipes.floor, Grid::Threads, n, all, s, SIM_GATE_TICK);
-  sink.barrier();
-  sink.mark(kFloor);
-  if (stops()) return true;
-  // 5. Tear marking; what stood on the triangles lost and the compaction run zero workgroups
-  // unless something tore this substep
-  if (m > 0) {
-    record(sink, pipes.tear_mark, Grid::Threads, m, SimPush{0, m, s, 0}, s, SIM_GATE_TICK);
-    sink.barrier();
-    sink.pass(pipes.tear_unsupported, Grid::Compaction, 0, nullptr, 0, s, SIM_GATE_COMPACTION, 0);
-    sink.barrier();
-    sink.pass(pipes.tear_flags, Grid::Compaction, 0, nullptr, 0, s, SIM_GATE_COMPACTION, 0);
-    sink.barrier();
-    recordScan(sink, pipes, SIM_SCAN_SCRATCH, 0, sizes.tear_slots, sizes.tear_sums, Grid::Compaction, s,
-               SIM_GATE_COMPACTION);
-    sink.pass(pipes.tear_compact, Grid::Compaction, 0, nullptr, 0, s, SIM_GATE_COMPACTION, 0);
-    sink.barrier();
-  }
-  sink.mark(kTear);
-  return stops();
+  return false;
 }
 
 } // namespace tender::gpu

@@ -1,8 +1,8 @@
 #pragma once
-/// The passes of one substep of the per-colour path, in the order of docs/ARCHITECTURE.md §3, recorded into a
-/// PassSink: the GPU solver dispatches them for its sheet; a fleet dispatches each for every sheet
-/// of a batch, and its gate (SIM_GATE_* in sim_config.h) picks the sheets that run it, those that
-/// would run it alone.
+/// The passes of one substep of the per-colour path, as the pass table says (SIM_STAGES and
+/// SIM_DISPATCHES, shaders/shared/sim_passes.h), recorded into a PassSink: the GPU solver dispatches them for its
+/// sheet; a fleet dispatches each for every sheet of a batch, and its gate (SIM_GATE_* in sim_config.h) picks the
+/// sheets that run it, those that would run it alone.
 #include <cstdint>
 #include <vector>
 
@@ -17,8 +17,8 @@ namespace tender::gpu {
 /// workgroups when the candidate lists stand in for the hash).
 enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash };
 
-/// Timestamp categories of a tick, in Solver::passTimes() order. kFused: the fused small-sheet
-/// tick, every pass in one dispatch.
+/// Timestamp categories of a tick, in Solver::passTimes() order (SIM_DISPATCHES' category column
+/// names the first six). kFused: the fused small-sheet tick, every pass in one dispatch.
 enum PassCategory : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kFused, kCategoryCount };
 
 /// The full grid of `count` elements of `p`, with `sheets` workgroups in z: wider than
@@ -26,13 +26,13 @@ enum PassCategory : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTe
 glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets = 1);
 
 /// The full grids of the hash passes, in recording order: every substep records the same hash
-/// passes into the same slots (at most SIM_HASH_DISPATCHES), whose live arguments the passes
+/// passes as the same hash dispatches (at most SIM_HASH_DISPATCHES), whose live arguments the passes
 /// dispatch from.
-class HashSlots {
+class HashGrids {
 public:
-  /// A pass of grid `grid` is recorded. A hash pass of full grid `full` takes the next slot and
+  /// A pass of grid `grid` is recorded. A hash pass of full grid `full` is the next hash dispatch and
   /// returns it (its grid checked against earlier substeps'); any other pass makes the next hash
-  /// pass take slot 0.
+  /// pass the first.
   uint32_t record(Grid grid, glm::uvec4 full);
   const std::vector<glm::uvec4>& grids() const { return grids_; }
   void clear() {
@@ -57,10 +57,10 @@ struct SheetPassTarget {
 
 /// Records a pass of one sheet on its descriptor set, as the solver dispatches it: `count`
 /// elements (Grid::Threads; none: nothing recorded), one workgroup, the compaction's indirect
-/// arguments, or the next hash slot's live arguments. `bound` is the pipeline bound on `t.cmd`.
+/// arguments, or the next hash dispatch's live arguments. `bound` is the pipeline bound on `t.cmd`.
 /// Returns false when nothing was recorded.
-bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashSlots& slots, const ComputePipeline& p, Grid grid,
-                     uint32_t count, const void* push, uint32_t push_size);
+bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& hash_grids, const ComputePipeline& p,
+                     Grid grid, uint32_t count, const void* push, uint32_t push_size);
 
 /// Where the passes of a substep go.
 class PassSink {
@@ -85,8 +85,11 @@ struct SubstepPlan {
   uint32_t iterations = 0;
   bool collision = false;
   bool air = false;
-  uint32_t stop = SIM_NONE; ///< last pass to record (passesPerSubstep numbering; Solver::stopNextTickAfter)
+  uint32_t stop = SIM_NONE; ///< last pass to record (SIM_STAGES numbering; Solver::stopNextTickAfter)
 };
+
+/// Timestamps a substep of the per-colour path records (one where each category ends).
+uint32_t marksPerSubstep();
 
 /// Records the passes of substep `s` of a sheet of this topology and layout; `pass` counts them.
 /// Returns true when the tick stops within it (SubstepPlan::stop).

@@ -46,6 +46,13 @@ inline SimState run(Simulation& sim, int ticks) {
   return s;
 }
 
+/// Number of torn constraints.
+inline uint32_t tornCount(const SimState& s) {
+  uint32_t n = 0;
+  for (uint32_t t : s.torn) n += t != 0u ? 1u : 0u;
+  return n;
+}
+
 /// True when two arrays hold the same bytes (and are the same size).
 template <typename T>
 bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {

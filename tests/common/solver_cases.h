@@ -201,6 +201,7 @@ TYPED_TEST_P(SolverCase, PauseFreezesTheState) {
   sim.setScript(script("5 pause on\n10 pause off\n"));
   SimState a = run(sim, 6);
   SimState b = run(sim, 4);
+  ASSERT_EQ(a.pos.size(), 96u);
   EXPECT_TRUE(sameBytes(a.pos, b.pos));
   EXPECT_EQ(sim.physicsTicks(), 5u);
   run(sim, 2); // tick 10 unpauses

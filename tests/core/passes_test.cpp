@@ -21,14 +21,14 @@ shaderio::SimUniforms uniforms(uint32_t substeps, uint32_t iterations, uint32_t 
 TEST(Passes, OrderOfOneSubstep) {
   const shaderio::SimUniforms u = uniforms(3, 2, 5, true);
   ASSERT_EQ(passesPerTick(u), 3u * (1u + 10u + 1u + 1u + 1u));
-  EXPECT_EQ(passAt(u, 0), (PassPoint{0, PassKind::Integrate}));
-  EXPECT_EQ(passAt(u, 1), (PassPoint{0, PassKind::Project, 0, 0}));
-  EXPECT_EQ(passAt(u, 7), (PassPoint{0, PassKind::Project, 1, 1}));
-  EXPECT_EQ(passAt(u, 10), (PassPoint{0, PassKind::Project, 1, 4}));
-  EXPECT_EQ(passAt(u, 11), (PassPoint{0, PassKind::Collide}));
-  EXPECT_EQ(passAt(u, 12), (PassPoint{0, PassKind::Floor}));
-  EXPECT_EQ(passAt(u, 13), (PassPoint{0, PassKind::Tear}));
-  EXPECT_EQ(passAt(u, 14), (PassPoint{1, PassKind::Integrate}));
+  EXPECT_EQ(passAt(u, 0), (PassPoint{0, PassKind::integrate}));
+  EXPECT_EQ(passAt(u, 1), (PassPoint{0, PassKind::project, 0, 0}));
+  EXPECT_EQ(passAt(u, 7), (PassPoint{0, PassKind::project, 1, 1}));
+  EXPECT_EQ(passAt(u, 10), (PassPoint{0, PassKind::project, 1, 4}));
+  EXPECT_EQ(passAt(u, 11), (PassPoint{0, PassKind::collide}));
+  EXPECT_EQ(passAt(u, 12), (PassPoint{0, PassKind::floor}));
+  EXPECT_EQ(passAt(u, 13), (PassPoint{0, PassKind::tear}));
+  EXPECT_EQ(passAt(u, 14), (PassPoint{1, PassKind::integrate}));
   EXPECT_EQ(describePass(passAt(u, 21)), "substep 1, project (iteration 1, colour 1)");
 }
 
@@ -40,13 +40,13 @@ TEST(Passes, IndexIsTheInverseOfPassAt) {
     }
   shaderio::SimUniforms u = uniforms(2, 2, 3, false);
   EXPECT_EQ(passesPerTick(u), 2u * 9u);
-  EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::Collide}));
-  EXPECT_FALSE(passIndex(u, PassPoint{2, PassKind::Floor}));
-  EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::Project, 2, 0}));
-  EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::Project, 0, 3}));
+  EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::collide}));
+  EXPECT_FALSE(passIndex(u, PassPoint{2, PassKind::floor}));
+  EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::project, 2, 0}));
+  EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::project, 0, 3}));
   u.reset_active = 1;
   EXPECT_EQ(passesPerTick(u), 1u);
-  EXPECT_EQ(passAt(u, 0).kind, PassKind::Reset);
+  EXPECT_EQ(passAt(u, 0).kind, PassKind::reset);
   EXPECT_EQ(describePass(passAt(u, 0)), "reset");
 }
 
@@ -55,10 +55,10 @@ TEST(Passes, PlantedUlpParsesAndRefusesMalformedText) {
   auto p = parsePlantedUlp("12:3:project.1.4:700", error);
   ASSERT_TRUE(p) << error;
   EXPECT_EQ(p->tick, 12u);
-  EXPECT_EQ(p->pass, (PassPoint{3, PassKind::Project, 1, 4}));
+  EXPECT_EQ(p->pass, (PassPoint{3, PassKind::project, 1, 4}));
   EXPECT_EQ(p->particle, 700u);
   ASSERT_TRUE(parsePlantedUlp("0:0:floor:1", error));
-  EXPECT_EQ(parsePlantedUlp("0:0:collide:1", error)->pass.kind, PassKind::Collide);
+  EXPECT_EQ(parsePlantedUlp("0:0:collide:1", error)->pass.kind, PassKind::collide);
   for (const char* bad : {"", "1:2:floor", "x:1:floor:2", "1:2:bogus:3", "1:2:project.1:3", "1:2:floor:-1",
                           "1:2:floor:3:4", "1:2:project.a.b:3"}) {
     error.clear();

@@ -31,11 +31,4 @@ inline void expectIdentical(const SimState& a, const SimState& b) {
   EXPECT_EQ(a.triangle_count, b.triangle_count);
 }
 
-/// Number of torn constraints.
-inline uint32_t tornCount(const SimState& s) {
-  uint32_t n = 0;
-  for (uint32_t t : s.torn) n += t ? 1u : 0u;
-  return n;
-}
-
 } // namespace tender::test

@@ -32,8 +32,6 @@ std::vector<uint32_t> pieces(const SimState& s) {
   return out;
 }
 
-uint32_t tornCount(const SimState& s) { return uint32_t(std::count(s.torn.begin(), s.torn.end(), 1u)); }
-
 } // namespace
 
 TEST(Pieces, ATearAcrossTheSheetLeavesTwoPiecesThatFallApart) {
@@ -50,7 +48,7 @@ TEST(Pieces, ATearAcrossTheSheetLeavesTwoPiecesThatFallApart) {
     }
     const shaderio::SimUniforms u = sim.makeUniforms();
     ASSERT_GT(solver.markTears(u), 0u);
-    ASSERT_GT(solver.markUnsupported(), 0u) << name << ": the quads the tear cut keep their diagonals";
+    ASSERT_GT(solver.markUnsupported(u), 0u) << name << ": the quads the tear cut keep their diagonals";
     solver.compact();
     SimState s;
     solver.readback(s);

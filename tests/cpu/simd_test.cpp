@@ -10,7 +10,7 @@
 #include <limits>
 #include <random>
 
-#include "cpu/collision.h"
+#include "cpu/cpu_collision.h"
 #include "cpu/cpu_runs.h"
 #include "cpu/simd_kernels.h"
 #include "cpu/worker_pool.h"

@@ -4,34 +4,34 @@
 #include <thread>
 
 #include "common/fleet_cases.h"
-#include "gpu/gpu_fleet.h"
+#include "gpu/gpu_batch.h"
 #include "gpu/gpu_solver.h"
 #include "gpu_test_env.h"
 
 namespace tender::test {
 namespace {
 
-class GpuFleetTest : public GpuTest {};
+class GpuBatchTest : public GpuTest {};
 
-TEST_F(GpuFleetTest, EachSheetOfAMixedBatchMatchesItsRunAlone) {
+TEST_F(GpuBatchTest, EachSheetOfAMixedBatchMatchesItsRunAlone) {
   const std::vector<FleetSheet> sheets = mixedFleet(37);
-  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()));
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()));
   gpu::GpuSolver alone(ctx());
   const uint32_t tore = expectFleetMatchesAlone(batch, alone, sheets, 60);
   EXPECT_GT(tore, 0u);
   EXPECT_LT(tore, sheets.size());
 }
 
-TEST_F(GpuFleetTest, TheFleetMatchesTheCpuReference) {
+TEST_F(GpuBatchTest, TheFleetMatchesTheCpuReference) {
   const std::vector<FleetSheet> sheets = mixedFleet(9);
-  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()));
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()));
   CpuSolver alone(cpuOptionsLike(ctx()));
   expectFleetMatchesAlone(batch, alone, sheets, 40);
 }
 
-TEST_F(GpuFleetTest, OneDispatchRunsEveryQueuedSheetsTick) {
+TEST_F(GpuBatchTest, OneDispatchRunsEveryQueuedSheetsTick) {
   const std::vector<FleetSheet> sheets = mixedFleet(4);
-  gpu::GpuFleet batch(ctx(), 4);
+  gpu::GpuBatch batch(ctx(), 4);
   Fleet fleet(batch, sheets);
   fleet.tick();
   for (uint32_t i = 0; i < 4; ++i) EXPECT_EQ(fleet.sim(i).physicsTicks(), 1u);
@@ -45,13 +45,13 @@ TEST_F(GpuFleetTest, OneDispatchRunsEveryQueuedSheetsTick) {
 
 // The per-colour passes of sheets the fused tick does not take, both ways: batched (a GPU's
 // default) and sheet by sheet (a CPU device's)
-class GpuFleetPasses : public GpuTest, public testing::WithParamInterface<gpu::FleetPasses> {};
+class GpuBatchPasses : public GpuTest, public testing::WithParamInterface<gpu::BatchPasses> {};
 
-TEST_P(GpuFleetPasses, AFlushRunsFusedAndPerColourSheetsTogether) {
+TEST_P(GpuBatchPasses, AFlushRunsFusedAndPerColourSheetsTogether) {
   // Sheet 5 has hash cells of 5 spacings: a CPU device's fused tick does not take it, so alone
   // and in the fleet it runs the per-colour passes, while the others run the fused tick.
   const std::vector<FleetSheet> sheets = mixedFleet(6);
-  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()), GetParam());
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
   gpu::GpuSolver alone(ctx());
   expectFleetMatchesAlone(batch, alone, sheets, 12);
   const bool cpu_device = ctx().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
@@ -64,14 +64,14 @@ TEST_P(GpuFleetPasses, AFlushRunsFusedAndPerColourSheetsTogether) {
     EXPECT_EQ(batch.dispatchesPerFlush(), 1u);
 }
 
-TEST_P(GpuFleetPasses, SheetsTooLargeForTheFusedTickMatchTheirRunsAlone) {
+TEST_P(GpuBatchPasses, SheetsTooLargeForTheFusedTickMatchTheirRunsAlone) {
   // 48 x 48: over SIM_FUSED_MAX_PARTICLES. Batched, each pass is one dispatch for every sheet and
   // a gate picks the sheets that run it (substeps, iterations, air, collision, hash, tears, reset).
   // Seven sheets: a yank (1, 5), a reset (2, 6), a ray grab (3), tearing off (3), stiff against
   // tearing (2), collision off (4), air (1, 6), 6 to 8 substeps, 3 or 4 iterations.
   const std::vector<FleetSheet> sheets = mixedFleet(7, 48, 48);
-  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()), GetParam());
-  EXPECT_EQ(batch.passesPerSheet(), GetParam() == gpu::FleetPasses::PerSheet);
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
+  EXPECT_EQ(batch.passesPerSheet(), GetParam() == gpu::BatchPasses::PerSheet);
   gpu::GpuSolver alone(ctx());
   const uint32_t tore = expectFleetMatchesAlone(batch, alone, sheets, 30);
   EXPECT_FALSE(alone.usesFusedPath());
@@ -79,29 +79,29 @@ TEST_P(GpuFleetPasses, SheetsTooLargeForTheFusedTickMatchTheirRunsAlone) {
   EXPECT_LT(tore, sheets.size());
 }
 
-TEST_P(GpuFleetPasses, ThePerColourFleetMatchesTheCpuReference) {
+TEST_P(GpuBatchPasses, ThePerColourFleetMatchesTheCpuReference) {
   const std::vector<FleetSheet> sheets = mixedFleet(3, 48, 48);
-  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()), GetParam());
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
   CpuSolver alone(cpuOptionsLike(ctx()));
   expectFleetMatchesAlone(batch, alone, sheets, 20);
 }
 
 // Without the candidate lists (the switch the solver and the fleet both honour), every substep with
 // collision builds the hash, in a fleet as alone.
-TEST_P(GpuFleetPasses, WithoutCandidateListsSheetsMatchTheirRunsAlone) {
+TEST_P(GpuBatchPasses, WithoutCandidateListsSheetsMatchTheirRunsAlone) {
   const std::vector<FleetSheet> sheets = mixedFleet(3, 48, 48);
-  gpu::GpuFleet batch(ctx(), uint32_t(sheets.size()), GetParam());
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
   batch.setCandidateLists(false);
   gpu::GpuSolver alone(ctx());
   alone.setCandidateLists(false);
   expectFleetMatchesAlone(batch, alone, sheets, 12);
 }
 
-TEST_P(GpuFleetPasses, LargeSheetsRecordTheDispatchesOfOneSheetPerPassOrPerSheet) {
+TEST_P(GpuBatchPasses, LargeSheetsRecordTheDispatchesOfOneSheetPerPassOrPerSheet) {
   // Five sheets of one size: batched, the passes one of them records alone; sheet by sheet, five
   // times those
   const SimParams p = preset("tender", {"cols=48", "rows=48"});
-  gpu::GpuFleet batch(ctx(), 5, GetParam());
+  gpu::GpuBatch batch(ctx(), 5, GetParam());
   Fleet fleet(batch, std::vector<FleetSheet>(5, FleetSheet{p, {}}));
   gpu::GpuSolver alone(ctx());
   Simulation sim(p, alone);
@@ -113,14 +113,14 @@ TEST_P(GpuFleetPasses, LargeSheetsRecordTheDispatchesOfOneSheetPerPassOrPerSheet
   EXPECT_EQ(batch.dispatchesPerFlush(), alone.dispatchesPerTick() * (batch.passesPerSheet() ? 5u : 1u));
 }
 
-INSTANTIATE_TEST_SUITE_P(Fleet, GpuFleetPasses, testing::Values(gpu::FleetPasses::Batched, gpu::FleetPasses::PerSheet),
-                         [](const testing::TestParamInfo<gpu::FleetPasses>& param) {
-                           return param.param == gpu::FleetPasses::Batched ? std::string("batched")
+INSTANTIATE_TEST_SUITE_P(Fleet, GpuBatchPasses, testing::Values(gpu::BatchPasses::Batched, gpu::BatchPasses::PerSheet),
+                         [](const testing::TestParamInfo<gpu::BatchPasses>& param) {
+                           return param.param == gpu::BatchPasses::Batched ? std::string("batched")
                                                                            : std::string("per_sheet");
                          });
 
-TEST_F(GpuFleetTest, ACpuDeviceRunsThePerColourPassesSheetBySheet) {
-  gpu::GpuFleet batch(ctx(), 2);
+TEST_F(GpuBatchTest, ACpuDeviceRunsThePerColourPassesSheetBySheet) {
+  gpu::GpuBatch batch(ctx(), 2);
   EXPECT_EQ(batch.passesPerSheet(), ctx().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
 }
 

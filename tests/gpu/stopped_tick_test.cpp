@@ -35,12 +35,6 @@ Cut runCut(Solver& solver, const SimParams& p, const char* text, uint64_t ticks,
   return c;
 }
 
-uint32_t tornCount(const SimState& s) {
-  uint32_t n = 0;
-  for (uint32_t t : s.torn) n += t;
-  return n;
-}
-
 class StoppedTick : public GpuTest {};
 
 } // namespace
@@ -79,7 +73,7 @@ TEST_F(StoppedTick, EveryPassMatchesTheCpuFusedAndPerColour) {
       const Cut got = runCut(*g, p, text, tick, k);
       const char* path = g == &fused ? "fused" : "per-colour";
       EXPECT_TRUE(sameState(ref.state, got.state)) << path << ", after pass " << k << ": " << describePass(ref.pass);
-      if (ref.pass.kind == PassKind::Collide) {
+      if (ref.pass.kind == PassKind::collide) {
         EXPECT_TRUE(sameBytes(ref.deltas, got.deltas)) << path << ", deltas after " << describePass(ref.pass);
         for (const glm::vec4& d : ref.deltas) deltas_compared = deltas_compared || d != glm::vec4(0.0f);
       }

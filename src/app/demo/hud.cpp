@@ -197,7 +197,7 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
     if (s.triangles > 0) ImGui::Text("%u triangles", s.triangles);
     if (s.times && !s.times->ms.empty() &&
         ImGui::CollapsingHeader("GPU time per pass", ImGuiTreeNodeFlags_DefaultOpen)) {
-      // What the last tick measured: each pass, or on the fused path the one dispatch that runs
+      // What the last tick measured: each pass, or for the fused tick the one dispatch that runs
       // them all (the passes it fuses have no time of their own)
       double total = 0.0;
       for (auto& [name, ms] : s.times->ms) {

@@ -1,4 +1,4 @@
-#include "collision.h"
+#include "cpu_collision.h"
 
 #include <algorithm>
 #include <atomic>

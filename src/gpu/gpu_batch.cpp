@@ -1,4 +1,4 @@
-#include "gpu_fleet.h"
+#include "gpu_batch.h"
 
 #include <algorithm>
 #include <cstring>
@@ -24,44 +24,44 @@ constexpr VkDeviceSize kArgsBytes = 16ull * SIM_BATCH_ARGS_COUNT;
 
 } // namespace
 
-/// Sheet i of the fleet as a Solver: uploads, resets and read-backs of its slices. Its ticks never
-/// come here: the fleet's QueuedSolver queues them and the fleet runs them all in one dispatch.
-class GpuFleet::Sheet final : public Solver {
+/// Sheet i of the batch as a Solver: uploads, resets and read-backs of its slices. Its ticks never
+/// come here: the QueuedSolver queues them and the batch runs them all in one dispatch.
+class GpuBatch::Sheet final : public Solver {
 public:
-  Sheet(GpuFleet& fleet, uint32_t index) : fleet_(fleet), index_(index) {}
+  Sheet(GpuBatch& batch, uint32_t index) : batch_(batch), index_(index) {}
   std::string name() const override { return "gpu"; }
-  void upload(const SheetTopology& topo) override { fleet_.uploadSheet(index_, topo); }
+  void upload(const SheetTopology& topo) override { batch_.uploadSheet(index_, topo); }
   void tick(const SimUniforms&) override { throw std::logic_error("a fleet's sheet ticks through its batch"); }
-  void beginReset() override { fleet_.resetSheet(index_); }
+  void beginReset() override { batch_.resetSheet(index_); }
   /// The normals are computed from the positions when the state is read back.
   void computeNormals() override {}
   PickResult pick(glm::vec3 o, glm::vec3 d, float radius) override {
-    return pickNearest(fleet_.readSheetPositions(index_), o, d, radius);
+    return pickNearest(batch_.readSheetPositions(index_), o, d, radius);
   }
-  glm::vec3 particlePosition(uint32_t index) override { return glm::vec3(fleet_.readParticle(index_, index)); }
-  void readback(SimState& out) override { fleet_.readSheet(index_, out); }
-  void finish() override { fleet_.finish(); }
-  uint32_t dispatchesPerTick() const override { return fleet_.last_dispatches_; }
-  uint64_t memoryBytes() const override { return fleet_.memoryBytes() / std::max<uint32_t>(fleet_.size(), 1); }
-  Arithmetic arithmetic() const override { return arithmeticOf(fleet_.float_rules_, fleet_.math_); }
+  glm::vec3 particlePosition(uint32_t index) override { return glm::vec3(batch_.readParticle(index_, index)); }
+  void readback(SimState& out) override { batch_.readSheet(index_, out); }
+  void finish() override { batch_.finish(); }
+  uint32_t dispatchesPerTick() const override { return batch_.last_dispatches_; }
+  uint64_t memoryBytes() const override { return batch_.memoryBytes() / std::max<uint32_t>(batch_.size(), 1); }
+  Arithmetic arithmetic() const override { return arithmeticOf(batch_.float_rules_, batch_.math_); }
   void stopNextTickAfter(uint32_t last_pass) override {
     if (last_pass != SIM_NONE) throw std::runtime_error("a fleet runs whole ticks (tender diff runs one sheet)");
   }
-  void readDeltas(std::vector<glm::vec4>& out) override { fleet_.readSheetDeltas(index_, out); }
+  void readDeltas(std::vector<glm::vec4>& out) override { batch_.readSheetDeltas(index_, out); }
 
 private:
-  GpuFleet& fleet_;
+  GpuBatch& batch_;
   uint32_t index_;
 };
 
-GpuFleet::GpuFleet(VulkanContext& ctx, uint32_t sheets, FleetPasses passes) : ctx_(ctx) { create(sheets, passes); }
+GpuBatch::GpuBatch(VulkanContext& ctx, uint32_t sheets, BatchPasses passes) : ctx_(ctx) { create(sheets, passes); }
 
-GpuFleet::GpuFleet(std::unique_ptr<VulkanContext> ctx, uint32_t sheets)
+GpuBatch::GpuBatch(std::unique_ptr<VulkanContext> ctx, uint32_t sheets)
     : owned_ctx_(std::move(ctx)), ctx_(*owned_ctx_) {
-  create(sheets, FleetPasses::Auto);
+  create(sheets, BatchPasses::Auto);
 }
 
-void GpuFleet::create(uint32_t sheets, FleetPasses passes) {
+void GpuBatch::create(uint32_t sheets, BatchPasses passes) {
   // A sheet per workgroup: x of the fused tick's grid, z of a pass's
   const uint32_t most = std::min(ctx_.properties().limits.maxComputeWorkGroupCount[0],
                                  ctx_.properties().limits.maxComputeWorkGroupCount[2]);
@@ -89,7 +89,7 @@ void GpuFleet::create(uint32_t sheets, FleetPasses passes) {
   substeps_per_dispatch_ = shape.substeps_per_dispatch;
   fused_max_cell_spacings_ = shape.max_cell_spacings;
   sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
-  per_sheet_ = passes == FleetPasses::PerSheet || (passes == FleetPasses::Auto && cpu_device);
+  per_sheet_ = passes == BatchPasses::PerSheet || (passes == BatchPasses::Auto && cpu_device);
   if (per_sheet_) {
     sheet_set_layout_ = createSheetSetLayout(dev);
     VkPushConstantRange sheet_range{VK_SHADER_STAGE_COMPUTE_BIT, 0, uint32_t(sizeof(SimPush))};
@@ -121,7 +121,7 @@ void GpuFleet::create(uint32_t sheets, FleetPasses passes) {
   }
 }
 
-GpuFleet::~GpuFleet() {
+GpuBatch::~GpuBatch() {
   VkDevice dev = ctx_.device();
   vkDeviceWaitIdle(dev);
   for (Buffer& b : buf_) ctx_.destroyBuffer(b);
@@ -136,7 +136,7 @@ GpuFleet::~GpuFleet() {
   if (layout_) vkDestroyPipelineLayout(dev, layout_, nullptr);
 }
 
-void GpuFleet::allocate(const SheetTopology& topo) {
+void GpuBatch::allocate(const SheetTopology& topo) {
   topo_ = topo;
   spacing_ = structuralSpacing(topo);
   sizes_ = SheetLayout::of(topo, ctx_.properties().limits.maxStorageBufferRange);
@@ -191,13 +191,13 @@ void GpuFleet::allocate(const SheetTopology& topo) {
   allocated_ = true;
 }
 
-void GpuFleet::finish() {
+void GpuBatch::finish() {
   if (!pending_) return;
   VK_CHECK(vkWaitForFences(ctx_.device(), 1, &fence_, VK_TRUE, UINT64_MAX));
   pending_ = false;
 }
 
-void GpuFleet::flush() {
+void GpuBatch::flush() {
   // The queued sheets, their uniforms into the host buffer (the last flush has finished reading it).
   // Each takes the path it takes alone: the fused tick or the per-colour passes.
   finish();
@@ -295,7 +295,7 @@ void GpuFleet::flush() {
   if (!passes.empty() && per_sheet_) {
     // Each sheet's per-colour passes, on its own descriptor set, as it records them alone
     const uint32_t n = topo_.particleCount();
-    hash_slots_.clear();
+    hash_grids_.clear();
     for (size_t k = 0; k < passes.size(); ++k) {
       const SimUniforms& u = pass_uniforms[k];
       pass_sheet_ = passes[k];
@@ -314,7 +314,7 @@ void GpuFleet::flush() {
     }
     pass_sheet_ = -1;
     glm::uvec4 grids[SIM_HASH_DISPATCHES] = {};
-    std::copy(hash_slots_.grids().begin(), hash_slots_.grids().end(), grids);
+    std::copy(hash_grids_.grids().begin(), hash_grids_.grids().end(), grids);
     std::memcpy(inputs + args_at, grids, sizeof(grids));
   } else if (!passes.empty()) {
     // The per-colour passes of the most substeps and iterations, each for every sheet; a sheet
@@ -328,15 +328,14 @@ void GpuFleet::flush() {
       barrier();
     }
     uint32_t count = 0;
-    hash_slots_.clear();
+    hash_grids_.clear();
     for (uint32_t s = 0; s < pass_substeps; ++s) recordSubstep(*this, passes_, topo_, sizes_, plan, s, count);
     // The batch's indirect arguments (the copy recorded above takes them at submission): the full
     // grids, and the live ones of every substep with no workgroups until a sheet needs them
     glm::uvec4 args[SIM_BATCH_ARGS_COUNT] = {};
     const uint32_t compact_groups = (sizes_.tear_slots + SIM_WG_TEAR - 1) / SIM_WG_TEAR;
-    const uint32_t cx = std::min<uint32_t>(compact_groups, SIM_MAX_GROUPS_X);
-    args[SIM_BATCH_ARGS_FULL_COMPACT] = glm::uvec4(cx, (compact_groups + cx - 1) / cx, pass_sheets_, 0);
-    for (uint32_t k = 0; k < hash_slots_.grids().size(); ++k) args[k] = hash_slots_.grids()[k];
+    args[SIM_BATCH_ARGS_FULL_COMPACT] = glm::uvec4(groupGrid(compact_groups), pass_sheets_, 0);
+    for (uint32_t k = 0; k < hash_grids_.grids().size(); ++k) args[k] = hash_grids_.grids()[k];
     for (uint32_t s = 0; s < SIM_MAX_SUBSTEPS; ++s) {
       for (uint32_t k = 0; k < SIM_HASH_DISPATCHES; ++k)
         args[SIM_BATCH_ARGS_LIVE_HASH + s * SIM_HASH_DISPATCHES + k] = glm::uvec4(0, args[k].y, pass_sheets_, 0);
@@ -350,7 +349,7 @@ void GpuFleet::flush() {
   pending_ = true;
 }
 
-void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
+void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
                     uint32_t substep, uint32_t gate, uint32_t gate_arg) {
   if (pass_sheet_ >= 0) {
     passOfSheet(uint32_t(pass_sheet_), p, grid, count, push, push_size);
@@ -363,7 +362,7 @@ void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
   // arm (the gates skip the other sheets).
   if ((grid == Grid::Threads || grid == Grid::Hash) && count == 0) return;
   const glm::uvec4 full = fullGrid(p, grid == Grid::Threads || grid == Grid::Hash ? count : 1u, pass_sheets_);
-  const uint32_t hash_slot = hash_slots_.record(grid, full);
+  const uint32_t hash_dispatch = hash_grids_.record(grid, full);
   BatchPassPush bp{};
   if (push_size) std::memcpy(&bp.pass, push, push_size);
   const VkDeviceAddress table = table_address_;
@@ -386,7 +385,7 @@ void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
     break;
   case Grid::Hash:
     vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer,
-                          16ull * (SIM_BATCH_ARGS_LIVE_HASH + substep * SIM_HASH_DISPATCHES + hash_slot));
+                          16ull * (SIM_BATCH_ARGS_LIVE_HASH + substep * SIM_HASH_DISPATCHES + hash_dispatch));
     break;
   case Grid::Compaction:
     vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer, 16ull * (SIM_BATCH_ARGS_LIVE_COMPACT + substep));
@@ -395,7 +394,7 @@ void GpuFleet::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
   ++last_dispatches_;
 }
 
-void GpuFleet::passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
+void GpuBatch::passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
                            uint32_t push_size) {
   const SheetPassTarget target{cmd_,
                                sheet_layout_,
@@ -403,12 +402,12 @@ void GpuFleet::passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint
                                sliceOffset(SIM_BIND_HASH_ARGS, i),
                                buf_[SIM_BIND_COUNTERS].buffer,
                                sliceOffset(SIM_BIND_COUNTERS, i)};
-  if (recordSheetPass(target, bound_, hash_slots_, p, grid, count, push, push_size)) ++last_dispatches_;
+  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size)) ++last_dispatches_;
 }
 
-void GpuFleet::barrier() { computeToCompute(cmd_); }
+void GpuBatch::barrier() { computeToCompute(cmd_); }
 
-uint64_t GpuFleet::memoryBytes() const {
+uint64_t GpuBatch::memoryBytes() const {
   uint64_t total = table_.size + inputs_.size;
   for (const Buffer& b : buf_) total += b.size;
   return total;

@@ -1,5 +1,5 @@
 #pragma once
-/// A fleet of sheets on Vulkan: each of the sheet's storage buffers holds a slice per sheet, and
+/// A batch of sheets on Vulkan: each of the sheet's storage buffers holds a slice per sheet, and
 /// the shaders reach a sheet's slices by device address from a table (SIM_BATCH_* in sim_config.h).
 /// Sheets that take the fused tick run it in one dispatch of tick_batch.comp, one workgroup each;
 /// the others run the per-colour passes, each pass one dispatch for all of them (a sheet per
@@ -20,12 +20,9 @@
 
 namespace tender::gpu {
 
-/// `v` rounded up to a multiple of `a`.
-inline VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
-
-/// How a fleet runs the per-colour passes of the sheets the fused tick does not take. Both give
+/// How a batch runs the per-colour passes of the sheets the fused tick does not take. Both give
 /// every sheet the bits of its run alone.
-enum class FleetPasses : uint8_t {
+enum class BatchPasses : uint8_t {
   Auto,    ///< Batched on a GPU, PerSheet on a CPU device
   Batched, ///< each pass one dispatch for every sheet (a sheet per workgroup z, the SIM_BATCH_PASS builds)
   /// each sheet's passes in turn, on a descriptor set over its slices (the solver's own shaders):
@@ -33,20 +30,20 @@ enum class FleetPasses : uint8_t {
   PerSheet,
 };
 
-class GpuFleet final : public SheetBatch, private PassSink {
+class GpuBatch final : public SheetBatch, private PassSink {
 public:
-  /// A fleet of `sheets` sheets on an existing context (it must outlive the fleet). Throws with
+  /// A batch of `sheets` sheets on an existing context (it must outlive the batch). Throws with
   /// one line when the device cannot run it (no device addresses).
-  GpuFleet(VulkanContext& ctx, uint32_t sheets, FleetPasses passes = FleetPasses::Auto);
-  /// A fleet that owns its context.
-  GpuFleet(std::unique_ptr<VulkanContext> ctx, uint32_t sheets);
-  /// True when the per-colour passes run sheet by sheet (FleetPasses::PerSheet).
+  GpuBatch(VulkanContext& ctx, uint32_t sheets, BatchPasses passes = BatchPasses::Auto);
+  /// A batch that owns its context.
+  GpuBatch(std::unique_ptr<VulkanContext> ctx, uint32_t sheets);
+  /// True when the per-colour passes run sheet by sheet (BatchPasses::PerSheet).
   bool passesPerSheet() const { return per_sheet_; }
   /// Keeps (default) or drops the collision candidate lists, as GpuSolver::setCandidateLists.
   void setCandidateLists(bool keep) { candidates_allowed_ = keep; }
-  ~GpuFleet() override;
-  GpuFleet(const GpuFleet&) = delete;
-  GpuFleet& operator=(const GpuFleet&) = delete;
+  ~GpuBatch() override;
+  GpuBatch(const GpuBatch&) = delete;
+  GpuBatch& operator=(const GpuBatch&) = delete;
 
   std::string name() const override { return "gpu"; }
   uint32_t size() const override { return uint32_t(queued_.size()); }
@@ -62,7 +59,7 @@ private:
   class Sheet;
   friend class Sheet;
 
-  void create(uint32_t sheets, FleetPasses passes);
+  void create(uint32_t sheets, BatchPasses passes);
   // PassSink: a pass of the per-colour path for the sheets at queue[pass_first_, + pass_sheets_)
   void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t substep,
             uint32_t gate, uint32_t gate_arg) override;
@@ -71,7 +68,7 @@ private:
                    uint32_t push_size);
   void barrier() override;
   void mark(PassCategory) override {}
-  /// Allocates every buffer for the fleet from the first sheet's topology.
+  /// Allocates every buffer for the batch from the first sheet's topology.
   void allocate(const SheetTopology& topo);
   void uploadSheet(uint32_t i, const SheetTopology& topo);
   void resetSheet(uint32_t i);
@@ -79,12 +76,8 @@ private:
   glm::vec4 readParticle(uint32_t i, uint32_t particle);
   std::vector<glm::vec4> readSheetPositions(uint32_t i);
   void readSheetDeltas(uint32_t i, std::vector<glm::vec4>& out);
-  /// Copies `bytes` of each (binding, sheet) slice listed into one host buffer; returns it.
-  Buffer download(const std::vector<std::pair<uint32_t, VkDeviceSize>>& slices, uint32_t sheet,
-                  std::vector<VkDeviceSize>& offsets);
-  /// Records the start contents of sheet i's slices of the table's bindings (those a reset restores).
-  void stage(VkCommandBuffer cmd, uint32_t i, const std::vector<BindingSpec>& table, bool restored_only,
-             Buffer& staging);
+  /// Where sheet i's bindings live: its slices.
+  SheetPlace place(uint32_t i) const;
   VkDeviceSize sliceOffset(uint32_t binding, uint32_t sheet) const { return stride_[binding] * sheet; }
 
   std::unique_ptr<VulkanContext> owned_ctx_;
@@ -94,9 +87,9 @@ private:
 
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   PipelineSet owned_pipelines_;
-  ComputePipeline tick_batch_;     ///< the fused tick of a fleet (null: the device has too little shared memory)
-  SimPipelines passes_;            ///< the per-colour passes of a fleet (SIM_BATCH_PASS)
-  bool per_sheet_ = false;         ///< FleetPasses::PerSheet
+  ComputePipeline tick_batch_;     ///< the fused tick of a batch (null: the device has too little shared memory)
+  SimPipelines passes_;            ///< the per-colour passes of a batch (SIM_BATCH_PASS)
+  bool per_sheet_ = false;         ///< BatchPasses::PerSheet
   bool candidates_allowed_ = true; ///< setCandidateLists
   VkDescriptorSetLayout sheet_set_layout_ = VK_NULL_HANDLE; ///< PerSheet: a sheet's set, as the solver's
   VkPipelineLayout sheet_layout_ = VK_NULL_HANDLE;
@@ -107,7 +100,7 @@ private:
   float fused_max_cell_spacings_ = -1.0f;     ///< largest hash cell the fused tick takes (< 0: any; FusedShape)
   float spacing_ = 0.0f;                      ///< the sheets' grid spacing
   uint32_t pass_first_ = 0, pass_sheets_ = 0; ///< the sheets in the queue the passes being recorded run for
-  HashSlots hash_slots_;                      ///< full grids of the hash passes, in recording order
+  HashGrids hash_grids_;                      ///< full grids of the hash passes, in recording order
   VkPipeline bound_ = VK_NULL_HANDLE;         ///< pipeline bound while recording
   FloatRules float_rules_;
   MathSwitches math_;

@@ -1,0 +1,63 @@
+// Per-element bodies of the simulation's passes that the CPU reference runs as they are (the
+// projection, the air, the tear marks): the
+// shaders' main()s and the fused tick call them (sim_elements.glsl includes this file after the
+// buffers), and so does CpuSolver (src/cpu/sheet_elements.h includes it inside a struct whose
+// members bear the buffers' names). They read the sheet by those names: u (SimUniforms), prev,
+// torn, tri_edges, counters, and the positions through SIM_POSITION(j); atomicAdd and
+// atomicExchange are GLSL's (C++: sheet_elements.h).
+#ifndef SIM_BODIES_H
+#define SIM_BODIES_H
+
+/// Projects constraint c (one colour's constraints share no particle, so no races): both ends
+/// move by solveDistance, weighted by inverse mass.
+SIM_INLINE void projectConstraint(Constraint c) {
+  vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b); // a != b: each end is read once
+  PairDelta d = solveDistance(pa, pb, c.rest, u.stiffness[c.kind_id & SIM_KIND_MASK]);
+  SIM_POSITION(c.a) = pa + vec4(d.da, 0.0f);
+  SIM_POSITION(c.b) = pb + vec4(d.db, 0.0f);
+}
+
+/// True when triangle t (original id) has lost an edge.
+SIM_INLINE bool triangleGone(uint t) {
+  uvec2 e = tri_edges[t];
+  return torn[e.x] != 0u || torn[e.y] != 0u;
+}
+
+/// The air on particle i (SIM_FLAG_AIR): meanAir of airOnTriangle over its live triangles, each
+/// at the positions (SIM_POSITION) and previous positions of the start of the substep.
+SIM_INLINE vec3 airOnParticle(uint i) {
+  vec3 sum = vec3(0.0f);
+  uint count = 0u;
+  for (uint k = 0u; k < 6u; ++k) {
+    uint t = particleTriangle(i, k, u.cols, u.rows);
+    if (t == SIM_NONE || triangleGone(t)) continue;
+    uvec3 c = gridTriangle(t, u.cols);
+    sum += airOnTriangle(vec3(SIM_POSITION(c.x)), vec3(SIM_POSITION(c.y)), vec3(SIM_POSITION(c.z)), vec3(prev[c.x]),
+                         vec3(prev[c.y]), vec3(prev[c.z]), u.air);
+    ++count;
+  }
+  return meanAir(sum, count);
+}
+
+/// Marks constraint c (ends at pa, pb; not torn yet) when stretched beyond the tear threshold and
+/// counts it once; true for the first mark of the substep.
+SIM_INLINE bool markTear(Constraint c, vec4 pa, vec4 pb) {
+  if (!shouldTear(pa, pb, c.rest, c.kind_id & SIM_KIND_MASK, u.tear_factor, u.tear_kinds)) return false;
+  if (atomicExchange(torn[c.kind_id >> SIM_KIND_BITS], 1u) != 0u) return false; // a copy marked it first
+  atomicAdd(counters.torn_total, 1u);
+  return atomicAdd(counters.torn_new, 1u) == 0u;
+}
+
+/// After the tear marks of a substep (and only when something tore): marks a shear or tri-bend
+/// constraint that has lost its triangles (unsupported in xpbd.h). It reads the flags of structural
+/// constraints only, which no longer change in this substep.
+SIM_INLINE void markUnsupported(Constraint c) {
+  uint kind = c.kind_id & SIM_KIND_MASK, id = c.kind_id >> SIM_KIND_BITS;
+  if ((kind != SIM_KIND_SHEAR && kind != SIM_KIND_TRIBEND) || torn[id] != 0u) return;
+  uvec2 t = supportTriangles(c.a, c.b, kind, u.cols);
+  if (!unsupported(kind, triangleGone(t.x), triangleGone(t.y))) return;
+  if (atomicExchange(torn[id], 1u) != 0u) return; // a copy marked it first
+  atomicAdd(counters.torn_total, 1u);
+  atomicAdd(counters.torn_new, 1u);
+}
+#endif

@@ -1,0 +1,136 @@
+// The passes of the simulation: one table each for its kernels, the stages of a substep and the
+// dispatches of each stage, read by GLSL, C++ and CMake alike. What runs, in which order, how it
+// is numbered, gated and timed is derived from these rows:
+//   SIM_KERNELS    the pipelines (SimPipelines' members, makePassPipelines) and the kernels a fleet
+//                  also builds batched (shaders/CMakeLists.txt reads the rows)
+//   SIM_STAGES     the numbered passes of a substep: `tender diff` and a tick cut short
+//                  (core/passes.h), the CPU tick's order (CpuSolver::tick), the fused tick's pass
+//                  numbers (fused_tick.glsl)
+//   SIM_DISPATCHES what the per-colour path records for each stage (gpu/substep_passes.cpp): the
+//                  sheet's solver and a fleet alike
+// Keep one row per line, as written. A new pass is a row here, its shader and its shared body:
+// docs/ARCHITECTURE.md §3a has the recipe.
+#ifndef SIM_PASSES_H
+#define SIM_PASSES_H
+#include "prelude.h"
+#include "sim_config.h"
+
+// The per-colour kernels, in the order a substep dispatches them (normals runs once a frame,
+// reset during the animated reset).
+// X(name, push, per_invocation, batched)
+//   name            shaders/sim/<name>.comp.glsl, SimPipelines::<name>
+//   push            its push constants: SIM (SimPush), SCAN (ScanPush) or NONE
+//   per_invocation  elements one invocation covers
+//   batched         1: a fleet runs it once for the whole batch (built again with SIM_BATCH_PASS)
+#define SIM_KERNELS(X)                                                                                                 \
+  X(air, SIM, 1, 1)                                                                                                    \
+  X(integrate, SIM, 1, 1)                                                                                              \
+  X(project, SIM, 1, 1)                                                                                                \
+  X(candidates_check, SIM, 1, 1)                                                                                       \
+  X(candidates_decide, SIM, 1, 1)                                                                                      \
+  X(hash_count, SIM, 1, 1)                                                                                             \
+  X(scan, SCAN, SIM_SCAN_PER_THREAD, 1)                                                                                \
+  X(scan_add, SCAN, 1, 1)                                                                                              \
+  X(hash_scatter, SIM, 1, 1)                                                                                           \
+  X(hash_sort, SIM, 1, 1)                                                                                              \
+  X(collide, SIM, 1, 1)                                                                                                \
+  X(candidates_finish, SIM, 1, 1)                                                                                      \
+  X(floor, SIM, 1, 1)                                                                                                  \
+  X(tear_mark, SIM, 1, 1)                                                                                              \
+  X(tear_unsupported, NONE, 1, 1)                                                                                      \
+  X(tear_flags, NONE, 1, 1)                                                                                            \
+  X(tear_compact, NONE, 1, 1)                                                                                          \
+  X(normals, SIM, 1, 0)                                                                                                \
+  X(reset, SIM, 1, 1)
+
+// The stages of a substep, in the order they run; each is one numbered pass, or one per colour of
+// each iteration. A tick numbers its passes substep x passesPerSubstep + the pass within the
+// substep.
+// X(name, id, repeat, condition)
+//   name       what `tender diff` and TENDER_TEST_PLANT_ULP call it; PassKind::<name> in C++
+//   id         its place in this table (0u, 1u, ...); SIM_STAGE_<name>
+//   repeat     ONCE, or COLOUR: once per colour of each iteration
+//   condition  ALWAYS, or COLLISION: only while collision is on
+#define SIM_STAGES(X)                                                                                                  \
+  X(integrate, 0u, ONCE, ALWAYS)                                                                                       \
+  X(project, 1u, COLOUR, ALWAYS)                                                                                       \
+  X(collide, 2u, ONCE, COLLISION)                                                                                      \
+  X(floor, 3u, ONCE, ALWAYS)                                                                                           \
+  X(tear, 4u, ONCE, ALWAYS)
+#define SIM_STAGE_COUNT 5u
+
+// The dispatches of each stage, in the order the per-colour path records them (a barrier after
+// each). The fused tick and the CPU run the same bodies in the same order.
+// X(stage, kernel, elements, grid, gate, needs, category)
+//   stage     its row in SIM_STAGES
+//   kernel    its row in SIM_KERNELS (scan: a scan of several blocks adds scan and scan_add)
+//   elements  what it covers and its push constants: PARTICLES, COLOUR (the stage's colour),
+//             CONSTRAINTS, ONE (one invocation), HASH_ARGS (one invocation, the hash's
+//             arguments), HASH_CELLS and TEAR_SLOTS (a scan of the hash's cells or of the
+//             compaction's slots), INDIRECT (the grid's arguments, no push constants)
+//   grid      Threads (from the elements), Hash (the live hash arguments candidates_decide
+//             copies) or Compaction (the tear compaction's arguments): gpu::Grid
+//   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)
+//   needs     ALWAYS, AIR (the sheet has air) or CONSTRAINTS (the sheet has constraints)
+//   category  its timestamp category (gpu::PassCategory k<category>)
+#define SIM_DISPATCHES(X)                                                                                              \
+  X(integrate, air, PARTICLES, Threads, AIR, AIR, Integrate)                                                           \
+  X(integrate, integrate, PARTICLES, Threads, TICK, ALWAYS, Integrate)                                                 \
+  X(project, project, COLOUR, Threads, ITERATION, ALWAYS, Project)                                                     \
+  X(collide, candidates_check, PARTICLES, Threads, COLLISION, ALWAYS, Hash)                                            \
+  X(collide, candidates_decide, HASH_ARGS, Threads, COLLISION, ALWAYS, Hash)                                           \
+  X(collide, hash_count, PARTICLES, Hash, HASH, ALWAYS, Hash)                                                          \
+  X(collide, scan, HASH_CELLS, Hash, HASH, ALWAYS, Hash)                                                               \
+  X(collide, hash_scatter, PARTICLES, Hash, HASH, ALWAYS, Hash)                                                        \
+  X(collide, hash_sort, PARTICLES, Hash, HASH, ALWAYS, Hash)                                                           \
+  X(collide, collide, PARTICLES, Threads, COLLISION, ALWAYS, Collide)                                                  \
+  X(collide, candidates_finish, ONE, Threads, COLLISION, ALWAYS, Collide)                                              \
+  X(floor, floor, PARTICLES, Threads, TICK, ALWAYS, Floor)                                                             \
+  X(tear, tear_mark, CONSTRAINTS, Threads, TICK, CONSTRAINTS, Tear)                                                    \
+  X(tear, tear_unsupported, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                       \
+  X(tear, tear_flags, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                             \
+  X(tear, scan, TEAR_SLOTS, Compaction, COMPACTION, CONSTRAINTS, Tear)                                                 \
+  X(tear, tear_compact, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)
+
+#define SIM_STAGE_ID(name, id, repeat, condition) SIM_CONST uint SIM_STAGE_##name = id;
+SIM_STAGES(SIM_STAGE_ID)
+#undef SIM_STAGE_ID
+
+// A stage's condition and repeat as values (stagePasses)
+#define SIM_STAGE_RUNS_ALWAYS true
+#define SIM_STAGE_RUNS_COLLISION false
+#define SIM_STAGE_REPEATS_ONCE false
+#define SIM_STAGE_REPEATS_COLOUR true
+
+/// Passes stage `stage` numbers in a substep of `iterations` x `colors` projections, with
+/// collision on or off (0: it does not run).
+SIM_INLINE uint stagePasses(uint stage, uint iterations, uint colors, bool collision) {
+  uint passes = 0u;
+#define SIM_STAGE_PASSES(name, id, repeat, condition)                                                                  \
+  if (stage == id && (SIM_STAGE_RUNS_##condition || collision))                                                        \
+    passes = SIM_STAGE_REPEATS_##repeat ? iterations * colors : 1u;
+  SIM_STAGES(SIM_STAGE_PASSES)
+#undef SIM_STAGE_PASSES
+  return passes;
+}
+
+/// Number within its substep of the first pass of stage `stage` (of SIM_STAGE_COUNT: the passes of
+/// a substep).
+SIM_INLINE uint stageFirstPass(uint stage, uint iterations, uint colors, bool collision) {
+  uint first = 0u;
+  for (uint k = 0u; k < stage; ++k) first += stagePasses(k, iterations, colors, collision);
+  return first;
+}
+
+/// The grid of `groups` workgroups: at most SIM_MAX_GROUPS_X in x, the rest spilled into y (the
+/// shaders linearise the group index, threadIndex in sim_common.glsl).
+SIM_INLINE uvec2 groupGrid(uint groups) {
+  uint gx = min(groups, uint(SIM_MAX_GROUPS_X));
+  return uvec2(gx, gx > 0u ? (groups + gx - 1u) / gx : 0u);
+}
+
+/// Passes one substep numbers.
+SIM_INLINE uint passesPerSubstep(uint iterations, uint colors, bool collision) {
+  return stageFirstPass(SIM_STAGE_COUNT, iterations, colors, collision);
+}
+#endif

@@ -1,0 +1,148 @@
+// The per-colour path records a substep as the pass table says (SIM_STAGES, SIM_DISPATCHES in
+// shaders/shared/sim_passes.h): the stages in their numbered order, every pass of a stage its
+// dispatches, a timestamp where each category ends, and a tick cut short after pass k records the
+// dispatches of passes 0..k and nothing more. No device: the sink only writes down what it is given.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "core/passes.h"
+#include "core/sheet.h"
+#include "gpu/substep_passes.h"
+
+using namespace tender;
+using namespace tender::gpu;
+
+namespace {
+
+struct Recorded {
+  std::string kernel;
+  uint32_t gate = 0, gate_arg = 0;
+};
+
+/// Writes down each pass (by kernel name), barrier and mark.
+class RecordingSink final : public PassSink {
+public:
+  explicit RecordingSink(const SimPipelines& pipes) {
+#define NAME_OF(name, push, per_invocation, batched) names_.emplace_back(pipes.name.pipeline, #name);
+    SIM_KERNELS(NAME_OF)
+#undef NAME_OF
+  }
+  void pass(const ComputePipeline& p, Grid, uint32_t, const void*, uint32_t, uint32_t, uint32_t gate,
+            uint32_t gate_arg) override {
+    for (const auto& [pipeline, name] : names_)
+      if (pipeline == p.pipeline) passes.push_back({name, gate, gate_arg});
+    ++barriers_due;
+  }
+  void barrier() override { barriers_due = 0; }
+  void mark(PassCategory c) override { marks.push_back(c); }
+
+  std::vector<Recorded> passes;
+  std::vector<PassCategory> marks;
+  uint32_t barriers_due = 0; ///< passes recorded since the last barrier
+
+private:
+  std::vector<std::pair<VkPipeline, std::string>> names_;
+};
+
+/// Pipelines with distinct (never dispatched) handles.
+SimPipelines fakePipelines() {
+  SimPipelines pipes;
+  uintptr_t handle = 1;
+#define FAKE(name, push, per_invocation, batched) pipes.name.pipeline = reinterpret_cast<VkPipeline>(handle++);
+  SIM_KERNELS(FAKE)
+#undef FAKE
+  return pipes;
+}
+
+std::vector<std::string> kernels(const std::vector<Recorded>& passes) {
+  std::vector<std::string> names;
+  for (const Recorded& r : passes) names.push_back(r.kernel);
+  return names;
+}
+
+} // namespace
+
+TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
+  SimParams p = *presetParams("tender");
+  p.cols = 8;
+  p.rows = 6;
+  const SheetTopology topo = buildSheet(p);
+  const SheetLayout sizes = SheetLayout::of(topo, VkDeviceSize(1) << 27);
+  const SimPipelines pipes = fakePipelines();
+  RecordingSink sink(pipes);
+  uint32_t pass = 0;
+  const SubstepPlan plan{2, true, true, SIM_NONE};
+  EXPECT_FALSE(recordSubstep(sink, pipes, topo, sizes, plan, 0, pass));
+  EXPECT_EQ(pass, shaderio::passesPerSubstep(2, topo.colorCount(), true));
+  EXPECT_EQ(sink.barriers_due, 0u); // every pass is followed by a barrier
+
+  std::vector<std::string> expected = {"air", "integrate"};
+  std::vector<uint32_t> iterations;
+  for (uint32_t it = 0; it < 2; ++it)
+    for (const ColorRange& range : topo.colors)
+      if (range.count > 0) {
+        expected.push_back("project");
+        iterations.push_back(it);
+      }
+  for (const char* k :
+       {"candidates_check", "candidates_decide", "hash_count", "scan", "hash_scatter", "hash_sort", "collide",
+        "candidates_finish", "floor", "tear_mark", "tear_unsupported", "tear_flags", "scan", "tear_compact"})
+    expected.push_back(k);
+  EXPECT_EQ(kernels(sink.passes), expected);
+  for (size_t k = 0, project = 0; k < sink.passes.size(); ++k)
+    if (sink.passes[k].kernel == "project") {
+      EXPECT_EQ(sink.passes[k].gate, SIM_GATE_ITERATION);
+      EXPECT_EQ(sink.passes[k].gate_arg, iterations[project++]);
+    }
+  EXPECT_EQ(sink.marks, (std::vector<PassCategory>{kIntegrate, kProject, kHash, kCollide, kFloor, kTear}));
+  EXPECT_EQ(marksPerSubstep(), sink.marks.size());
+}
+
+TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
+  SimParams p = *presetParams("tender");
+  p.cols = 6;
+  p.rows = 5;
+  const SheetTopology topo = buildSheet(p);
+  const SheetLayout sizes = SheetLayout::of(topo, VkDeviceSize(1) << 27);
+  for (const ColorRange& range : topo.colors) ASSERT_GT(range.count, 0u);
+  const SimPipelines pipes = fakePipelines();
+  shaderio::SimUniforms u{};
+  u.substeps = 1;
+  u.iterations = 1;
+  u.color_count = topo.colorCount();
+  u.flags = SIM_FLAG_COLLISION;
+  // The last kernel each stage records
+  const auto lastOf = [](PassKind kind) -> std::string {
+    switch (kind) {
+    case PassKind::integrate:
+      return "integrate";
+    case PassKind::project:
+      return "project";
+    case PassKind::collide:
+      return "candidates_finish";
+    case PassKind::floor:
+      return "floor";
+    case PassKind::tear:
+      return "tear_compact";
+    case PassKind::reset:
+      break;
+    }
+    return "?";
+  };
+  for (uint32_t stop = 0; stop < passesPerTick(u); ++stop) {
+    RecordingSink sink(pipes);
+    uint32_t pass = 0;
+    EXPECT_TRUE(recordSubstep(sink, pipes, topo, sizes, SubstepPlan{1, true, false, stop}, 0, pass)) << stop;
+    EXPECT_EQ(pass, stop + 1);
+    const PassPoint at = passAt(u, stop);
+    ASSERT_FALSE(sink.passes.empty());
+    EXPECT_EQ(sink.passes.back().kernel, lastOf(at.kind)) << describePass(at);
+    if (at.kind == PassKind::project) {
+      size_t projects = 0;
+      for (const Recorded& r : sink.passes) projects += r.kernel == "project";
+      EXPECT_EQ(projects, at.color + 1) << describePass(at); // every colour of this sheet has constraints
+    }
+  }
+}
