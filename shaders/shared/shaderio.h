@@ -2,6 +2,7 @@
 /// C++ view of the GPU structs and per-element maths of the headers beside this one (C++ only:
 /// GLSL includes those headers directly).
 /// The same headers compile as GLSL; `using namespace glm` makes vec4, dot, length mean the same here.
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -10,6 +11,31 @@
 namespace shaderio {
 using namespace glm;
 using uint = glm::uint;
+
+/// GLSL's atomicExchange and atomicAdd, for the element bodies (sim_bodies.h) on a word other
+/// threads of a parallel loop may touch (relaxed: the end of the loop orders them, as a pipeline
+/// barrier does on the GPU).
+inline uint atomicExchange(uint& word, uint value) {
+  return std::atomic_ref<uint>(word).exchange(value, std::memory_order_relaxed);
+}
+inline uint atomicAdd(uint& word, uint value) {
+  return std::atomic_ref<uint>(word).fetch_add(value, std::memory_order_relaxed);
+}
+
+/// An array of words that threads of a parallel loop read while others set them (the torn flags
+/// in markUnsupported): `words[i]` reads with a relaxed atomic load and goes to atomicExchange and
+/// atomicAdd as a word, so the element bodies read as GLSL and race-free as C++.
+struct SharedWords {
+  uint* data;
+  struct Word {
+    uint* p;
+    operator uint() const { return std::atomic_ref<uint>(*p).load(std::memory_order_relaxed); }
+  };
+  Word operator[](uint i) const { return Word{data + i}; }
+};
+inline uint atomicExchange(SharedWords::Word word, uint value) { return atomicExchange(*word.p, value); }
+inline uint atomicAdd(SharedWords::Word word, uint value) { return atomicAdd(*word.p, value); }
+
 #include "sim_types.h"
 #include "xpbd.h"
 

@@ -4,9 +4,14 @@
 // buffers), and so does CpuSolver (src/cpu/sheet_elements.h includes it inside a struct whose
 // members bear the buffers' names). They read the sheet by those names: u (SimUniforms), prev,
 // torn, tri_edges, counters, and the positions through SIM_POSITION(j); atomicAdd and
-// atomicExchange are GLSL's (C++: sheet_elements.h).
+// atomicExchange are GLSL's (C++: shaderio.h).
 #ifndef SIM_BODIES_H
 #define SIM_BODIES_H
+
+// Position of particle j as the bodies read and write it (the fused tick: shared memory)
+#ifndef SIM_POSITION
+#define SIM_POSITION(j) pos[j]
+#endif
 
 /// Projects constraint c (one colour's constraints share no particle, so no races): both ends
 /// move by solveDistance, weighted by inverse mass.
@@ -48,14 +53,35 @@ SIM_INLINE bool markTear(Constraint c, vec4 pa, vec4 pb) {
   return atomicAdd(counters.torn_new, 1u) == 0u;
 }
 
-/// After the tear marks of a substep (and only when something tore): marks a shear or tri-bend
-/// constraint that has lost its triangles (unsupported in xpbd.h). It reads the flags of structural
-/// constraints only, which no longer change in this substep.
+/// True when no live triangle holds the structural edge from particle a to its grid neighbour b
+/// (edgeTriangles in xpbd.h). An edge no triangle holds at all (a sheet one particle wide) holds
+/// itself.
+SIM_INLINE bool edgeCut(uint a, uint b) {
+  uvec2 t = edgeTriangles(a, b, u.cols, u.rows);
+  bool held = (t.x != SIM_NONE && !triangleGone(t.x)) || (t.y != SIM_NONE && !triangleGone(t.y));
+  return !held && (t.x != SIM_NONE || t.y != SIM_NONE);
+}
+
+/// After the tear marks of a substep (and only when something tore): marks a constraint that no
+/// longer stands on the sheet, so that no constraint ties two pieces of the triangle mesh: a
+/// structural edge no live triangle holds, a bend over such an edge, a shear or tri-bend that has
+/// lost its triangles (unsupported in xpbd.h). Whether a triangle is gone is settled by the tear
+/// marks before this pass; the structural edges this pass marks are held by no live triangle, so
+/// marking them changes no triangle and the verdicts do not depend on the order.
 SIM_INLINE void markUnsupported(Constraint c) {
   uint kind = c.kind_id & SIM_KIND_MASK, id = c.kind_id >> SIM_KIND_BITS;
-  if ((kind != SIM_KIND_SHEAR && kind != SIM_KIND_TRIBEND) || torn[id] != 0u) return;
-  uvec2 t = supportTriangles(c.a, c.b, kind, u.cols);
-  if (!unsupported(kind, triangleGone(t.x), triangleGone(t.y))) return;
+  if (torn[id] != 0u) return;
+  bool cut;
+  if (kind == SIM_KIND_STRUCTURAL) {
+    cut = edgeCut(c.a, c.b);
+  } else if (kind == SIM_KIND_BEND) {
+    uint mid = (c.a + c.b) / 2u; // a bend spans two structural edges of a row or a column
+    cut = edgeCut(c.a, mid) || edgeCut(mid, c.b);
+  } else {
+    uvec2 t = supportTriangles(c.a, c.b, kind, u.cols);
+    cut = unsupported(c.a, c.b, kind, u.cols, triangleGone(t.x), triangleGone(t.y));
+  }
+  if (!cut) return;
   if (atomicExchange(torn[id], 1u) != 0u) return; // a copy marked it first
   atomicAdd(counters.torn_total, 1u);
   atomicAdd(counters.torn_new, 1u);

@@ -135,12 +135,28 @@ SIM_INLINE uvec2 supportTriangles(uint a, uint b, uint kind, uint cols) {
   return dy == 1u ? uvec2(2u * (y * quads + x) + 1u, 2u * (y * quads + x + 1u)) : uvec2(SIM_NONE, SIM_NONE);
 }
 
-/// True when a constraint has lost what it stands on (gone0, gone1: its support triangles lost an
-/// edge): a shear once the quad it crosses has lost both triangles (the sheet has parted there, a
-/// fold tears nothing), a tri-bend once either triangle of its hinge is gone.
-SIM_INLINE bool unsupported(uint kind, bool gone0, bool gone1) {
-  if (kind == SIM_KIND_SHEAR) return gone0 && gone1;
-  return kind == SIM_KIND_TRIBEND && (gone0 || gone1);
+/// True when a shear or tri-bend constraint from particle a to particle b (a < b) of a
+/// `cols`-wide grid has lost what it stands on (gone0, gone1: its support triangles lost an edge).
+/// A shear along the diagonal both halves of its quad share (top-left to bottom-right) goes once
+/// both are gone; the other diagonal, which crosses both halves, and a tri-bend, which crosses both
+/// triangles of its hinge, go once either is. No constraint then spans a triangle the sheet has
+/// lost, so torn pieces come apart; a fold tears nothing.
+SIM_INLINE bool unsupported(uint a, uint b, uint kind, uint cols, bool gone0, bool gone1) {
+  bool shared_diagonal = kind == SIM_KIND_SHEAR && b == a + cols + 1u;
+  if (shared_diagonal) return gone0 && gone1;
+  return (kind == SIM_KIND_SHEAR || kind == SIM_KIND_TRIBEND) && (gone0 || gone1);
+}
+
+/// The triangles (original ids; SIM_NONE where the sheet ends) that hold the structural edge from
+/// particle a to its grid neighbour b = a + 1 or a + cols: a row edge is the top edge of the second
+/// triangle of the quad below it and the bottom edge of the first of the quad above; a column edge
+/// the left edge of the first triangle of the quad to its right and the right edge of the second of
+/// the quad to its left.
+SIM_INLINE uvec2 edgeTriangles(uint a, uint b, uint cols, uint rows) {
+  uint x = a % cols, y = a / cols, quads = cols - 1u;
+  if (b == a + 1u)
+    return uvec2(y + 1u < rows ? 2u * (y * quads + x) + 1u : SIM_NONE, y > 0u ? 2u * ((y - 1u) * quads + x) : SIM_NONE);
+  return uvec2(x + 1u < cols ? 2u * (y * quads + x) : SIM_NONE, x > 0u ? 2u * (y * quads + x - 1u) + 1u : SIM_NONE);
 }
 
 /// The particles of triangle t (original id: two per quad, row by row, as buildSheet makes them:

@@ -4,11 +4,8 @@
 #ifndef SIM_ELEMENTS_GLSL
 #define SIM_ELEMENTS_GLSL
 
-// Position of particle j as the per-particle bodies read it (the fused tick: shared memory)
-#ifndef SIM_POSITION
-#define SIM_POSITION(j) pos[j]
-#endif
-// The bodies the CPU reference runs too
+// The bodies the CPU reference runs too; SIM_POSITION(j), the position of particle j as the bodies
+// read it (pos[j], or the fused tick's shared memory)
 #include "sim_bodies.h"
 
 // Spatial hash, step 1: the bucket of particle i (at p) and one more particle in that bucket.

@@ -187,7 +187,7 @@ uint32_t CpuSolver::markUnsupported(const SimUniforms& u) {
 }
 
 SheetElements CpuSolver::elements(const SimUniforms& u) {
-  return SheetElements{u, pos_.data(), prev_.data(), torn_.data(), topo_->tri_edges.data(), counters_};
+  return SheetElements{u, pos_.data(), prev_.data(), SharedWords{torn_.data()}, topo_->tri_edges.data(), counters_};
 }
 
 void CpuSolver::compact() {

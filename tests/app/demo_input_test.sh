@@ -70,7 +70,9 @@ hash=$(sed -n 's/^tender-demo: \([0-9]*\) steps, state hash \([0-9a-f]*\)$/\2/p'
   fail "the recording of the HUD edits does not replay to the demo's state $hash"
 echo "ok: HUD edits recorded as set events replay to the demo's state ($steps steps)"
 
-# A toss to the left, from tick 120: far out of the crumple start view (target 0, -1.8, 0).
+# A toss to the left, from tick 120: far out of the crumple start view (target 0, -1.8, 0). The grab
+# lifts its particle from the floor at once, which tears paper: tearing is off, so that the whole
+# sheet flies (a torn-off corner flies alone, and the rest stays in view).
 toss="$tmp/toss.txt"
 {
   echo "0 pins off"
@@ -80,7 +82,7 @@ toss="$tmp/toss.txt"
 } >"$toss"
 # Runs the toss for 15 s (F pressed first when $1 is "off"); prints the camera's exit line.
 toss_camera() {
-  start_demo --backend cpu --preset crumple --width 800 --height 600 --replay "$toss"
+  start_demo --backend cpu --preset crumple --set tear_factor=0 --width 800 --height 600 --replay "$toss"
   [ "$1" = off ] && xdotool key --window "$wid" f
   sleep 15
   alive "toss"

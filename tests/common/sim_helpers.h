@@ -53,6 +53,27 @@ inline uint32_t tornCount(const SimState& s) {
   return n;
 }
 
+/// Live constraints whose two particles lie in different pieces of the live triangle mesh (a
+/// particle no live triangle holds is a piece of its own): what would tie torn-apart pieces
+/// together. Judged from the state alone, by a union-find over the live triangles' corners.
+inline uint32_t tiesAcrossPieces(const SimState& s) {
+  std::vector<uint32_t> piece(s.pos.size());
+  for (uint32_t i = 0; i < piece.size(); ++i) piece[i] = i;
+  auto find = [&](uint32_t x) {
+    while (piece[x] != x) x = piece[x] = piece[piece[x]];
+    return x;
+  };
+  for (uint32_t t = 0; t < s.triangle_count; ++t) {
+    piece[find(s.triangles[t].x)] = find(s.triangles[t].y);
+    piece[find(s.triangles[t].y)] = find(s.triangles[t].z);
+  }
+  uint32_t ties = 0;
+  for (const ColorRange& range : s.colors)
+    for (uint32_t k = range.first; k < range.first + range.count; ++k)
+      ties += find(s.constraints[k].a) != find(s.constraints[k].b) ? 1u : 0u;
+  return ties;
+}
+
 /// True when two arrays hold the same bytes (and are the same size).
 template <typename T>
 bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {

@@ -1,6 +1,7 @@
-// Torn pieces come apart: once a tear runs across the sheet, the shear and tri-bend constraints
-// of the quads it cut go too (unsupported in xpbd.h), so the sheet is in two pieces that fall
-// apart; folding tears nothing.
+// Torn pieces come apart: once the triangle mesh has parted, no constraint ties its pieces together
+// (markUnsupported in sim_bodies.h: an edge no live triangle holds, a bend over such an edge, a
+// diagonal across a lost triangle, a tri-bend over one), so the pieces fall apart; folding tears
+// nothing.
 #include <algorithm>
 #include <map>
 #include <numeric>
@@ -110,4 +111,25 @@ TEST(Pieces, AHardPullLeavesNothingAboveThePins) {
   }
   EXPECT_GT(tornCount(s), 0u);
   EXPECT_LE(top, pin_y + 1e-3f) << "a particle is " << top - pin_y << " above the pins";
+}
+
+// A piece of the mesh is free: through a hard yank of each preset that tears, and after it, no live
+// constraint joins particles of two pieces of the live triangle mesh (it used to leave bends over
+// cut edges and diagonals across lost triangles, which kept a torn-out shred hanging on the sheet).
+TEST(Pieces, NoConstraintTiesTwoPiecesOfTheMesh) {
+  for (const char* name : {"tender", "crumple"}) {
+    const SimParams p = preset(name, {"wind=off", "cols=24", "rows=36"});
+    CpuSolver solver;
+    Simulation sim(p, solver);
+    sim.setScript(script("0 grab particle 850\n2 move 0 -12 0\n4 move 8 -14 6\n6 move -8 -16 -6\n9 move 0 -30 0\n"
+                         "30 release\n"));
+    uint32_t ties = 0, torn = 0;
+    for (int t = 0; t < 120; t += 10) {
+      const SimState s = run(sim, 10);
+      ties += tiesAcrossPieces(s);
+      torn = tornCount(s);
+    }
+    EXPECT_GT(torn, 0u) << name << ": the yank tears";
+    EXPECT_EQ(ties, 0u) << name << ": live constraints tie pieces of the mesh together";
+  }
 }

@@ -62,14 +62,22 @@ std::vector<std::string> kernels(const std::vector<Recorded>& passes) {
   return names;
 }
 
+/// The topology of a `cols` x `rows` tender sheet.
+SheetTopology tenderSheet(uint32_t cols, uint32_t rows) {
+  SimParams p = *presetParams("tender");
+  p.cols = cols;
+  p.rows = rows;
+  return buildSheet(p);
+}
+
+/// Its layout on a device that binds 128 MiB.
+SheetLayout layoutOf(const SheetTopology& topo) { return SheetLayout::of(topo, VkDeviceSize(1) << 27); }
+
 } // namespace
 
 TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
-  SimParams p = *presetParams("tender");
-  p.cols = 8;
-  p.rows = 6;
-  const SheetTopology topo = buildSheet(p);
-  const SheetLayout sizes = SheetLayout::of(topo, VkDeviceSize(1) << 27);
+  const SheetTopology topo = tenderSheet(8, 6);
+  const SheetLayout sizes = layoutOf(topo);
   const SimPipelines pipes = fakePipelines();
   RecordingSink sink(pipes);
   uint32_t pass = 0;
@@ -101,11 +109,8 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
 }
 
 TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
-  SimParams p = *presetParams("tender");
-  p.cols = 6;
-  p.rows = 5;
-  const SheetTopology topo = buildSheet(p);
-  const SheetLayout sizes = SheetLayout::of(topo, VkDeviceSize(1) << 27);
+  const SheetTopology topo = tenderSheet(6, 5);
+  const SheetLayout sizes = layoutOf(topo);
   for (const ColorRange& range : topo.colors) ASSERT_GT(range.count, 0u);
   const SimPipelines pipes = fakePipelines();
   shaderio::SimUniforms u{};
