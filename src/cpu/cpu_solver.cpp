@@ -1,7 +1,6 @@
 #include "cpu_solver.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 
 #include "core/host_queries.h"
@@ -68,6 +67,7 @@ void CpuSolver::upload(const SheetTopology& topo) {
   triangles_ = topo.triangles;
   triangle_count_ = topo.triangleCount();
   ticks_ = 0;
+  counters_ = {};
   stop_after_ = SIM_NONE;
   collision_.upload(topo.adj_offsets, topo.adj_list, topo.hash_size, grain_);
 }
@@ -144,8 +144,9 @@ void CpuSolver::floorPass(const SimUniforms& u) {
   });
 }
 
-// Marks the live constraints among array slots [begin, end) of the split arrays that shouldTear;
-// returns how many tore. The SIMD length test picks out the few that can tear, 64 at most at a time.
+// Marks the live constraints among array slots [begin, end) of the split arrays that the shaders'
+// markTear tears (counted in counters_.torn_new). The SIMD length test picks out the few that can
+// tear, 64 at most at a time.
 void CpuSolver::markTearsRange(SheetElements& e, uint32_t begin, uint32_t end) {
   const SimUniforms& u = e.u;
   const vec4* p = pos_.data();
