@@ -54,6 +54,7 @@ static_assert(offsetof(PickResult, pos) == 16);
 static_assert(offsetof(SimUniforms, stiffness) == 80);
 static_assert(offsetof(SimUniforms, grab_index) == 96);
 static_assert(offsetof(SimUniforms, air) == 112);
-static_assert(offsetof(SimUniforms, wind) == 128);
-static_assert(sizeof(SimUniforms) == 128 + 4 * 16 * SIM_MAX_SUBSTEPS);
+static_assert(offsetof(SimUniforms, hinge) == 128);
+static_assert(offsetof(SimUniforms, wind) == 176);
+static_assert(sizeof(SimUniforms) == 176 + 4 * 16 * SIM_MAX_SUBSTEPS);
 } // namespace shaderio

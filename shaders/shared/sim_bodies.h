@@ -3,7 +3,7 @@
 // shaders' main()s and the fused tick call them (sim_elements.glsl includes this file after the
 // buffers), and so does CpuSolver (src/cpu/sheet_elements.h includes it inside a struct whose
 // members bear the buffers' names). They read the sheet by those names: u (SimUniforms), prev,
-// torn, tri_edges, counters, and the positions through SIM_POSITION(j); atomicAdd and
+// torn, tri_edges, hinges, counters, and the positions through SIM_POSITION(j); atomicAdd and
 // atomicExchange are GLSL's (C++: shaderio.h).
 #ifndef SIM_BODIES_H
 #define SIM_BODIES_H
@@ -13,13 +13,44 @@
 #define SIM_POSITION(j) pos[j]
 #endif
 
-/// Projects constraint c (one colour's constraints share no particle, so no races): both ends
-/// move by solveDistance, weighted by inverse mass.
-SIM_INLINE void projectConstraint(Constraint c) {
+/// Projects hinge k (SIM_KIND_HINGE) in iteration `iteration` of the substep: one XPBD step of its
+/// four corners toward its rest angle (solveHinge), its multiplier starting from zero in the first
+/// iteration.
+SIM_INLINE void projectHinge(uint k, uint iteration) {
+  uvec4 q = gridHinge(k, u.cols, u.rows);
+  vec4 pu = SIM_POSITION(q.x), pv = SIM_POSITION(q.y), pa = SIM_POSITION(q.z), pb = SIM_POSITION(q.w);
+  HingeState st = hinges[k];
+  float alpha = hingeIsDiagonal(k, u.cols, u.rows) ? 0.5f * u.crease.x : u.crease.x;
+  HingeDelta d = solveHinge(pu, pv, pa, pb, st.x, alpha, iteration == 0u ? 0.0f : st.z);
+  SIM_POSITION(q.x) = pu + vec4(d.du, 0.0f);
+  SIM_POSITION(q.y) = pv + vec4(d.dv, 0.0f);
+  SIM_POSITION(q.z) = pa + vec4(d.da, 0.0f);
+  SIM_POSITION(q.w) = pb + vec4(d.db, 0.0f);
+  hinges[k].z = d.lambda;
+}
+
+/// Projects constraint c in iteration `iteration` of the substep (one colour's constraints share
+/// no particle, so no races): a hinge by projectHinge, any other both ends by solveDistance,
+/// weighted by inverse mass.
+SIM_INLINE void projectConstraint(Constraint c, uint iteration) {
+  if ((c.kind_id & SIM_KIND_MASK) == SIM_KIND_HINGE) {
+    projectHinge((c.kind_id >> SIM_KIND_BITS) - u.hinge.x, iteration);
+    return;
+  }
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b); // a != b: each end is read once
   PairDelta d = solveDistance(pa, pb, c.rest, u.stiffness[c.kind_id & SIM_KIND_MASK]);
   SIM_POSITION(c.a) = pa + vec4(d.da, 0.0f);
   SIM_POSITION(c.b) = pb + vec4(d.db, 0.0f);
+}
+
+/// The crease of hinge k after the substep's projection (creaseReturn), unless it is torn or
+/// degenerate.
+SIM_INLINE void creaseHinge(uint k) {
+  if (torn[u.hinge.x + k] != 0u) return;
+  uvec4 q = gridHinge(k, u.cols, u.rows);
+  HingeAngle h =
+      hingeAngle(vec3(SIM_POSITION(q.x)), vec3(SIM_POSITION(q.y)), vec3(SIM_POSITION(q.z)), vec3(SIM_POSITION(q.w)));
+  if (h.valid) hinges[k] = creaseReturn(hinges[k], h.angle, u.crease.y, u.crease.z);
 }
 
 /// True when triangle t (original id) has lost an edge.
@@ -64,8 +95,8 @@ SIM_INLINE bool edgeCut(uint a, uint b) {
 
 /// After the tear marks of a substep (and only when something tore): marks a constraint that no
 /// longer stands on the sheet, so that no constraint ties two pieces of the triangle mesh: a
-/// structural edge no live triangle holds, a bend over such an edge, a shear or tri-bend that has
-/// lost its triangles (unsupported in xpbd.h). Whether a triangle is gone is settled by the tear
+/// structural edge no live triangle holds, a bend over such an edge, a shear, tri-bend or hinge
+/// that has lost its triangles (unsupported in xpbd.h). Whether a triangle is gone is settled by the tear
 /// marks before this pass; the structural edges this pass marks are held by no live triangle, so
 /// marking them changes no triangle and the verdicts do not depend on the order.
 SIM_INLINE void markUnsupported(Constraint c) {
@@ -78,7 +109,8 @@ SIM_INLINE void markUnsupported(Constraint c) {
     uint mid = (c.a + c.b) / 2u; // a bend spans two structural edges of a row or a column
     cut = edgeCut(c.a, mid) || edgeCut(mid, c.b);
   } else {
-    uvec2 t = supportTriangles(c.a, c.b, kind, u.cols);
+    uvec2 t = kind == SIM_KIND_HINGE ? hingeTriangles(id - u.hinge.x, u.cols, u.rows)
+                                     : supportTriangles(c.a, c.b, kind, u.cols);
     cut = unsupported(c.a, c.b, kind, u.cols, triangleGone(t.x), triangleGone(t.y));
   }
   if (!cut) return;

@@ -28,13 +28,17 @@
 // Sentinel particle index: nothing grabbed, nothing picked
 #define SIM_NONE 0xFFFFFFFFu
 
-// Constraint kinds (low two bits of Constraint.kind_id; the original id sits above them)
+// Constraint kinds (low three bits of Constraint.kind_id; the original id sits above them). A
+// hinge is the signed dihedral angle between the two triangles of an interior edge: its a and b
+// are the corners opposite the edge, the edge itself follows from the grid (gridHinge in xpbd.h)
 #define SIM_KIND_STRUCTURAL 0u
 #define SIM_KIND_SHEAR 1u
 #define SIM_KIND_BEND 2u
 #define SIM_KIND_TRIBEND 3u
-#define SIM_KIND_BITS 2u
-#define SIM_KIND_MASK 3u
+#define SIM_KIND_HINGE 4u
+#define SIM_KIND_COUNT 5u
+#define SIM_KIND_BITS 3u
+#define SIM_KIND_MASK 7u
 
 // Descriptor bindings of the simulation set (one set, shared by every sim pass)
 #define SIM_BIND_UNIFORMS 0
@@ -66,21 +70,23 @@
 #define SIM_BIND_CANDIDATES 26
 #define SIM_BIND_CANDIDATE_BASE 27
 #define SIM_BIND_HASH_ARGS 28
+// Per hinge (HingeState): its plastic rest angle, the yield its hardening added, its XPBD multiplier
+#define SIM_BIND_HINGES 29
 // A fleet's shaders (tick_batch.comp, and the per-colour passes built with SIM_BATCH_PASS) reach
 // each binding's buffer through its device address instead: the fleet's table (BatchArgs.table)
 // holds, per binding (SIM_BIND_*; the uniforms are one SimUniforms per sheet), the address of sheet
 // 0's slice and the bytes from one sheet's slice to the next, then at SIM_BATCH_QUEUE the list of
 // sheets to tick (one per workgroup of tick_batch, one per workgroup z of a pass)
-#define SIM_BATCH_QUEUE 29
+#define SIM_BATCH_QUEUE 30
 // ... and at SIM_BATCH_ARGS the indirect arguments of the per-colour passes of a batch (uvec4 each,
 // workgroup counts x, y and z = the batch's sheets): the full grids of the hash passes (a slot per
 // pass, as SIM_BIND_HASH_ARGS) and of the compaction, which the host writes, then per substep the
 // live ones, which the host writes with x = 0 and a sheet's candidates_decide (hash) or tear_mark
 // (compaction) raises to the full grid's x when that sheet needs them: a pass that no sheet of the
 // batch needs runs zero workgroups, as it does for a sheet alone
-#define SIM_BATCH_ARGS 30
+#define SIM_BATCH_ARGS 31
 // Entries of the fleet's table
-#define SIM_BATCH_ENTRIES 31
+#define SIM_BATCH_ENTRIES 32
 #define SIM_BATCH_ARGS_FULL_COMPACT SIM_HASH_DISPATCHES
 #define SIM_BATCH_ARGS_LIVE_HASH (SIM_BATCH_ARGS_FULL_COMPACT + 1u)
 #define SIM_BATCH_ARGS_LIVE_COMPACT (SIM_BATCH_ARGS_LIVE_HASH + SIM_MAX_SUBSTEPS * SIM_HASH_DISPATCHES)
@@ -105,6 +111,8 @@
 #define SIM_GATE_COMPACTION 5u
 // SIM_GATE_RESET: the sheet runs a frame of the animated reset (reset)
 #define SIM_GATE_RESET 6u
+// SIM_GATE_CREASE: the sheet has hinges and creases (crease)
+#define SIM_GATE_CREASE 7u
 // Sheets per hardware thread that one dispatch of a fleet takes on a CPU device, which runs a
 // substep per dispatch: each thread keeps its sheet's arrays (under 1 MiB for 32 x 48) in its
 // cache through every substep before the next sheets start (lavapipe, 2 threads, 64 sheets of

@@ -26,6 +26,7 @@
   X(air, SIM, 1, 1)                                                                                                    \
   X(integrate, SIM, 1, 1)                                                                                              \
   X(project, SIM, 1, 1)                                                                                                \
+  X(crease, SIM, 1, 1)                                                                                                 \
   X(candidates_check, SIM, 1, 1)                                                                                       \
   X(candidates_decide, SIM, 1, 1)                                                                                      \
   X(hash_count, SIM, 1, 1)                                                                                             \
@@ -54,10 +55,11 @@
 #define SIM_STAGES(X)                                                                                                  \
   X(integrate, 0u, ONCE, ALWAYS)                                                                                       \
   X(project, 1u, COLOUR, ALWAYS)                                                                                       \
-  X(collide, 2u, ONCE, COLLISION)                                                                                      \
-  X(floor, 3u, ONCE, ALWAYS)                                                                                           \
-  X(tear, 4u, ONCE, ALWAYS)
-#define SIM_STAGE_COUNT 5u
+  X(crease, 2u, ONCE, ALWAYS)                                                                                          \
+  X(collide, 3u, ONCE, COLLISION)                                                                                      \
+  X(floor, 4u, ONCE, ALWAYS)                                                                                           \
+  X(tear, 5u, ONCE, ALWAYS)
+#define SIM_STAGE_COUNT 6u
 
 // The dispatches of each stage, in the order the per-colour path records them (a barrier after
 // each). The fused tick and the CPU run the same bodies in the same order.
@@ -65,18 +67,20 @@
 //   stage     its row in SIM_STAGES
 //   kernel    its row in SIM_KERNELS (scan: a scan of several blocks adds scan and scan_add)
 //   elements  what it covers and its push constants: PARTICLES, COLOUR (the stage's colour),
-//             CONSTRAINTS, ONE (one invocation), HASH_ARGS (one invocation, the hash's
+//             HINGES, CONSTRAINTS, ONE (one invocation), HASH_ARGS (one invocation, the hash's
 //             arguments), HASH_CELLS and TEAR_SLOTS (a scan of the hash's cells or of the
 //             compaction's slots), INDIRECT (the grid's arguments, no push constants)
 //   grid      Threads (from the elements), Hash (the live hash arguments candidates_decide
 //             copies) or Compaction (the tear compaction's arguments): gpu::Grid
 //   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)
-//   needs     ALWAYS, AIR (the sheet has air) or CONSTRAINTS (the sheet has constraints)
+//   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases) or
+//             CONSTRAINTS (the sheet has constraints)
 //   category  its timestamp category (gpu::PassCategory k<category>)
 #define SIM_DISPATCHES(X)                                                                                              \
   X(integrate, air, PARTICLES, Threads, AIR, AIR, Integrate)                                                           \
   X(integrate, integrate, PARTICLES, Threads, TICK, ALWAYS, Integrate)                                                 \
   X(project, project, COLOUR, Threads, ITERATION, ALWAYS, Project)                                                     \
+  X(crease, crease, HINGES, Threads, CREASE, CREASE, Project)                                                          \
   X(collide, candidates_check, PARTICLES, Threads, COLLISION, ALWAYS, Hash)                                            \
   X(collide, candidates_decide, HASH_ARGS, Threads, COLLISION, ALWAYS, Hash)                                           \
   X(collide, hash_count, PARTICLES, Hash, HASH, ALWAYS, Hash)                                                          \

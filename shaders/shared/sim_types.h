@@ -50,6 +50,14 @@ struct SimUniforms {
 
   vec4 air; // SIM_FLAG_AIR: x pressure, y friction factor (SimParams::airPressureFactor), z 1 / (3 dt)
 
+  uvec4 hinge; // x original id of the first hinge (hinge k is constraint x + k), y hinges (SIM_KIND_HINGE)
+  // Hinges: x the XPBD compliance of an edge hinge over dt^2 (a diagonal's is half), y the yield
+  // angle in radians (0: elastic, no creases), z the hardening
+  vec4 crease;
+  // The closing hand around the grabbed particle: x its radius, y how far it is closed (0 open, 1
+  // shut), z the share of the way to the closed hand a particle in reach goes each substep
+  vec4 hand;
+
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
   vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet
   vec4 grab_target[SIM_MAX_SUBSTEPS]; // grabbed particle position per substep; w: 0 free, 1 held, 2 tossed
@@ -64,9 +72,14 @@ struct SimUniforms {
 // Air on every triangle (airOnTriangle in xpbd.h): a pass before integration sums it per particle
 #define SIM_FLAG_AIR 8u
 
+/// The state of one hinge (SIM_BIND_HINGES, SheetState::hinges): x its rest angle (radians, in
+/// (-pi, pi]; 0 on a flat sheet, moved by creasing), y the yield its hardening has added, z the
+/// multiplier of its XPBD projection in this substep, w unused.
+#define HingeState vec4
+
 /// Push constants of every simulation dispatch.
 struct SimPush {
-  uint first;   // first element (constraint of a colour range, particle, ...)
+  uint first;   // first element (particle, ...); the projection: the iteration
   uint count;   // element count of this dispatch
   uint substep; // substep index inside the tick
   uint color;   // colour index for projection and compaction

@@ -135,16 +135,16 @@ SIM_INLINE uvec2 supportTriangles(uint a, uint b, uint kind, uint cols) {
   return dy == 1u ? uvec2(2u * (y * quads + x) + 1u, 2u * (y * quads + x + 1u)) : uvec2(SIM_NONE, SIM_NONE);
 }
 
-/// True when a shear or tri-bend constraint from particle a to particle b (a < b) of a
+/// True when a shear, tri-bend or hinge constraint from particle a to particle b (a < b) of a
 /// `cols`-wide grid has lost what it stands on (gone0, gone1: its support triangles lost an edge).
 /// A shear along the diagonal both halves of its quad share (top-left to bottom-right) goes once
-/// both are gone; the other diagonal, which crosses both halves, and a tri-bend, which crosses both
-/// triangles of its hinge, go once either is. No constraint then spans a triangle the sheet has
+/// both are gone; the other diagonal, which crosses both halves, and a tri-bend or a hinge, which
+/// cross both triangles of their edge, go once either is. No constraint then spans a triangle the sheet has
 /// lost, so torn pieces come apart; a fold tears nothing.
 SIM_INLINE bool unsupported(uint a, uint b, uint kind, uint cols, bool gone0, bool gone1) {
   bool shared_diagonal = kind == SIM_KIND_SHEAR && b == a + cols + 1u;
   if (shared_diagonal) return gone0 && gone1;
-  return (kind == SIM_KIND_SHEAR || kind == SIM_KIND_TRIBEND) && (gone0 || gone1);
+  return (kind == SIM_KIND_SHEAR || kind == SIM_KIND_TRIBEND || kind == SIM_KIND_HINGE) && (gone0 || gone1);
 }
 
 /// The triangles (original ids; SIM_NONE where the sheet ends) that hold the structural edge from
@@ -157,6 +157,142 @@ SIM_INLINE uvec2 edgeTriangles(uint a, uint b, uint cols, uint rows) {
   if (b == a + 1u)
     return uvec2(y + 1u < rows ? 2u * (y * quads + x) + 1u : SIM_NONE, y > 0u ? 2u * ((y - 1u) * quads + x) : SIM_NONE);
   return uvec2(x + 1u < cols ? 2u * (y * quads + x) : SIM_NONE, x > 0u ? 2u * (y * quads + x - 1u) + 1u : SIM_NONE);
+}
+
+/// Hinges of a cols x rows grid (SIM_KIND_HINGE, numbered as gridHinge takes them): one across each
+/// interior row edge, each interior column edge and the diagonal of each quad.
+SIM_INLINE uint hingeCount(uint cols, uint rows) {
+  if (cols < 2u || rows < 2u) return 0u;
+  return (cols - 1u) * (rows - 2u) + (cols - 2u) * (rows - 1u) + (cols - 1u) * (rows - 1u);
+}
+
+/// Hinge k (< hingeCount) of a cols x rows grid: x and y the ends of its edge, z and w the corners
+/// opposite it, so that (x, y, z) and (y, x, w) are its two triangles counter-clockwise from +Z (as
+/// gridTriangle gives them). The hinges across the row edges (i, j)-(i + 1, j) of rows 1 to
+/// rows - 2 come first, row by row; then those across the column edges (i, j)-(i, j + 1) of
+/// columns 1 to cols - 2; then the diagonal top-left to bottom-right of each quad.
+SIM_INLINE uvec4 gridHinge(uint k, uint cols, uint rows) {
+  uint row_hinges = (cols - 1u) * (rows - 2u), col_hinges = (cols - 2u) * (rows - 1u);
+  if (k < row_hinges) {
+    uint p = (k / (cols - 1u) + 1u) * cols + k % (cols - 1u);
+    return uvec4(p, p + 1u, p - cols, p + cols + 1u);
+  }
+  k -= row_hinges;
+  if (k < col_hinges) {
+    uint p = (k / (cols - 2u)) * cols + k % (cols - 2u) + 1u;
+    return uvec4(p, p + cols, p + cols + 1u, p - 1u);
+  }
+  k -= col_hinges;
+  uint tl = (k / (cols - 1u)) * cols + k % (cols - 1u);
+  return uvec4(tl + cols + 1u, tl, tl + cols, tl + 1u);
+}
+
+/// True when hinge k of a cols x rows grid is a quad's diagonal (its edge is sqrt 2 x spacing long:
+/// the same rigidity takes half the compliance there).
+SIM_INLINE bool hingeIsDiagonal(uint k, uint cols, uint rows) {
+  return k >= (cols - 1u) * (rows - 2u) + (cols - 2u) * (rows - 1u);
+}
+
+/// The two triangles (original ids) of hinge k of a cols x rows grid: the one with corner z of
+/// gridHinge, then the one with corner w.
+SIM_INLINE uvec2 hingeTriangles(uint k, uint cols, uint rows) {
+  uint quads = cols - 1u, row_hinges = quads * (rows - 2u), col_hinges = (cols - 2u) * (rows - 1u);
+  if (k < row_hinges) {
+    uint q = (k / quads + 1u) * quads + k % quads; // the quad below the edge
+    return uvec2(2u * (q - quads), 2u * q + 1u);
+  }
+  k -= row_hinges;
+  if (k < col_hinges) {
+    uint q = (k / (cols - 2u)) * quads + k % (cols - 2u) + 1u; // the quad right of the edge
+    return uvec2(2u * q, 2u * (q - 1u) + 1u);
+  }
+  k -= col_hinges;
+  return uvec2(2u * k, 2u * k + 1u);
+}
+
+/// True when a sheet of `hinges` hinges creases at this yield (creaseReturn; 0: elastic).
+SIM_INLINE bool creasing(uint hinges, float yield0) { return hinges > 0u && yield0 > 0.0f; }
+
+/// The signed angle of a hinge and its gradient (Bergou et al., Discrete Shells).
+struct HingeAngle {
+  float angle; // radians in (-pi, pi]: 0 flat, positive when either corner moves along its triangle's normal
+  bool valid;  // false for a degenerate hinge (an edge or a triangle of no size): no angle
+  vec3 gu, gv, ga, gb;
+};
+
+/// The angle of the hinge with edge pu-pv and opposite corners pa and pb (gridHinge's order): from
+/// the normals na of (pu, pv, pa) and nb of (pv, pu, pb), atan2 of (nb x na) . e and (na . nb) |e|.
+/// The gradient: a corner moves the angle by its normal over its height above the edge, and the
+/// ends of the edge take the rest by the lever rule, so the four sum to zero.
+SIM_INLINE HingeAngle hingeAngle(vec3 pu, vec3 pv, vec3 pa, vec3 pb) {
+  HingeAngle h;
+  h.angle = 0.0f;
+  h.valid = false;
+  h.gu = vec3(0.0f);
+  h.gv = vec3(0.0f);
+  h.ga = vec3(0.0f);
+  h.gb = vec3(0.0f);
+  vec3 e = pv - pu;
+  vec3 na = cross3(e, pa - pu), nb = cross3(pu - pv, pb - pv);
+  float e2 = dot3(e, e), na2 = dot3(na, na), nb2 = dot3(nb, nb);
+  // A triangle whose height is under 1e-4 of its edge has no normal to speak of
+  float tiny = 1e-8f * e2 * e2;
+  if (!(e2 > 1e-30f) || !(na2 > tiny) || !(nb2 > tiny) || !(na2 < 1e30f) || !(nb2 < 1e30f)) return h;
+  float el = simSqrt(e2);
+  h.angle = simAtan2(dot3(cross3(nb, na), e), dot3(na, nb) * el);
+  h.valid = true;
+  h.ga = na * simDiv(el, na2);
+  h.gb = nb * simDiv(el, nb2);
+  float sa = simDiv(dot3(pa - pu, e), e2), sb = simDiv(dot3(pb - pu, e), e2);
+  h.gu = -(h.ga * (1.0f - sa) + h.gb * (1.0f - sb));
+  h.gv = -(h.ga * sa + h.gb * sb);
+  return h;
+}
+
+/// Corrections of the four corners of a hinge and its new XPBD multiplier.
+struct HingeDelta {
+  vec3 du, dv, da, db;
+  float lambda;
+};
+
+/// One XPBD step of a hinge (corners pu, pv, pa, pb; w the inverse mass) toward its rest angle:
+/// with compliance over dt^2 `alpha` and the multiplier so far `lambda`,
+/// dlambda = (-C - alpha lambda) / (sum w |grad C|^2 + alpha), C = wrap(angle - rest).
+SIM_INLINE HingeDelta solveHinge(vec4 pu, vec4 pv, vec4 pa, vec4 pb, float rest, float alpha, float lambda) {
+  HingeDelta r;
+  r.du = vec3(0.0f);
+  r.dv = vec3(0.0f);
+  r.da = vec3(0.0f);
+  r.db = vec3(0.0f);
+  r.lambda = lambda;
+  HingeAngle h = hingeAngle(vec3(pu), vec3(pv), vec3(pa), vec3(pb));
+  if (!h.valid) return r;
+  float c = wrapAngle(h.angle - rest);
+  float denom =
+      ((pu.w * dot3(h.gu, h.gu) + pv.w * dot3(h.gv, h.gv)) + pa.w * dot3(h.ga, h.ga)) + pb.w * dot3(h.gb, h.gb) + alpha;
+  if (!(denom > 0.0f)) return r;
+  float dl = simDiv(-c - alpha * lambda, denom);
+  r.du = h.gu * (dl * pu.w);
+  r.dv = h.gv * (dl * pv.w);
+  r.da = h.ga * (dl * pa.w);
+  r.db = h.gb * (dl * pb.w);
+  r.lambda = lambda + dl;
+  return r;
+}
+
+/// The crease of a hinge after a substep's projection (once per substep, so it does not depend on
+/// the iteration count): a return map. With d = wrap(angle - rest) and the yield y = yield0 +
+/// state.y, a hinge bent |d| - y past its yield moves its rest angle that far toward its angle over
+/// (1 + hardening), and the hardening raises its yield by as much. yield0 = 0: elastic.
+SIM_INLINE HingeState creaseReturn(HingeState st, float angle, float yield0, float hardening) {
+  float d = wrapAngle(angle - st.x);
+  float over = abs(d) - (yield0 + st.y);
+  if (yield0 > 0.0f && over > 0.0f) {
+    float step = simDiv(over, 1.0f + hardening);
+    st.x = wrapAngle(st.x + (d < 0.0f ? -step : step));
+    st.y = st.y + hardening * step;
+  }
+  return st;
 }
 
 /// The particles of triangle t (original id: two per quad, row by row, as buildSheet makes them:

@@ -95,6 +95,7 @@ void main() {
   uint per_substep = passesPerSubstep(u.iterations, u.color_count, collision);
   uint integrate_pass = stageFirstPass(SIM_STAGE_integrate, u.iterations, u.color_count, collision);
   uint project_pass = stageFirstPass(SIM_STAGE_project, u.iterations, u.color_count, collision);
+  uint crease_pass = stageFirstPass(SIM_STAGE_crease, u.iterations, u.color_count, collision);
   uint collide_pass = stageFirstPass(SIM_STAGE_collide, u.iterations, u.color_count, collision);
   uint floor_pass = stageFirstPass(SIM_STAGE_floor, u.iterations, u.color_count, collision);
   uint tear_pass = stageFirstPass(SIM_STAGE_tear, u.iterations, u.color_count, collision);
@@ -125,14 +126,23 @@ void main() {
     for (uint it = 0u; it < u.iterations; ++it)
       for (uint c = 0u; c < u.color_count; ++c) {
         uvec2 range = color_range[c];
-        for (uint t = lid; t < range.y; t += kInvocations) projectConstraint(constraints[range.x + t]);
+        for (uint t = lid; t < range.y; t += kInvocations) projectConstraint(constraints[range.x + t], it);
         sync();
         if (stopsAfter(first_pass + project_pass + it * u.color_count + c)) {
           storePositions(n);
           return;
         }
       }
-    // 3. Collision (as candidates_check, hash_*, collide and candidates_finish). From the candidate lists
+    // 3. The creases (as crease.comp)
+    if (creasing(u.hinge.y, u.crease.y)) {
+      for (uint k = lid; k < u.hinge.y; k += kInvocations) creaseHinge(k);
+      sync();
+    }
+    if (stopsAfter(first_pass + crease_pass)) {
+      storePositions(n);
+      return;
+    }
+    // 4. Collision (as candidates_check, hash_*, collide and candidates_finish). From the candidate lists
     // while they hold every pair that can touch (no particle has travelled SIM_CANDIDATE_TRAVEL x skin
     // since they were built); otherwise from the spatial hash (count, scan, scatter, order within
     // bucket) and a search of the 27 cells around each particle, which rebuilds the lists as it
@@ -165,7 +175,7 @@ void main() {
         sync();
       }
     }
-    // 4. Each particle takes its repulsion (from the lists, or gathered here from the hash's
+    // 5. Each particle takes its repulsion (from the lists, or gathered here from the hash's
     // bucket-ordered copy of the positions) and meets the floor (as floor.comp). A tick that
     // stops after the collision keeps the repulsion in delta (as collide.comp) instead.
     bool stop_collide = collision && stopsAfter(first_pass + collide_pass);
@@ -190,7 +200,7 @@ void main() {
     }
     if (collision && lid == 0u)
       counters.candidate_state = candidatesNextStateOf(state, mode, counters.candidate_flags.y != 0u);
-    // 5. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
+    // 6. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
     // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
     // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
     // substep it tore in removed it), and kinds that cannot tear skip the position loads.

@@ -62,6 +62,7 @@ Vec4Ref g_pos, g_prev, g_rest_pos, g_delta, g_candidate_base, g_reset_from;
 Vec2Ref g_uv;
 ConstraintRef g_constraints;
 Uvec2Ref g_color_range, g_tri_edges;
+Vec4Ref g_hinges;
 UintRef g_adj_offsets, g_adj_list, g_adj_mask, g_cell_count, g_cell_start, g_cell_particles, g_particle_cell, g_torn,
     g_scratch, g_cell_scatter, g_candidates;
 Uvec4Ref g_triangles, g_compact_tmp, g_cell_pos;
@@ -106,6 +107,7 @@ void bindSheet(uint sheet) {
   g_cell_pos = Uvec4Ref(batchSlice(SIM_BIND_CELL_POS, sheet));
   g_hash_args = Uvec4Ref(batchSlice(SIM_BIND_HASH_ARGS, sheet));
   g_counters = CountersRef(batchSlice(SIM_BIND_COUNTERS, sheet));
+  g_hinges = Vec4Ref(batchSlice(SIM_BIND_HINGES, sheet));
 }
 #define u g_u.v
 #define pos g_pos.v
@@ -134,6 +136,7 @@ void bindSheet(uint sheet) {
 #define cell_pos g_cell_pos.v
 #define hash_args g_hash_args.v
 #define counters g_counters.v
+#define hinges g_hinges.v
 #else
 layout(std140, set = 0, binding = SIM_BIND_UNIFORMS) uniform UniformsBlock { SimUniforms u; };
 layout(std430, set = 0, binding = SIM_BIND_POS) SIM_COHERENT buffer PosBuffer { vec4 pos[]; };
@@ -176,6 +179,7 @@ layout(std430, set = 0, binding = SIM_BIND_CANDIDATE_BASE) SIM_COHERENT buffer C
 };
 // Indirect arguments of the separate hash passes: SIM_HASH_DISPATCHES live, then as many full
 layout(std430, set = 0, binding = SIM_BIND_HASH_ARGS) SIM_COHERENT buffer HashArgsBuffer { uvec4 hash_args[]; };
+layout(std430, set = 0, binding = SIM_BIND_HINGES) SIM_COHERENT buffer HingeBuffer { HingeState hinges[]; };
 
 #endif
 
@@ -238,6 +242,8 @@ bool batchGateTakes() {
     return collision && collideModeNow() != SIM_COLLIDE_CANDIDATES;
   case SIM_GATE_COMPACTION:
     return counters.compact_dispatch.x != 0u;
+  case SIM_GATE_CREASE:
+    return creasing(u.hinge.y, u.crease.y);
   default:
     return true;
   }

@@ -78,7 +78,7 @@ std::string showFloat(uint32_t bits) {
 }
 
 void compareVectors(const std::vector<glm::vec4>& a, const std::vector<glm::vec4>& b, const char* name,
-                    std::optional<Difference>& first) {
+                    std::optional<Difference>& first, const char* element = "particle") {
   if (first) return;
   static const char* kAxis[4] = {"x", "y", "z", "w"};
   Difference d;
@@ -87,7 +87,7 @@ void compareVectors(const std::vector<glm::vec4>& a, const std::vector<glm::vec4
       if (bitsOf(a[i][c]) != bitsOf(b[i][c])) {
         if (d.count++ == 0) {
           const uint32_t x = bitsOf(a[i][c]), y = bitsOf(b[i][c]);
-          d.what = "particle " + std::to_string(i) + " " + name + "." + kAxis[c];
+          d.what = std::string(element) + " " + std::to_string(i) + " " + name + "." + kAxis[c];
           d.a = showFloat(x);
           d.b = showFloat(y);
           d.ulps = std::llabs(orderedBits(x) - orderedBits(y));
@@ -130,6 +130,8 @@ std::optional<Difference> compare(const Side& x, const Side& y, bool deltas) {
   compareVectors(x.state.pos, y.state.pos, "pos", first);
   compareVectors(x.state.prev, y.state.prev, "prev", first);
   if (deltas) compareVectors(x.deltas, y.deltas, "collision delta", first);
+  // A hinge's x: its rest angle, y: the yield its hardening added, z: its multiplier
+  compareVectors(x.state.hinges, y.state.hinges, "state", first, "hinge");
   compareRecords(
       x.state.torn, y.state.torn, "torn flag of constraint",
       [](uint32_t t) { return std::string(t ? "torn" : "whole"); }, first);

@@ -171,9 +171,10 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   std::printf("tender sim: preset %s, backend %s, %ux%u = %u particles, %llu ticks\n", common.params.preset.c_str(),
               solver.name().c_str(), common.params.cols, common.params.rows, st.particles,
               static_cast<unsigned long long>(o.ticks));
-  std::printf("  constraints %u structural, %u shear, %u bend, %u tri-bend in %u colours; %u torn; %u triangles\n",
-              st.constraints[0], st.constraints[1], st.constraints[2], st.constraints[3], st.colors, st.torn,
-              st.triangles);
+  std::printf("  constraints %u structural, %u shear, %u bend, %u tri-bend, %u hinge in %u colours; %u torn; %u "
+              "triangles; %u creased\n",
+              st.constraints[0], st.constraints[1], st.constraints[2], st.constraints[3], st.constraints[4], st.colors,
+              st.torn, st.triangles, st.creased);
   std::printf("  bbox (%.3f %.3f %.3f) .. (%.3f %.3f %.3f), max stretch %.4f, NaN %u\n", st.bbox_min.x, st.bbox_min.y,
               st.bbox_min.z, st.bbox_max.x, st.bbox_max.y, st.bbox_max.z, st.max_stretch, st.nan_count);
   std::printf("  %.4f ms/tick (median, slowest %.4f), state hash %s\n", median, slowest,

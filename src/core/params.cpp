@@ -122,6 +122,9 @@ const std::vector<Param>& params() {
       scoped(boolParam("shear", &SimParams::shear, "diagonal constraints"), ParamScope::Topology),
       scoped(boolParam("bend", &SimParams::bend, "skip-one bend constraints"), ParamScope::Topology),
       scoped(boolParam("tri_bend", &SimParams::tri_bend, "bending across adjacent triangles"), ParamScope::Topology),
+      scoped(boolParam("dihedral", &SimParams::dihedral,
+                       "signed dihedral bending of every hinge (XPBD, bending_rigidity; creases)"),
+             ParamScope::Topology),
       floatParam("tick_hz", &SimParams::tick_hz, 1.0f, 10000.0f, "fixed ticks per second"),
       uintParam("substeps", &SimParams::substeps, 1, SIM_MAX_SUBSTEPS, "substeps per tick"),
       uintParam("iterations", &SimParams::iterations, 1, 256, "constraint iterations per substep"),
@@ -140,6 +143,12 @@ const std::vector<Param>& params() {
       floatParam("skin_friction", &SimParams::skin_friction, 0.0f, 1.0f, "air friction along the sheet"),
       floatParam("stiffness", &SimParams::stiffness, 0.0f, 1.0f, "structural and shear stiffness"),
       floatParam("bend_stiffness", &SimParams::bend_stiffness, 0.0f, 1.0f, "bend stiffness"),
+      floatParam("bending_rigidity", &SimParams::bending_rigidity, 1e-12f, 1e6f,
+                 "bending rigidity of the hinges (N m; dihedral)"),
+      floatParam("crease_yield", &SimParams::crease_yield, 0.0f, 180.0f,
+                 "degrees a hinge bends past its rest angle before it creases (0: elastic)"),
+      floatParam("crease_hardening", &SimParams::crease_hardening, 0.0f, 1000.0f,
+                 "yield a crease adds per radian it moves the rest angle"),
       floatParam("tear_factor", &SimParams::tear_factor, 0.0f, 100.0f, "tear beyond factor x rest; 0: never"),
       boolParam("tear_structural", &SimParams::tear_structural, "structural constraints may tear"),
       boolParam("tear_shear", &SimParams::tear_shear, "shear constraints may tear"),
@@ -185,6 +194,11 @@ float SimParams::airPressureFactor() const {
   return air_density * drag_coefficient / (2.0f * (paper_weight * 1e-3f) * spacing * spacing);
 }
 
+float SimParams::hingeCompliance() const {
+  const double dt = 1.0 / (double(tick_hz) * substeps);
+  return float(double(paper_weight) * 1e-3 * double(spacing) * spacing / (3.0 * double(bending_rigidity) * dt * dt));
+}
+
 float SimParams::airFrictionFactor() const {
   return air_density * skin_friction / (2.0f * (paper_weight * 1e-3f) * spacing * spacing);
 }
@@ -207,8 +221,12 @@ std::optional<SimParams> presetParams(const std::string& name) {
     p.wind_kind = WindKind::Noise;
     p.wind_scale = 0.15f;
     p.bend = false;
-    p.tri_bend = true;
-    p.bend_stiffness = 0.8f;
+    // Paper's hinges, creasing, with a rigidity that suits the scene's scale (not SI: a sheet of
+    // 6 x 9 units under a gravity of 0.5)
+    p.dihedral = true;
+    p.bending_rigidity = 0.02f;
+    p.crease_yield = kPaperCreaseYield;
+    p.crease_hardening = kPaperCreaseHardening;
     p.cell_size = 0.375f; // 2.5 x spacing, as in `tender`
     p.floor_y = -10.0f;
     p.restitution = 0.3f;
@@ -217,7 +235,7 @@ std::optional<SimParams> presetParams(const std::string& name) {
     if (name == "crumple-low")
       p.cols = 30, p.rows = 45, p.spacing = 0.15f * 39.0f / 29.0f, p.cell_size = 2.5f * p.spacing;
   } else if (name == "paper") {
-    // A real receipt in SI units: 80 mm x 300 mm of 48 g/m^2 thermal paper, let go in still air
+    // A real receipt in SI units: 80 mm x 300 mm of 55 g/m^2 thermal paper, let go in still air
     // with its lowest point 1 m above the floor, leaning 5 degrees from flat.
     p.cols = 17;
     p.rows = 61;
@@ -225,12 +243,17 @@ std::optional<SimParams> presetParams(const std::string& name) {
     p.pins = PinMode::None;
     p.tilt = 85.0f;
     p.view_scale = 0.1f;
-    p.paper_weight = 48.0f;
+    p.paper_weight = 55.0f;
     p.floor_y = 0.0f;
     p.damping = 1.0f; // the air slows it, not a uniform damping
     p.air = true;
     p.wind = false;
-    p.bend_stiffness = 0.6f;
+    // Thermal paper's hinges (README: Paper): its rigidity and the yield of its creases
+    p.bend = false;
+    p.dihedral = true;
+    p.bending_rigidity = kPaperRigidity;
+    p.crease_yield = kPaperCreaseYield;
+    p.crease_hardening = kPaperCreaseHardening;
     p.cell_size = 2.5f * p.spacing;
     p.restitution = 0.05f;
     p.friction = 0.6f;
@@ -310,9 +333,13 @@ SheetCounts sheetCounts(const SimParams& p) {
   SheetCounts c;
   c.particles = w * h;
   c.constraints = pairs(w, 1) * h + w * pairs(h, 1);
-  if (p.shear) c.constraints += 2 * pairs(w, 1) * pairs(h, 1);
+  if (p.shear) c.constraints += (p.dihedral ? 1 : 2) * pairs(w, 1) * pairs(h, 1);
   if (p.bend) c.constraints += pairs(w, 2) * h + w * pairs(h, 2);
   if (p.tri_bend) c.constraints += pairs(w, 1) * pairs(h, 2) + pairs(w, 2) * pairs(h, 1);
+  if (p.dihedral && w > 1 && h > 1) {
+    c.hinges = pairs(w, 1) * pairs(h, 2) + pairs(w, 2) * pairs(h, 1) + pairs(w, 1) * pairs(h, 1);
+    c.constraints += c.hinges;
+  }
   c.triangles = 2 * pairs(w, 1) * pairs(h, 1);
   c.hash_buckets = 2;
   while (c.hash_buckets < 2 * c.particles) c.hash_buckets <<= 1;
@@ -321,14 +348,14 @@ SheetCounts sheetCounts(const SimParams& p) {
 
 uint64_t estimateSheetBytes(const SimParams& p, const std::string& backend) {
   const SheetCounts c = sheetCounts(p);
-  const uint64_t n = c.particles, m = c.constraints, t = c.triangles, hb = c.hash_buckets;
+  const uint64_t n = c.particles, m = c.constraints, t = c.triangles, hb = c.hash_buckets, hinges = c.hinges;
   // SheetTopology: rest, uv, constraints, adjacency (offsets and 2 entries per constraint),
   // triangles and their edges.
   const uint64_t topology = 24 * n + 16 * m + 4 * n + 8 * m + 24 * t;
   // Building it: colour masks, colours, the sorted copy, the edge ids of the triangles.
   const uint64_t building = 8 * n + 20 * m + 8 * n;
   // The read-back state: pos, prev, normal, constraints, torn flags, triangles.
-  const uint64_t state = 48 * n + 20 * m + 16 * t;
+  const uint64_t state = 48 * n + 20 * m + 16 * t + 16 * hinges;
   uint64_t solver = 0;
   if (backend == "cpu") {
     // Particle arrays (pos, prev, rest, normal, delta, reset source, uv), constraints with their
@@ -342,7 +369,7 @@ uint64_t estimateSheetBytes(const SimParams& p, const std::string& backend) {
     solver =
         80 * n + topology + 16 * 9 * n + 4 * 6 * n + 36 * m + 48 * t + 12 * hb + 80 * n + 4 * (m + t) + 72 * n + 16 * m;
   }
-  return topology + std::max(building, state) + solver;
+  return topology + std::max(building, state) + solver + 16 * hinges; // the solver's hinge states
 }
 
 uint64_t availableMemoryBytes() {

@@ -21,17 +21,25 @@ std::vector<uint32_t> pinIndices(PinMode mode, uint32_t cols, uint32_t /*rows*/)
   return pins;
 }
 
-std::vector<uint32_t> colorGreedy(const std::vector<shaderio::Constraint>& cs, uint32_t particle_count) {
+std::vector<uint32_t> colorGreedy(const std::vector<shaderio::Constraint>& cs, uint32_t cols, uint32_t rows,
+                                  uint32_t hinge_first) {
   // used[i] has bit c set when particle i already has a constraint of colour c.
-  std::vector<uint64_t> used(particle_count, 0);
+  std::vector<uint64_t> used(size_t(cols) * rows, 0);
   std::vector<uint32_t> color(cs.size());
+  uint32_t distance_colors = 0;
   for (size_t k = 0; k < cs.size(); ++k) {
-    uint64_t busy = used[cs[k].a] | used[cs[k].b];
+    const uint32_t id = constraintId(cs[k]);
+    const bool hinge = constraintKind(cs[k]) == SIM_KIND_HINGE;
+    const glm::uvec4 q = hinge ? shaderio::gridHinge(id - hinge_first, cols, rows) : glm::uvec4(cs[k].a, cs[k].b, 0, 0);
+    const uint32_t corners = hinge ? 4 : 2;
+    // The hinges' colours start after every colour the other kinds took.
+    uint64_t busy = hinge ? (uint64_t(1) << distance_colors) - 1 : 0;
+    for (uint32_t j = 0; j < corners; ++j) busy |= used[q[j]];
     if (busy == ~uint64_t(0)) throw std::runtime_error("constraint graph needs more than 64 colours");
-    uint32_t c = uint32_t(std::countr_one(busy));
+    const uint32_t c = uint32_t(std::countr_one(busy));
     color[k] = c;
-    used[cs[k].a] |= uint64_t(1) << c;
-    used[cs[k].b] |= uint64_t(1) << c;
+    if (!hinge) distance_colors = std::max(distance_colors, c + 1);
+    for (uint32_t j = 0; j < corners; ++j) used[q[j]] |= uint64_t(1) << c;
   }
   return color;
 }
@@ -107,8 +115,10 @@ SheetTopology buildSheet(const SimParams& p) {
   if (p.shear) {
     for (uint32_t j = 0; j + 1 < H; ++j)
       for (uint32_t i = 0; i + 1 < W; ++i) add(idx(i, j), idx(i + 1, j + 1), diag, SIM_KIND_SHEAR);
-    for (uint32_t j = 0; j + 1 < H; ++j)
-      for (uint32_t i = 0; i + 1 < W; ++i) add(idx(i + 1, j), idx(i, j + 1), diag, SIM_KIND_SHEAR);
+    // The other diagonal spans the hinge along the first: with hinges, the sheet folds there.
+    if (!p.dihedral)
+      for (uint32_t j = 0; j + 1 < H; ++j)
+        for (uint32_t i = 0; i + 1 < W; ++i) add(idx(i + 1, j), idx(i, j + 1), diag, SIM_KIND_SHEAR);
   }
   if (p.bend) {
     for (uint32_t j = 0; j < H; ++j)
@@ -125,6 +135,16 @@ SheetTopology buildSheet(const SimParams& p) {
       for (uint32_t i = 1; i + 1 < W; ++i) add(idx(i - 1, j), idx(i + 1, j + 1), r5, SIM_KIND_TRIBEND);
   }
 
+  if (p.dihedral) {
+    // Hinges last, in gridHinge's order; a and b are the corners opposite the edge.
+    t.hinge_first = uint32_t(cs.size());
+    for (uint32_t k = 0; k < shaderio::hingeCount(W, H); ++k) {
+      const glm::uvec4 q = shaderio::gridHinge(k, W, H);
+      add(std::min(q.z, q.w), std::max(q.z, q.w), glm::length(glm::vec3(t.rest_pos[q.z] - t.rest_pos[q.w])),
+          SIM_KIND_HINGE);
+    }
+  }
+
   // Adjacency (CSR, sorted) from the initial constraints.
   t.adj_offsets.assign(N + 1, 0);
   for (auto& c : cs) t.adj_offsets[c.a + 1]++, t.adj_offsets[c.b + 1]++;
@@ -138,7 +158,7 @@ SheetTopology buildSheet(const SimParams& p) {
   }
 
   // Colour and sort.
-  t.colors = sortByColor(cs, colorGreedy(cs, N));
+  t.colors = sortByColor(cs, colorGreedy(cs, W, H, t.hinge_first));
   t.constraints = std::move(cs);
 
   // Triangles: two per quad, split along (i,j)-(i+1,j+1), counter-clockwise seen from +Z.

@@ -18,21 +18,23 @@ struct ColorRange {
 /// Everything both solvers upload unchanged.
 struct SheetTopology {
   uint32_t cols = 0, rows = 0;
-  std::vector<glm::vec4> rest_pos;               ///< xyz start position, w = 1 for a pin point
-  std::vector<glm::vec2> uv;                     ///< receipt texture coordinates
-  std::vector<shaderio::Constraint> constraints; ///< sorted by colour
-  std::vector<ColorRange> colors;                ///< ranges into `constraints`
-  std::array<uint32_t, 4> kind_counts{};         ///< constraints per kind
-  std::vector<uint32_t> adj_offsets;             ///< CSR: neighbours of i are adj_list[adj_offsets[i] .. [i+1])
-  std::vector<uint32_t> adj_list;                ///< sorted ascending per particle
-  std::vector<glm::uvec4> triangles;             ///< xyz vertices (counter-clockwise from +z), w = triangle id
-  std::vector<glm::uvec2> tri_edges;             ///< per triangle id: original ids of its two structural edges
-  uint32_t hash_size = 0;                        ///< spatial hash buckets: power of two >= 2N
+  std::vector<glm::vec4> rest_pos;                    ///< xyz start position, w = 1 for a pin point
+  std::vector<glm::vec2> uv;                          ///< receipt texture coordinates
+  std::vector<shaderio::Constraint> constraints;      ///< sorted by colour
+  std::vector<ColorRange> colors;                     ///< ranges into `constraints`
+  std::array<uint32_t, SIM_KIND_COUNT> kind_counts{}; ///< constraints per kind
+  uint32_t hinge_first = 0;                           ///< original id of hinge 0 (gridHinge): hinges are the last ids
+  std::vector<uint32_t> adj_offsets;                  ///< CSR: neighbours of i are adj_list[adj_offsets[i] .. [i+1])
+  std::vector<uint32_t> adj_list;                     ///< sorted ascending per particle
+  std::vector<glm::uvec4> triangles;                  ///< xyz vertices (counter-clockwise from +z), w = triangle id
+  std::vector<glm::uvec2> tri_edges;                  ///< per triangle id: original ids of its two structural edges
+  uint32_t hash_size = 0;                             ///< spatial hash buckets: power of two >= 2N
 
   uint32_t particleCount() const { return uint32_t(rest_pos.size()); }
   uint32_t constraintCount() const { return uint32_t(constraints.size()); }
   uint32_t triangleCount() const { return uint32_t(triangles.size()); }
   uint32_t colorCount() const { return uint32_t(colors.size()); }
+  uint32_t hingeCount() const { return kind_counts[SIM_KIND_HINGE]; }
   /// True when particles a and b share a constraint in the initial topology.
   bool adjacent(uint32_t a, uint32_t b) const;
 };
@@ -54,8 +56,11 @@ struct SheetPlacement {
 };
 SheetPlacement sheetPlacement(const SimParams& p);
 
-/// Greedy colouring: colour of each constraint, smallest colour free at both ends.
-std::vector<uint32_t> colorGreedy(const std::vector<shaderio::Constraint>& cs, uint32_t particle_count);
+/// Greedy colouring: colour of each constraint, smallest colour free at every particle it moves
+/// (both ends; a hinge's four corners, gridHinge on a `cols` x `rows` grid). Hinges take colours of
+/// their own, after the others', so that a colour holds one kind of projection.
+std::vector<uint32_t> colorGreedy(const std::vector<shaderio::Constraint>& cs, uint32_t cols, uint32_t rows,
+                                  uint32_t hinge_first = ~0u);
 
 /// Stable-sorts constraints by colour and returns the colour ranges.
 std::vector<ColorRange> sortByColor(std::vector<shaderio::Constraint>& cs, const std::vector<uint32_t>& color);

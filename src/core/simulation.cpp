@@ -198,6 +198,9 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   u.flags = (p.collision ? SIM_FLAG_COLLISION : 0u) | (pins_ ? SIM_FLAG_PINS : 0u) | (p.air ? SIM_FLAG_AIR : 0u);
   if (p.air) u.air = glm::vec4(p.airPressureFactor(), p.airFrictionFactor(), 1.0f / (3.0f * u.dt), 0.0f);
   u.stiffness = glm::vec4(p.stiffness, p.stiffness, p.bend_stiffness, p.bend_stiffness);
+  u.hinge = glm::uvec4(topo_.hinge_first, topo_.hingeCount(), 0u, 0u);
+  u.crease = glm::vec4(p.hingeCompliance(), float(double(p.crease_yield) * (3.14159265358979323846 / 180.0)),
+                       p.crease_hardening, 0.0f);
   u.reset_active = reset_frame_ > 0 ? 1u : 0u;
   u.reset_alpha = reset_frame_ > 0 ? float(SIM_RESET_FRAMES - reset_frame_ + 1) / float(SIM_RESET_FRAMES) : 0.0f;
   u.iterations = p.iterations;

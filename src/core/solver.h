@@ -16,6 +16,7 @@ struct SimState {
   std::vector<shaderio::Constraint> constraints; ///< live constraints, colour ranges compacted in place
   std::vector<ColorRange> colors;                ///< first stays, count shrinks as constraints tear
   std::vector<uint32_t> torn;                    ///< per original constraint id: 1 when torn
+  std::vector<glm::vec4> hinges;                 ///< per hinge (HingeState): rest angle, added yield, multiplier
   std::vector<glm::uvec4> triangles;             ///< live triangles (first triangle_count entries)
   uint32_t triangle_count = 0;
 };

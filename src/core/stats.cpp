@@ -7,8 +7,8 @@
 namespace tender {
 
 const char* kindName(uint32_t kind) {
-  static const char* names[] = {"structural", "shear", "bend", "tri_bend"};
-  return kind < 4 ? names[kind] : "?";
+  static const char* names[SIM_KIND_COUNT] = {"structural", "shear", "bend", "tri_bend", "hinge"};
+  return kind < SIM_KIND_COUNT ? names[kind] : "?";
 }
 
 uint64_t fnv1a(const void* data, size_t size, uint64_t h) {
@@ -25,6 +25,11 @@ SheetStats computeStats(const SimState& s, float substep_dt) {
   st.colors = uint32_t(s.colors.size());
   for (uint32_t t : s.torn) st.torn += t ? 1u : 0u;
   st.triangles = s.triangle_count;
+  for (const glm::vec4& h : s.hinges) {
+    const float deg = std::abs(h.x) * float(180.0 / 3.14159265358979323846);
+    st.max_crease_deg = std::max(st.max_crease_deg, deg);
+    st.creased += deg > kCreasedDegrees ? 1u : 0u;
+  }
   st.state_hash = hashPositions(s.pos);
   st.bbox_min = glm::vec3(INFINITY);
   st.bbox_max = glm::vec3(-INFINITY);
@@ -56,12 +61,14 @@ nlohmann::json statsJson(const SheetStats& s) {
   j["particles"] = s.particles;
   nlohmann::json cs;
   uint32_t total = 0;
-  for (uint32_t k = 0; k < 4; ++k) cs[kindName(k)] = s.constraints[k], total += s.constraints[k];
+  for (uint32_t k = 0; k < SIM_KIND_COUNT; ++k) cs[kindName(k)] = s.constraints[k], total += s.constraints[k];
   cs["total"] = total;
   j["constraints"] = cs;
   j["colors"] = s.colors;
   j["torn"] = s.torn;
   j["triangles"] = s.triangles;
+  j["creased"] = s.creased;
+  j["max_crease_deg"] = s.max_crease_deg;
   j["state_hash"] = hashHex(s.state_hash);
   j["bbox_min"] = {s.bbox_min.x, s.bbox_min.y, s.bbox_min.z};
   j["bbox_max"] = {s.bbox_max.x, s.bbox_max.y, s.bbox_max.z};

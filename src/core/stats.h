@@ -10,13 +10,18 @@
 
 namespace tender {
 
+/// A hinge whose rest angle is this far from flat (degrees) counts as creased.
+constexpr float kCreasedDegrees = 2.0f;
+
 struct SheetStats {
   uint32_t particles = 0;
-  std::array<uint32_t, 4> constraints{}; ///< alive per kind
+  std::array<uint32_t, SIM_KIND_COUNT> constraints{}; ///< alive per kind
   uint32_t colors = 0;
   uint32_t torn = 0;
   uint32_t triangles = 0;
-  uint64_t state_hash = 0; ///< FNV-1a 64 of the position bytes
+  uint32_t creased = 0;        ///< hinges whose rest angle is more than kCreasedDegrees from flat
+  float max_crease_deg = 0.0f; ///< largest |rest angle| of a hinge, degrees
+  uint64_t state_hash = 0;     ///< FNV-1a 64 of the position bytes
   glm::vec3 bbox_min{0.0f}, bbox_max{0.0f};
   float max_stretch = 0.0f; ///< largest length / rest over alive structural constraints
   uint32_t nan_count = 0;   ///< non-finite position components

@@ -64,6 +64,7 @@ void CpuSolver::upload(const SheetTopology& topo) {
   colors_ = topo.colors;
   splitConstraints();
   torn_.assign(topo.constraintCount(), 0u);
+  hinges_.assign(topo.hingeCount(), vec4(0.0f));
   triangles_ = topo.triangles;
   triangle_count_ = topo.triangleCount();
   ticks_ = 0;
@@ -101,14 +102,19 @@ void CpuSolver::integrate(const SimUniforms& u, uint32_t s) {
   });
 }
 
-// Projects constraints [begin, end) of one colour (no two share a particle): the SIMD kernels
-// project all but the last few, the shaders' projectConstraint the rest.
-void CpuSolver::projectRange(SheetElements& e, const float stiffness[4], uint32_t begin, uint32_t end) {
+// Projects constraints [begin, end) of one colour (no two share a particle) in iteration
+// `iteration`: the SIMD kernels project all but the last few distance constraints, the shaders'
+// projectConstraint the rest (and a colour of hinges, which have colours of their own).
+void CpuSolver::projectRange(SheetElements& e, const float stiffness[4], uint32_t iteration, uint32_t begin,
+                             uint32_t end) {
   const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
   const float* rest = con_rest_.data();
-  uint32_t k =
-      simd_ ? simd::project(reinterpret_cast<float*>(pos_.data()), ca, cb, rest, kind, stiffness, begin, end) : begin;
-  for (; k < end; ++k) e.projectConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]});
+  const bool hinges = begin < end && kind[begin] == SIM_KIND_HINGE;
+  uint32_t k = simd_ && !hinges
+                   ? simd::project(reinterpret_cast<float*>(pos_.data()), ca, cb, rest, kind, stiffness, begin, end)
+                   : begin;
+  for (; k < end; ++k)
+    e.projectConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]}, iteration);
 }
 
 void CpuSolver::projectColors(const SimUniforms& u, uint32_t first, uint32_t count) {
@@ -123,11 +129,20 @@ void CpuSolver::projectColors(const SimUniforms& u, uint32_t first, uint32_t cou
   const uint32_t per_job = std::max(1u, WorkerPool::kMaxPhases / colors) * colors;
   for (uint32_t done = 0; done < count; done += per_job)
     pool_->runPhases(std::min(per_job, count - done), chunks, [&](uint32_t phase, uint32_t chunk) {
-      const ColorRange& range = colors_[(first + done + phase) % colors];
+      const uint32_t pass = first + done + phase;
+      const ColorRange& range = colors_[pass % colors];
       const uint32_t begin = WorkerPool::chunkBound(range.count, chunks, chunk);
       const uint32_t end = WorkerPool::chunkBound(range.count, chunks, chunk + 1);
-      projectRange(e, stiffness, range.first + begin, range.first + end);
+      projectRange(e, stiffness, pass / colors, range.first + begin, range.first + end);
     });
+}
+
+void CpuSolver::creasePass(const SimUniforms& u) {
+  if (!creasing(u.hinge.y, u.crease.y)) return;
+  SheetElements e = elements(u);
+  pool_->parallelFor(u.hinge.y, grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
+    for (uint32_t k = begin; k < end; ++k) e.creaseHinge(k);
+  });
 }
 
 void CpuSolver::floorPass(const SimUniforms& u) {
@@ -188,7 +203,8 @@ uint32_t CpuSolver::markUnsupported(const SimUniforms& u) {
 }
 
 SheetElements CpuSolver::elements(const SimUniforms& u) {
-  return SheetElements{u, pos_.data(), prev_.data(), SharedWords{torn_.data()}, topo_->tri_edges.data(), counters_};
+  return SheetElements{
+      u, pos_.data(), prev_.data(), SharedWords{torn_.data()}, topo_->tri_edges.data(), hinges_.data(), counters_};
 }
 
 void CpuSolver::compact() {
@@ -282,6 +298,9 @@ void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint3
   case PassKind::project:
     projectColors(u, first, count); // Gauss-Seidel over the colours
     break;
+  case PassKind::crease:
+    creasePass(u); // hinges bent past their yield move their rest angles
+    break;
   case PassKind::collide:
     collide(u); // repulsion of unconnected neighbours (Jacobi)
     break;
@@ -307,6 +326,7 @@ void CpuSolver::beginReset() {
   colors_ = topo_->colors;
   splitConstraints();
   std::fill(torn_.begin(), torn_.end(), 0u);
+  std::fill(hinges_.begin(), hinges_.end(), vec4(0.0f));
   triangles_ = topo_->triangles;
   triangle_count_ = topo_->triangleCount();
 }
@@ -334,6 +354,7 @@ void CpuSolver::readback(SimState& out) {
   out.constraints = constraints_;
   out.colors = colors_;
   out.torn = torn_;
+  out.hinges = hinges_;
   out.triangles.assign(triangles_.begin(), triangles_.begin() + triangle_count_);
   out.triangle_count = triangle_count_;
 }
@@ -341,8 +362,9 @@ void CpuSolver::readback(SimState& out) {
 uint64_t CpuSolver::memoryBytes() const {
   return capacityBytes(pos_) + capacityBytes(prev_) + capacityBytes(rest_) + capacityBytes(normal_) +
          capacityBytes(reset_from_) + capacityBytes(uv_) + capacityBytes(constraints_) + capacityBytes(colors_) +
-         capacityBytes(torn_) + capacityBytes(con_a_) + capacityBytes(con_b_) + capacityBytes(con_kind_) +
-         capacityBytes(con_id_) + capacityBytes(con_rest_) + capacityBytes(triangles_) + collision_.memoryBytes();
+         capacityBytes(torn_) + capacityBytes(hinges_) + capacityBytes(con_a_) + capacityBytes(con_b_) +
+         capacityBytes(con_kind_) + capacityBytes(con_id_) + capacityBytes(con_rest_) + capacityBytes(triangles_) +
+         collision_.memoryBytes();
 }
 
 } // namespace tender

@@ -83,8 +83,11 @@ public:
   void project(const shaderio::SimUniforms& u, uint32_t iterations) {
     projectColors(u, 0, iterations * uint32_t(colors_.size()));
   }
-  /// Colour passes [first, first + count) of the Gauss-Seidel sweep (pass k: colour k % colours).
+  /// Colour passes [first, first + count) of the Gauss-Seidel sweep (pass k: colour k % colours of
+  /// iteration k / colours).
   void projectColors(const shaderio::SimUniforms& u, uint32_t first, uint32_t count);
+  /// The creases of the substep (creaseHinge), when the sheet creases.
+  void creasePass(const shaderio::SimUniforms& u);
   /// The collision of one substep (CpuCollision::substep); returns the mode (SIM_CANDIDATE_*).
   uint32_t collide(const shaderio::SimUniforms& u) { return collision_.substep(u, pos_.data()); }
   /// Applies the collision deltas, then the ground contact.
@@ -103,6 +106,8 @@ public:
   std::vector<glm::vec4>& positions() { return pos_; }
   /// Previous positions, for tests.
   std::vector<glm::vec4>& previous() { return prev_; }
+  /// The hinges' states (HingeState), for tests.
+  std::vector<glm::vec4>& hingeStates() { return hinges_; }
   /// The collision: spatial hash, gather, candidate lists.
   CpuCollision& collision() { return collision_; }
   /// First hash slot of each bucket, then the end (CpuCollision::cellStart).
@@ -113,7 +118,8 @@ public:
   glm::uvec4 candidateState() const { return collision_.candidateState(); }
 
 private:
-  void projectRange(shaderio::SheetElements& e, const float stiffness[4], uint32_t begin, uint32_t end);
+  void projectRange(shaderio::SheetElements& e, const float stiffness[4], uint32_t iteration, uint32_t begin,
+                    uint32_t end);
   void markTearsRange(shaderio::SheetElements& e, uint32_t begin, uint32_t end);
   /// The sheet as the shaders' element bodies read it (sim_bodies.h).
   shaderio::SheetElements elements(const shaderio::SimUniforms& u);
@@ -134,6 +140,7 @@ private:
   std::vector<uint32_t> con_a_, con_b_, con_kind_, con_id_;
   std::vector<float> con_rest_;
   std::vector<uint32_t> torn_;
+  std::vector<glm::vec4> hinges_; ///< HingeState per hinge
   std::vector<glm::uvec4> triangles_;
   uint32_t triangle_count_ = 0;
   shaderio::Counters counters_{}; ///< the tear counts the element bodies keep (torn_new: this substep)

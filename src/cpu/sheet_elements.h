@@ -14,6 +14,7 @@ struct SheetElements {
   SharedWords torn; ///< read while markUnsupported marks edges no triangle holds
 
   const uvec2* tri_edges;
+  HingeState* hinges;
   Counters& counters;
 
 #include "sim_bodies.h"

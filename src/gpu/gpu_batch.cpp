@@ -230,6 +230,7 @@ void GpuBatch::flush() {
     plan.iterations = std::max(plan.iterations, u.iterations);
     plan.collision = plan.collision || (u.flags & SIM_FLAG_COLLISION) != 0u;
     plan.air = plan.air || (u.flags & SIM_FLAG_AIR) != 0u;
+    plan.crease = plan.crease || creasing(u.hinge.y, u.crease.y);
   }
   if (fused.empty() && passes.empty()) return;
   last_dispatches_ = 0;
@@ -308,7 +309,8 @@ void GpuBatch::flush() {
         pass(sheet_passes_.reset, Grid::Threads, n, &all, sizeof(all), 0, SIM_GATE_RESET, 0);
         continue;
       }
-      const SubstepPlan sheet_plan{u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u, (u.flags & SIM_FLAG_AIR) != 0u};
+      const SubstepPlan sheet_plan{u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u, (u.flags & SIM_FLAG_AIR) != 0u,
+                                   SIM_NONE, creasing(u.hinge.y, u.crease.y)};
       for (uint32_t s = 0; s < substepCount(u.substeps); ++s)
         recordSubstep(*this, sheet_passes_, topo_, sizes_, sheet_plan, s, count);
     }

@@ -143,8 +143,13 @@ void GpuSolver::tick(const SimUniforms& u) {
     dispatches_per_tick_ = 1;
     return;
   }
-  RecordKey key{substepCount(u.substeps), u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u,
-                usesFusedPath(u),         stop_after_,  (u.flags & SIM_FLAG_AIR) != 0u};
+  RecordKey key{substepCount(u.substeps),
+                u.iterations,
+                (u.flags & SIM_FLAG_COLLISION) != 0u,
+                usesFusedPath(u),
+                stop_after_,
+                (u.flags & SIM_FLAG_AIR) != 0u,
+                creasing(u.hinge.y, u.crease.y)};
   stop_after_ = SIM_NONE;
   if (flight.recorded != key) recordTick(flight, index, key);
   ctx_.submit(flight.tick, flight.fence);

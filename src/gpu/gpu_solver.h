@@ -126,6 +126,7 @@ private:
     bool fused = false;
     uint32_t stop = SIM_NONE; ///< last pass recorded (stopNextTickAfter)
     bool air = false;         ///< the air pass runs before integration (SIM_FLAG_AIR)
+    bool crease = false;      ///< the crease pass runs after the projection (creasing)
     bool operator==(const RecordKey&) const = default;
   };
   struct InFlight {

@@ -142,6 +142,7 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
       spec(SIM_BIND_CONSTRAINTS, 16ull * m, topo.constraints.data(), bytesOf(topo.constraints), kRestored | kReadBack),
       spec(SIM_BIND_COLOR_RANGES, 8ull * topo.colorCount(), d.colors.data(), bytesOf(d.colors), kRestored | kReadBack),
       spec(SIM_BIND_TORN, 4ull * m, nullptr, 0, kRestored | kReadBack),
+      spec(SIM_BIND_HINGES, 16ull * topo.hingeCount(), nullptr, 0, kRestored | kReadBack),
       spec(SIM_BIND_TRIANGLES, 16ull * t, topo.triangles.data(), bytesOf(topo.triangles), kRestored | kReadBack),
       spec(SIM_BIND_COUNTERS, sizeof(Counters), &d.counters, sizeof(Counters), kRestored | kReadBack),
       spec(SIM_BIND_TRI_EDGES, 8ull * t, topo.tri_edges.data(), bytesOf(topo.tri_edges)),
@@ -177,6 +178,7 @@ void assembleState(const SheetTopology& topo, const std::function<const void*(ui
   take(SIM_BIND_NORMAL, out.normal, n);
   take(SIM_BIND_CONSTRAINTS, out.constraints, m);
   take(SIM_BIND_TORN, out.torn, m);
+  take(SIM_BIND_HINGES, out.hinges, topo.hingeCount());
   std::vector<glm::uvec2> colors;
   take(SIM_BIND_COLOR_RANGES, colors, topo.colorCount());
   std::vector<glm::uvec4> triangles;

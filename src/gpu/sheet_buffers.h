@@ -51,8 +51,8 @@ struct StartData {
 };
 
 /// Bindings of a sheet's descriptor set: the uniforms (SIM_BIND_UNIFORMS, a dynamic uniform buffer)
-/// and every storage array, up to SIM_BIND_HASH_ARGS.
-constexpr uint32_t kSheetBindingCount = SIM_BIND_HASH_ARGS + 1;
+/// and every storage array, up to SIM_BIND_HINGES.
+constexpr uint32_t kSheetBindingCount = SIM_BIND_HINGES + 1;
 
 /// The layout of a sheet's descriptor set (kSheetBindingCount bindings).
 VkDescriptorSetLayout createSheetSetLayout(VkDevice dev);

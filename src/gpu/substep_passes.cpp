@@ -55,9 +55,19 @@ bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& has
 namespace {
 
 /// What a dispatch covers (SIM_DISPATCHES' elements column).
-enum class Elements : uint8_t { PARTICLES, COLOUR, CONSTRAINTS, ONE, HASH_ARGS, HASH_CELLS, TEAR_SLOTS, INDIRECT };
+enum class Elements : uint8_t {
+  PARTICLES,
+  COLOUR,
+  HINGES,
+  CONSTRAINTS,
+  ONE,
+  HASH_ARGS,
+  HASH_CELLS,
+  TEAR_SLOTS,
+  INDIRECT
+};
 /// When a sheet records a dispatch (SIM_DISPATCHES' needs column).
-enum class Needs : uint8_t { ALWAYS, AIR, CONSTRAINTS };
+enum class Needs : uint8_t { ALWAYS, AIR, CREASE, CONSTRAINTS };
 
 /// One row of SIM_DISPATCHES.
 struct Dispatch {
@@ -117,12 +127,15 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
     break;
   case Elements::COLOUR: {
     // Pass k: colour k % colours of iteration k / colours; an empty colour records nothing
-    const uint32_t c = k % topo.colorCount();
+    const uint32_t c = k % topo.colorCount(), iteration = k / topo.colorCount();
     const ColorRange& range = topo.colors[c];
     if (range.count == 0) return;
-    record(sink, p, d.grid, range.count, SimPush{range.first, range.count, s, c}, s, d.gate, k / topo.colorCount());
+    record(sink, p, d.grid, range.count, SimPush{iteration, range.count, s, c}, s, d.gate, iteration);
     break;
   }
+  case Elements::HINGES:
+    record(sink, p, d.grid, topo.hingeCount(), SimPush{0, topo.hingeCount(), s, 0}, s, d.gate);
+    break;
   case Elements::CONSTRAINTS:
     record(sink, p, d.grid, m, SimPush{0, m, s, 0}, s, d.gate);
     break;
@@ -165,6 +178,7 @@ bool recordSubstep(PassSink& sink, const SimPipelines& pipes, const SheetTopolog
         const Dispatch& d = kDispatches[row];
         if (d.stage != stage) continue;
         const bool needed = d.needs == Needs::ALWAYS || (d.needs == Needs::AIR && plan.air) ||
+                            (d.needs == Needs::CREASE && plan.crease && topo.hingeCount() > 0) ||
                             (d.needs == Needs::CONSTRAINTS && has_constraints);
         if (needed) recordDispatch(sink, pipes, topo, sizes, d, s, k);
         if (k + 1 == passes && closesCategory(row)) sink.mark(d.category);

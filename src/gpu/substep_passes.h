@@ -79,13 +79,14 @@ protected:
   ~PassSink() = default;
 };
 
-/// What the passes of a substep cover: for a fleet, the most iterations of its sheets, and air and
-/// collision when any sheet has them.
+/// What the passes of a substep cover: for a fleet, the most iterations of its sheets, and air,
+/// collision and creases when any sheet has them.
 struct SubstepPlan {
   uint32_t iterations = 0;
   bool collision = false;
   bool air = false;
   uint32_t stop = SIM_NONE; ///< last pass to record (SIM_STAGES numbering; Solver::stopNextTickAfter)
+  bool crease = false;      ///< the crease pass runs (creasing in xpbd.h)
 };
 
 /// Timestamps a substep of the per-colour path records (one where each category ends).

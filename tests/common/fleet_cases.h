@@ -93,6 +93,7 @@ inline uint32_t expectFleetMatchesAlone(SheetBatch& batch, Solver& alone, const 
     EXPECT_TRUE(sameBytes(a.constraints, b.constraints)) << "sheet " << i;
     EXPECT_TRUE(sameBytes(a.colors, b.colors)) << "sheet " << i;
     EXPECT_TRUE(sameBytes(a.torn, b.torn)) << "sheet " << i;
+    EXPECT_TRUE(sameBytes(a.hinges, b.hinges)) << "sheet " << i;
     EXPECT_TRUE(sameBytes(a.triangles, b.triangles)) << "sheet " << i;
     uint32_t torn = 0;
     for (uint32_t k : a.torn) torn += k;

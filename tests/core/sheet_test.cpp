@@ -17,12 +17,29 @@ TEST(Sheet, CountsMatchTheSpecFor32x48) {
   EXPECT_EQ(t.constraintCount(), 2992u + 2914u + 2912u);
 }
 
-TEST(Sheet, CrumpleHasTriangleBending) {
+TEST(Sheet, CrumpleHasHinges) {
   SheetTopology t = buildSheet(*presetParams("crumple"));
   EXPECT_EQ(t.particleCount(), 2400u);
   EXPECT_EQ(t.kind_counts[SIM_KIND_BEND], 0u);
-  // One per interior structural edge: (W-1)(H-2) horizontal + (W-2)(H-1) vertical.
-  EXPECT_EQ(t.kind_counts[SIM_KIND_TRIBEND], 39u * 58u + 38u * 59u);
+  EXPECT_EQ(t.kind_counts[SIM_KIND_TRIBEND], 0u);
+  // One per interior edge: (W-1)(H-2) across rows, (W-2)(H-1) across columns, a diagonal per quad;
+  // the quads' other diagonal is gone (the sheet folds there)
+  EXPECT_EQ(t.kind_counts[SIM_KIND_HINGE], 39u * 58u + 38u * 59u + 39u * 59u);
+  EXPECT_EQ(t.kind_counts[SIM_KIND_SHEAR], 39u * 59u);
+  EXPECT_EQ(t.hinge_first + t.hingeCount(), t.constraintCount());
+  EXPECT_EQ(sheetCounts(*presetParams("crumple")).constraints, t.constraintCount());
+  // Each hinge's two triangles are the two of gridTriangle that hold its edge and its corners
+  for (uint32_t k = 0; k < t.hingeCount(); ++k) {
+    const glm::uvec4 q = shaderio::gridHinge(k, t.cols, t.rows);
+    const glm::uvec2 tris = shaderio::hingeTriangles(k, t.cols, t.rows);
+    auto has = [&](uint32_t tri, glm::uvec3 want) {
+      const glm::uvec3 c = shaderio::gridTriangle(tri, t.cols);
+      // the same three corners in the same cyclic order (counter-clockwise)
+      return (c == want) || (c == glm::uvec3(want.y, want.z, want.x)) || (c == glm::uvec3(want.z, want.x, want.y));
+    };
+    ASSERT_TRUE(has(tris.x, glm::uvec3(q.x, q.y, q.z))) << k;
+    ASSERT_TRUE(has(tris.y, glm::uvec3(q.y, q.x, q.w))) << k;
+  }
 }
 
 // No two constraints of one colour share a particle; ranges tile the array.

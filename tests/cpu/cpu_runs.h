@@ -27,6 +27,7 @@ inline void expectIdentical(const SimState& a, const SimState& b) {
   EXPECT_TRUE(sameBytes(a.constraints, b.constraints));
   EXPECT_TRUE(sameBytes(a.colors, b.colors));
   EXPECT_TRUE(sameBytes(a.torn, b.torn));
+  EXPECT_TRUE(sameBytes(a.hinges, b.hinges));
   EXPECT_TRUE(sameBytes(a.triangles, b.triangles));
   EXPECT_EQ(a.triangle_count, b.triangle_count);
 }

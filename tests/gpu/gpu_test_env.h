@@ -60,13 +60,20 @@ inline float maxAbsDiff(const std::vector<glm::vec4>& a, const std::vector<glm::
   return m;
 }
 
-/// Parity: two states hold the same bits in their positions and previous positions, and the same
-/// number of particles (an empty or short read-back fails). On failure: the first particle that
-/// differs and the largest difference.
+/// Parity: two states hold the same bits in their positions, previous positions and hinge states
+/// (rest angles, yields, multipliers), and the same number of particles (an empty or short
+/// read-back fails). On failure: the first particle that differs and the largest difference.
 inline ::testing::AssertionResult sameState(const SimState& a, const SimState& b) {
   if (a.pos.empty() || a.pos.size() != b.pos.size() || a.prev.size() != b.prev.size())
     return ::testing::AssertionFailure() << "the states differ in size: " << a.pos.size() << " and " << b.pos.size()
                                          << " particles";
+  if (a.hinges.size() != b.hinges.size() || !sameBytes(a.hinges, b.hinges)) {
+    size_t first = 0;
+    while (first < std::min(a.hinges.size(), b.hinges.size()) &&
+           std::memcmp(&a.hinges[first], &b.hinges[first], sizeof(glm::vec4)) == 0)
+      ++first;
+    return ::testing::AssertionFailure() << "the hinge states part at hinge " << first << " of " << a.hinges.size();
+  }
   if (sameBytes(a.pos, b.pos) && sameBytes(a.prev, b.prev)) return ::testing::AssertionSuccess();
   size_t first = 0;
   while (first < a.pos.size() && std::memcmp(&a.pos[first], &b.pos[first], sizeof(glm::vec4)) == 0 &&

@@ -62,11 +62,12 @@ std::vector<std::string> kernels(const std::vector<Recorded>& passes) {
   return names;
 }
 
-/// The topology of a `cols` x `rows` tender sheet.
+/// The topology of a `cols` x `rows` tender sheet with hinges.
 SheetTopology tenderSheet(uint32_t cols, uint32_t rows) {
   SimParams p = *presetParams("tender");
   p.cols = cols;
   p.rows = rows;
+  p.dihedral = true;
   return buildSheet(p);
 }
 
@@ -81,7 +82,7 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   const SimPipelines pipes = fakePipelines();
   RecordingSink sink(pipes);
   uint32_t pass = 0;
-  const SubstepPlan plan{2, true, true, SIM_NONE};
+  const SubstepPlan plan{2, true, true, SIM_NONE, true};
   EXPECT_FALSE(recordSubstep(sink, pipes, topo, sizes, plan, 0, pass));
   EXPECT_EQ(pass, shaderio::passesPerSubstep(2, topo.colorCount(), true));
   EXPECT_EQ(sink.barriers_due, 0u); // every pass is followed by a barrier
@@ -94,6 +95,7 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
         expected.push_back("project");
         iterations.push_back(it);
       }
+  expected.push_back("crease");
   for (const char* k :
        {"candidates_check", "candidates_decide", "hash_count", "scan", "hash_scatter", "hash_sort", "collide",
         "candidates_finish", "floor", "tear_mark", "tear_unsupported", "tear_flags", "scan", "tear_compact"})
@@ -104,7 +106,7 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
       EXPECT_EQ(sink.passes[k].gate, SIM_GATE_ITERATION);
       EXPECT_EQ(sink.passes[k].gate_arg, iterations[project++]);
     }
-  EXPECT_EQ(sink.marks, (std::vector<PassCategory>{kIntegrate, kProject, kHash, kCollide, kFloor, kTear}));
+  EXPECT_EQ(sink.marks, (std::vector<PassCategory>{kIntegrate, kProject, kProject, kHash, kCollide, kFloor, kTear}));
   EXPECT_EQ(marksPerSubstep(), sink.marks.size());
 }
 
@@ -125,6 +127,8 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
       return "integrate";
     case PassKind::project:
       return "project";
+    case PassKind::crease:
+      return "crease";
     case PassKind::collide:
       return "candidates_finish";
     case PassKind::floor:
@@ -139,7 +143,7 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
   for (uint32_t stop = 0; stop < passesPerTick(u); ++stop) {
     RecordingSink sink(pipes);
     uint32_t pass = 0;
-    EXPECT_TRUE(recordSubstep(sink, pipes, topo, sizes, SubstepPlan{1, true, false, stop}, 0, pass)) << stop;
+    EXPECT_TRUE(recordSubstep(sink, pipes, topo, sizes, SubstepPlan{1, true, false, stop, true}, 0, pass)) << stop;
     EXPECT_EQ(pass, stop + 1);
     const PassPoint at = passAt(u, stop);
     ASSERT_FALSE(sink.passes.empty());
