@@ -190,19 +190,17 @@ float simDiv(float a, float b) { return exactDiv(a, b); }
 
 #define SIM_PI 3.14159265f
 
-/// atan2(y, x) in (-pi, pi] from adds, multiplies and simDiv alone, so every device gives the same
-/// bits (a device's atan is not correctly rounded): the ratio of the smaller to the larger
-/// magnitude, past tan(pi / 8) turned by pi / 4, then Cephes' atanf polynomial (about 1e-7 rad
-/// from the true angle), unfolded into the octant. atan2(0, 0) is 0.
+/// atan2(y, x) in (-pi, pi] from adds, multiplies and one simDiv, so every device gives the same
+/// bits (a device's atan is not correctly rounded): the ratio t of the smaller to the larger
+/// magnitude (past tan(pi / 8), (small - big) / (small + big) and pi / 4 more), then Cephes' atanf
+/// polynomial (about 1e-7 rad from the true angle), unfolded into the octant. atan2(0, 0) is 0.
 SIM_INLINE float simAtan2(float y, float x) {
   float ax = abs(x), ay = abs(y);
   float big = max(ax, ay), small = min(ax, ay);
   if (!(big > 0.0f)) return 0.0f;
-  float t = simDiv(small, big), base = 0.0f;
-  if (t > 0.41421356f) {
-    t = simDiv(t - 1.0f, t + 1.0f);
-    base = 0.78539816f;
-  }
+  bool turn = small > 0.41421356f * big;
+  float t = simDiv(turn ? small - big : small, turn ? small + big : big);
+  float base = turn ? 0.78539816f : 0.0f;
   float z = t * t;
   float a =
       base + ((((0.0805374449538f * z - 0.138776856032f) * z + 0.199777106478f) * z - 0.333329491539f) * z * t + t);

@@ -48,8 +48,8 @@ SIM_INLINE void projectConstraint(Constraint c, uint iteration) {
 SIM_INLINE void creaseHinge(uint k) {
   if (torn[u.hinge.x + k] != 0u) return;
   uvec4 q = gridHinge(k, u.cols, u.rows);
-  HingeAngle h =
-      hingeAngle(vec3(SIM_POSITION(q.x)), vec3(SIM_POSITION(q.y)), vec3(SIM_POSITION(q.z)), vec3(SIM_POSITION(q.w)));
+  HingeAngle h = hingeAngle(vec3(SIM_POSITION(q.x)), vec3(SIM_POSITION(q.y)), vec3(SIM_POSITION(q.z)),
+                            vec3(SIM_POSITION(q.w)), false);
   if (h.valid) hinges[k] = creaseReturn(hinges[k], h.angle, u.crease.y, u.crease.z);
 }
 

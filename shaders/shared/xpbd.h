@@ -222,9 +222,9 @@ struct HingeAngle {
 
 /// The angle of the hinge with edge pu-pv and opposite corners pa and pb (gridHinge's order): from
 /// the normals na of (pu, pv, pa) and nb of (pv, pu, pb), atan2 of (nb x na) . e and (na . nb) |e|.
-/// The gradient: a corner moves the angle by its normal over its height above the edge, and the
-/// ends of the edge take the rest by the lever rule, so the four sum to zero.
-SIM_INLINE HingeAngle hingeAngle(vec3 pu, vec3 pv, vec3 pa, vec3 pb) {
+/// With `gradient`, the gradient: a corner moves the angle by its normal over its height above the
+/// edge, and the ends of the edge take the rest by the lever rule, so the four sum to zero.
+SIM_INLINE HingeAngle hingeAngle(vec3 pu, vec3 pv, vec3 pa, vec3 pb, bool gradient) {
   HingeAngle h;
   h.angle = 0.0f;
   h.valid = false;
@@ -241,9 +241,11 @@ SIM_INLINE HingeAngle hingeAngle(vec3 pu, vec3 pv, vec3 pa, vec3 pb) {
   float el = simSqrt(e2);
   h.angle = simAtan2(dot3(cross3(nb, na), e), dot3(na, nb) * el);
   h.valid = true;
+  if (!gradient) return h;
   h.ga = na * simDiv(el, na2);
   h.gb = nb * simDiv(el, nb2);
-  float sa = simDiv(dot3(pa - pu, e), e2), sb = simDiv(dot3(pb - pu, e), e2);
+  float inv_e2 = simDiv(1.0f, e2);
+  float sa = dot3(pa - pu, e) * inv_e2, sb = dot3(pb - pu, e) * inv_e2;
   h.gu = -(h.ga * (1.0f - sa) + h.gb * (1.0f - sb));
   h.gv = -(h.ga * sa + h.gb * sb);
   return h;
@@ -265,7 +267,7 @@ SIM_INLINE HingeDelta solveHinge(vec4 pu, vec4 pv, vec4 pa, vec4 pb, float rest,
   r.da = vec3(0.0f);
   r.db = vec3(0.0f);
   r.lambda = lambda;
-  HingeAngle h = hingeAngle(vec3(pu), vec3(pv), vec3(pa), vec3(pb));
+  HingeAngle h = hingeAngle(vec3(pu), vec3(pv), vec3(pa), vec3(pb), true);
   if (!h.valid) return r;
   float c = wrapAngle(h.angle - rest);
   float denom =

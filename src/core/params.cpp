@@ -359,9 +359,10 @@ uint64_t estimateSheetBytes(const SimParams& p, const std::string& backend) {
   uint64_t solver = 0;
   if (backend == "cpu") {
     // Particle arrays (pos, prev, rest, normal, delta, reset source, uv), constraints with their
-    // split copy and torn flags, triangles, adjacency, the hash and its sorted copies, the
+    // split copy (and the hinges' corners) and torn flags, triangles, adjacency, the hash and its sorted copies, the
     // collision candidate lists.
     solver = 104 * n + 40 * m + 16 * t + 4 * n + 8 * m + 8 * hb + 28 * n + 28 * n + 76 * n;
+    solver += 20 * m + 16 * hinges; // each slot's hinge corners and hinge, each hinge's corners
   } else {
     // The solver's copy of the topology, its storage buffers (particle arrays, constraints and
     // their compaction scratch, hash, candidate lists) and the largest staging of an upload.

@@ -35,6 +35,8 @@ void CpuSolver::splitConstraints() {
   con_kind_.resize(m);
   con_id_.resize(m);
   con_rest_.resize(m);
+  con_corners_.assign(4 * m, 0u);
+  con_hinge_.assign(m, 0u);
   for (size_t k = 0; k < m; ++k) {
     const Constraint& c = constraints_[order[k]];
     con_a_[k] = c.a;
@@ -42,6 +44,10 @@ void CpuSolver::splitConstraints() {
     con_kind_[k] = c.kind_id & SIM_KIND_MASK;
     con_id_[k] = c.kind_id >> SIM_KIND_BITS;
     con_rest_[k] = c.rest;
+    if (con_kind_[k] != SIM_KIND_HINGE) continue;
+    con_hinge_[k] = con_id_[k] - topo_->hinge_first;
+    const uvec4 q = gridHinge(con_hinge_[k], topo_->cols, topo_->rows);
+    for (uint32_t j = 0; j < 4; ++j) con_corners_[4 * k + j] = q[j];
   }
 }
 
@@ -65,6 +71,11 @@ void CpuSolver::upload(const SheetTopology& topo) {
   splitConstraints();
   torn_.assign(topo.constraintCount(), 0u);
   hinges_.assign(topo.hingeCount(), vec4(0.0f));
+  hinge_corners_.resize(4 * size_t(topo.hingeCount()));
+  for (uint32_t k = 0; k < topo.hingeCount(); ++k) {
+    const uvec4 q = gridHinge(k, topo.cols, topo.rows);
+    for (uint32_t j = 0; j < 4; ++j) hinge_corners_[4 * size_t(k) + j] = q[j];
+  }
   triangles_ = topo.triangles;
   triangle_count_ = topo.triangleCount();
   ticks_ = 0;
@@ -110,9 +121,16 @@ void CpuSolver::projectRange(SheetElements& e, const float stiffness[4], uint32_
   const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
   const float* rest = con_rest_.data();
   const bool hinges = begin < end && kind[begin] == SIM_KIND_HINGE;
-  uint32_t k = simd_ && !hinges
-                   ? simd::project(reinterpret_cast<float*>(pos_.data()), ca, cb, rest, kind, stiffness, begin, end)
-                   : begin;
+  uint32_t k = begin;
+  if (simd_ && !hinges)
+    k = simd::project(reinterpret_cast<float*>(pos_.data()), ca, cb, rest, kind, stiffness, begin, end);
+  if (simd_ && hinges) {
+    const uint32_t cols = topo_->cols, rows = topo_->rows;
+    const uint32_t first_diagonal = (cols - 1) * (rows - 2) + (cols - 2) * (rows - 1); // hingeIsDiagonal
+    k = simd::projectHinges(reinterpret_cast<float*>(pos_.data()), reinterpret_cast<float*>(hinges_.data()),
+                            con_corners_.data(), con_hinge_.data(), first_diagonal, e.u.crease.x, iteration, begin,
+                            end);
+  }
   for (; k < end; ++k)
     e.projectConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]}, iteration);
 }
@@ -141,7 +159,11 @@ void CpuSolver::creasePass(const SimUniforms& u) {
   if (!creasing(u.hinge.y, u.crease.y)) return;
   SheetElements e = elements(u);
   pool_->parallelFor(u.hinge.y, grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
-    for (uint32_t k = begin; k < end; ++k) e.creaseHinge(k);
+    uint32_t k = begin;
+    if (simd_)
+      k = simd::creaseHinges(reinterpret_cast<float*>(pos_.data()), reinterpret_cast<float*>(hinges_.data()),
+                             hinge_corners_.data(), torn_.data() + u.hinge.x, u.crease.y, u.crease.z, begin, end);
+    for (; k < end; ++k) e.creaseHinge(k);
   });
 }
 
@@ -220,6 +242,8 @@ void CpuSolver::compact() {
         con_b_[v] = con_b_[k];
         con_kind_[v] = con_kind_[k];
         con_id_[v] = con_id_[k];
+        con_hinge_[v] = con_hinge_[k];
+        for (uint32_t j = 0; j < 4; ++j) con_corners_[4 * v + j] = con_corners_[4 * k + j];
         con_rest_[v++] = con_rest_[k];
       }
     range.count = w - range.first;
@@ -363,7 +387,8 @@ uint64_t CpuSolver::memoryBytes() const {
   return capacityBytes(pos_) + capacityBytes(prev_) + capacityBytes(rest_) + capacityBytes(normal_) +
          capacityBytes(reset_from_) + capacityBytes(uv_) + capacityBytes(constraints_) + capacityBytes(colors_) +
          capacityBytes(torn_) + capacityBytes(hinges_) + capacityBytes(con_a_) + capacityBytes(con_b_) +
-         capacityBytes(con_kind_) + capacityBytes(con_id_) + capacityBytes(con_rest_) + capacityBytes(triangles_) +
+         capacityBytes(con_kind_) + capacityBytes(con_id_) + capacityBytes(con_rest_) + capacityBytes(con_corners_) +
+         capacityBytes(con_hinge_) + capacityBytes(hinge_corners_) + capacityBytes(triangles_) +
          collision_.memoryBytes();
 }
 

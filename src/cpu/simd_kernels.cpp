@@ -37,6 +37,26 @@ uint32_t project8([[maybe_unused]] float* pos, [[maybe_unused]] const uint32_t* 
   return begin;
 }
 
+uint32_t projectHinges([[maybe_unused]] float* pos, [[maybe_unused]] float* state,
+                       [[maybe_unused]] const uint32_t* corners, [[maybe_unused]] const uint32_t* hinge,
+                       [[maybe_unused]] uint32_t first_diagonal, [[maybe_unused]] float alpha,
+                       [[maybe_unused]] uint32_t iteration, uint32_t begin, [[maybe_unused]] uint32_t end) {
+#if defined(TENDER_CPU_AVX)
+  if (hasAvx()) return avx::projectHinges(pos, state, {corners, hinge, first_diagonal, alpha}, iteration, begin, end);
+#endif
+  return begin;
+}
+
+uint32_t creaseHinges([[maybe_unused]] float* pos, [[maybe_unused]] float* state,
+                      [[maybe_unused]] const uint32_t* corners, [[maybe_unused]] const uint32_t* torn,
+                      [[maybe_unused]] float yield0, [[maybe_unused]] float hardening, uint32_t begin,
+                      [[maybe_unused]] uint32_t end) {
+#if defined(TENDER_CPU_AVX)
+  if (hasAvx()) return avx::creaseHinges(pos, state, corners, torn, yield0, hardening, begin, end);
+#endif
+  return begin;
+}
+
 uint32_t project(float* pos, const uint32_t* a, const uint32_t* b, const float* rest, const uint32_t* kind,
                  const float stiffness[4], uint32_t begin, uint32_t end) {
   const uint32_t k = project8(pos, a, b, rest, kind, stiffness, begin, end);

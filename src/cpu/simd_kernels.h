@@ -38,6 +38,19 @@ uint32_t project8(float* pos, const uint32_t* a, const uint32_t* b, const float*
 uint32_t project(float* pos, const uint32_t* a, const uint32_t* b, const float* rest, const uint32_t* kind,
                  const float stiffness[4], uint32_t begin, uint32_t end);
 
+/// Projects the hinges of slots [begin, end) of one colour eight at a time with AVX, with the
+/// operations of projectHinge: `corners` holds each slot's gridHinge (4 words), `hinge` its hinge,
+/// hinges from `first_diagonal` on are diagonals, `alpha` is an edge hinge's compliance over dt^2.
+/// Returns the first slot it did not project (`begin` without AVX); the caller projects the rest.
+uint32_t projectHinges(float* pos, float* state, const uint32_t* corners, const uint32_t* hinge,
+                       uint32_t first_diagonal, float alpha, uint32_t iteration, uint32_t begin, uint32_t end);
+
+/// The creases of hinges [begin, end) eight at a time with AVX, with the operations of creaseHinge:
+/// `corners` holds each hinge's gridHinge (4 words), `torn` each hinge's torn flag. Returns the
+/// first hinge it did not do (`begin` without AVX).
+uint32_t creaseHinges(float* pos, float* state, const uint32_t* corners, const uint32_t* torn, float yield0,
+                      float hardening, uint32_t begin, uint32_t end);
+
 /// The length test of shouldTear for constraints [k, k + n), n a multiple of 4 up to 64: bit l is
 /// set when constraint k + l is longer than rest x tear_factor, with the same operations.
 uint64_t stretched(const float* pos, const uint32_t* a, const uint32_t* b, const float* rest, float tear_factor,

@@ -39,7 +39,7 @@ std::array<glm::vec3, 4> foldedHinge(double fold) {
 TEST(Hinge, TheAngleIsTheSignedFoldAndAtan2IsWithinAMicroradian) {
   for (double deg = -179.0; deg <= 180.0; deg += 0.5) {
     const auto h = foldedHinge(deg / kDeg);
-    const HingeAngle g = hingeAngle(h[0], h[1], h[2], h[3]);
+    const HingeAngle g = hingeAngle(h[0], h[1], h[2], h[3], true);
     ASSERT_TRUE(g.valid) << deg;
     EXPECT_NEAR(g.angle * kDeg, deg, 1e-4) << deg;
   }
@@ -62,7 +62,7 @@ TEST(Hinge, TheGradientIsTheAnglesDerivative) {
   for (int trial = 0; trial < 200; ++trial) {
     auto h = foldedHinge(double(trial % 40 - 20) * 0.15);
     for (glm::vec3& p : h) p += glm::vec3(jitter(rng), jitter(rng), jitter(rng));
-    const HingeAngle g = hingeAngle(h[0], h[1], h[2], h[3]);
+    const HingeAngle g = hingeAngle(h[0], h[1], h[2], h[3], true);
     ASSERT_TRUE(g.valid);
     const glm::vec3 grads[4] = {g.gu, g.gv, g.ga, g.gb};
     EXPECT_LT(glm::length(g.gu + g.gv + g.ga + g.gb), 1e-4f); // a translation turns nothing
@@ -174,7 +174,7 @@ std::vector<double> rowMedians(const SimState& s, const SimParams& p, bool rest)
       }
       const glm::uvec4 q = gridHinge(k, p.cols, p.rows);
       const HingeAngle g =
-          hingeAngle(glm::vec3(s.pos[q.x]), glm::vec3(s.pos[q.y]), glm::vec3(s.pos[q.z]), glm::vec3(s.pos[q.w]));
+          hingeAngle(glm::vec3(s.pos[q.x]), glm::vec3(s.pos[q.y]), glm::vec3(s.pos[q.z]), glm::vec3(s.pos[q.w]), false);
       row.push_back(g.valid ? std::abs(double(g.angle)) * kDeg : 0.0);
     }
     std::nth_element(row.begin(), row.begin() + row.size() / 2, row.end());
