@@ -54,9 +54,6 @@ struct SimUniforms {
   // Hinges: x the XPBD compliance of an edge hinge over dt^2 (a diagonal's is half), y the yield
   // angle in radians (0: elastic, no creases), z the hardening
   vec4 crease;
-  // The closing hand around the grabbed particle: x its radius, y how far it is closed (0 open, 1
-  // shut), z the share of the way to the closed hand a particle in reach goes each substep
-  vec4 hand;
 
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
   vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet
