@@ -187,11 +187,15 @@ SIM_INLINE uvec4 gridHinge(uint k, uint cols, uint rows) {
   return uvec4(tl + cols + 1u, tl, tl + cols, tl + 1u);
 }
 
+/// The first hinge of a cols x rows grid (cols, rows >= 2) that is a quad's diagonal: those after
+/// the row and column edges' (gridHinge).
+SIM_INLINE uint firstDiagonalHinge(uint cols, uint rows) {
+  return (cols - 1u) * (rows - 2u) + (cols - 2u) * (rows - 1u);
+}
+
 /// True when hinge k of a cols x rows grid is a quad's diagonal (its edge is sqrt 2 x spacing long:
 /// the same rigidity takes half the compliance there).
-SIM_INLINE bool hingeIsDiagonal(uint k, uint cols, uint rows) {
-  return k >= (cols - 1u) * (rows - 2u) + (cols - 2u) * (rows - 1u);
-}
+SIM_INLINE bool hingeIsDiagonal(uint k, uint cols, uint rows) { return k >= firstDiagonalHinge(cols, rows); }
 
 /// The two triangles (original ids) of hinge k of a cols x rows grid: the one with corner z of
 /// gridHinge, then the one with corner w.

@@ -362,7 +362,7 @@ uint64_t estimateSheetBytes(const SimParams& p, const std::string& backend) {
     // split copy (and the hinges' corners) and torn flags, triangles, adjacency, the hash and its sorted copies, the
     // collision candidate lists.
     solver = 104 * n + 40 * m + 16 * t + 4 * n + 8 * m + 8 * hb + 28 * n + 28 * n + 76 * n;
-    solver += 20 * m + 16 * hinges; // each slot's hinge corners and hinge, each hinge's corners
+    solver += 4 * m + 16 * hinges; // each slot's hinge, each hinge's corners
   } else {
     // The solver's copy of the topology, its storage buffers (particle arrays, constraints and
     // their compaction scratch, hash, candidate lists) and the largest staging of an upload.

@@ -35,7 +35,6 @@ void CpuSolver::splitConstraints() {
   con_kind_.resize(m);
   con_id_.resize(m);
   con_rest_.resize(m);
-  con_corners_.assign(4 * m, 0u);
   con_hinge_.assign(m, 0u);
   for (size_t k = 0; k < m; ++k) {
     const Constraint& c = constraints_[order[k]];
@@ -46,8 +45,6 @@ void CpuSolver::splitConstraints() {
     con_rest_[k] = c.rest;
     if (con_kind_[k] != SIM_KIND_HINGE) continue;
     con_hinge_[k] = con_id_[k] - topo_->hinge_first;
-    const uvec4 q = gridHinge(con_hinge_[k], topo_->cols, topo_->rows);
-    for (uint32_t j = 0; j < 4; ++j) con_corners_[4 * k + j] = q[j];
   }
 }
 
@@ -125,11 +122,9 @@ void CpuSolver::projectRange(SheetElements& e, const float stiffness[4], uint32_
   if (simd_ && !hinges)
     k = simd::project(reinterpret_cast<float*>(pos_.data()), ca, cb, rest, kind, stiffness, begin, end);
   if (simd_ && hinges) {
-    const uint32_t cols = topo_->cols, rows = topo_->rows;
-    const uint32_t first_diagonal = (cols - 1) * (rows - 2) + (cols - 2) * (rows - 1); // hingeIsDiagonal
     k = simd::projectHinges(reinterpret_cast<float*>(pos_.data()), reinterpret_cast<float*>(hinges_.data()),
-                            con_corners_.data(), con_hinge_.data(), first_diagonal, e.u.crease.x, iteration, begin,
-                            end);
+                            hinge_corners_.data(), con_hinge_.data(), firstDiagonalHinge(topo_->cols, topo_->rows),
+                            e.u.crease.x, iteration, begin, end);
   }
   for (; k < end; ++k)
     e.projectConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]}, iteration);
@@ -243,7 +238,6 @@ void CpuSolver::compact() {
         con_kind_[v] = con_kind_[k];
         con_id_[v] = con_id_[k];
         con_hinge_[v] = con_hinge_[k];
-        for (uint32_t j = 0; j < 4; ++j) con_corners_[4 * v + j] = con_corners_[4 * k + j];
         con_rest_[v++] = con_rest_[k];
       }
     range.count = w - range.first;
@@ -387,9 +381,8 @@ uint64_t CpuSolver::memoryBytes() const {
   return capacityBytes(pos_) + capacityBytes(prev_) + capacityBytes(rest_) + capacityBytes(normal_) +
          capacityBytes(reset_from_) + capacityBytes(uv_) + capacityBytes(constraints_) + capacityBytes(colors_) +
          capacityBytes(torn_) + capacityBytes(hinges_) + capacityBytes(con_a_) + capacityBytes(con_b_) +
-         capacityBytes(con_kind_) + capacityBytes(con_id_) + capacityBytes(con_rest_) + capacityBytes(con_corners_) +
-         capacityBytes(con_hinge_) + capacityBytes(hinge_corners_) + capacityBytes(triangles_) +
-         collision_.memoryBytes();
+         capacityBytes(con_kind_) + capacityBytes(con_id_) + capacityBytes(con_rest_) + capacityBytes(con_hinge_) +
+         capacityBytes(hinge_corners_) + capacityBytes(triangles_) + collision_.memoryBytes();
 }
 
 } // namespace tender

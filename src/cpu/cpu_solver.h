@@ -138,8 +138,8 @@ private:
   std::vector<ColorRange> colors_;
   // constraints_ split into one array per field, each colour ordered by first particle
   std::vector<uint32_t> con_a_, con_b_, con_kind_, con_id_;
-  // per slot of a hinge: its corners (gridHinge, 4 words) and its hinge
-  std::vector<uint32_t> con_corners_, con_hinge_;
+  std::vector<uint32_t> con_hinge_; ///< per slot of a hinge: its hinge
+
   std::vector<uint32_t> hinge_corners_; ///< per hinge: its gridHinge (4 words)
   std::vector<float> con_rest_;
   std::vector<uint32_t> torn_;

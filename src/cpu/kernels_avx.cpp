@@ -224,11 +224,14 @@ uint32_t projectHinges(float* pos, float* state, const HingeSlots& slots, uint32
     // Lane l is slot k + l (load puts rows 0-3 in the low half, 4-7 in the high half)
     alignas(32) uint32_t lane_hinge[8];
     for (uint32_t l = 0; l < 8; ++l) lane_hinge[l] = slots.hinge[k + l];
+    uint32_t corner[4][8]; // corner j of each lane's hinge
+    for (uint32_t l = 0; l < 8; ++l)
+      for (uint32_t j = 0; j < 4; ++j) corner[j][l] = slots.corners[4 * size_t(lane_hinge[l]) + j];
     Rows u, v, a, b, st;
-    load(u, pos, slots.corners + 4 * size_t(k) + 0, 4);
-    load(v, pos, slots.corners + 4 * size_t(k) + 1, 4);
-    load(a, pos, slots.corners + 4 * size_t(k) + 2, 4);
-    load(b, pos, slots.corners + 4 * size_t(k) + 3, 4);
+    load(u, pos, corner[0], 1);
+    load(v, pos, corner[1], 1);
+    load(a, pos, corner[2], 1);
+    load(b, pos, corner[3], 1);
     load(st, state, lane_hinge, 1);
     // hingeAngle
     const V3 pu{u.x, u.y, u.z}, pv{v.x, v.y, v.z}, pa{a.x, a.y, a.z}, pb{b.x, b.y, b.z};

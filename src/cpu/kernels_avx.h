@@ -17,7 +17,7 @@ uint32_t projectColor(float* pos, const uint32_t* a, const uint32_t* b, const fl
 
 /// One colour of hinges: what the arrays of a hinge slot hold.
 struct HingeSlots {
-  const uint32_t* corners; ///< 4 per slot: the edge's ends and its opposite corners (gridHinge)
+  const uint32_t* corners; ///< 4 per hinge: the edge's ends and its opposite corners (gridHinge)
   const uint32_t* hinge;   ///< per slot: the hinge (its HingeState)
   uint32_t first_diagonal; ///< hinges from here on are diagonals (half the compliance)
   float alpha;             ///< compliance over dt^2 of an edge hinge (SimUniforms::crease.x)

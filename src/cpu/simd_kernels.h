@@ -39,7 +39,7 @@ uint32_t project(float* pos, const uint32_t* a, const uint32_t* b, const float* 
                  const float stiffness[4], uint32_t begin, uint32_t end);
 
 /// Projects the hinges of slots [begin, end) of one colour eight at a time with AVX, with the
-/// operations of projectHinge: `corners` holds each slot's gridHinge (4 words), `hinge` its hinge,
+/// operations of projectHinge: `corners` holds each hinge's gridHinge (4 words), `hinge` each slot's hinge,
 /// hinges from `first_diagonal` on are diagonals, `alpha` is an edge hinge's compliance over dt^2.
 /// Returns the first slot it did not project (`begin` without AVX); the caller projects the rest.
 uint32_t projectHinges(float* pos, float* state, const uint32_t* corners, const uint32_t* hinge,

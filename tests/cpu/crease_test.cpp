@@ -125,12 +125,10 @@ TEST(Hinge, TheReturnMapMovesTheRestAngleByWhatPassesTheYield) {
 
 /// A sheet of `name` laid flat on its floor (rows running back along -z), with overrides.
 SimParams flatSheet(const char* name, std::vector<std::string> sets) {
-  SimParams p = preset(name, {});
   sets.insert(sets.begin(), {"tilt=90", "pins=none", "wind=off"});
-  p = preset(std::string(name), sets);
-  std::string top = "top_y=" + std::to_string(p.floor_y + 0.5f * p.spacing);
-  sets.push_back(top);
-  return preset(std::string(name), sets);
+  SimParams p = preset(std::string(name), sets);
+  p.top_y = p.floor_y + 0.5f * p.spacing; // a top_y != 0 places the flat sheet there
+  return p;
 }
 
 /// A fold in half and back at a hand's pace: the middle of the sheet's last row is carried over
