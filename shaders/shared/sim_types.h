@@ -54,6 +54,11 @@ struct SimUniforms {
   // Hinges: x the XPBD compliance of an edge hinge over dt^2 (a diagonal's is half), y the yield
   // angle in radians (0: elastic, no creases), z the hardening
   vec4 crease;
+  // The hand closing around the grab (handPull in xpbd.h), zero while it is open: x the fist's
+  // radius, y its reach (0: open), z the part of a particle's way into the fist it is drawn per
+  // substep, w the part of its velocity relative to the hand the grip takes per substep
+  vec4 hand;
+  vec4 hand_motion; // xyz the hand's displacement per substep
 
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
   vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet

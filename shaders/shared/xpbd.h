@@ -52,12 +52,43 @@ SIM_INLINE VerletState verletStep(vec4 pos, vec4 prev, vec3 accel, float damping
   return s;
 }
 
-/// One particle's integration at a substep. The grabbed particle (is_grabbed) follows grab_target
+/// Where in the fist the hand draws particle i, relative to its centre, per unit of fist radius:
+/// each component in [-1/4, 1/4), from a hash of i. The fingers are not a perfect sphere: a sheet
+/// lying flat through the centre buckles out of its plane instead of being squeezed within it.
+SIM_INLINE vec3 handFinger(uint i) {
+  uint h = i * 0x9E3779B9u;
+  h ^= h >> 16u;
+  h *= 0x7FEB352Du;
+  h ^= h >> 15u;
+  vec3 k = vec3(float(h & 1023u), float((h >> 10u) & 1023u), float((h >> 20u) & 1023u));
+  return k * 0.00048828125f - vec3(0.25f); // k / 2048 - 1/4, exact
+}
+
+/// The hand closing around the grab (hand.y > 0, see SimUniforms::hand) on free particle i that
+/// the Verlet step took from `previous` to `position`: within the hand's reach of its centre (the
+/// grab target) the grip takes hand.w of the particle's velocity relative to the hand's motion,
+/// then the particle is drawn hand.z of its way toward the fist (a ball of radius hand.x around the
+/// centre, moved by handFinger(i) x hand.x). Returns the particle's new position.
+SIM_INLINE vec4 handPull(vec4 position, vec4 previous, uint i, vec3 centre, vec4 hand, vec4 motion) {
+  vec3 p = vec3(position);
+  vec3 d = p - centre;
+  float dist2 = dot3(d, d);
+  if (hand.y > 0.0f && position.w > 0.0f && dist2 < hand.y * hand.y) {
+    p = p - (p - vec3(previous) - vec3(motion)) * hand.w;
+    d = p - (centre + handFinger(i) * hand.x);
+    float dist = simSqrt(dot3(d, d));
+    if (dist > hand.x) p = p - d * (simDiv(dist - hand.x, dist) * hand.z);
+  }
+  return vec4(p, position.w);
+}
+
+/// Particle i's integration at a substep. The grabbed particle (is_grabbed) follows grab_target
 /// when grab_target.w is 1 (held: infinite mass, previous position grab_prev) or is let go with the
-/// velocity grab_target - grab_prev when grab_target.w is 2 (a toss); otherwise damped Verlet.
-SIM_INLINE VerletState integrateParticle(vec4 pos, vec4 prev, vec4 rest, float u, bool is_grabbed, vec4 grab_target,
-                                         vec4 grab_prev, uint flags, float gravity, vec4 wind, vec4 wind_twist,
-                                         float damping, float dt2) {
+/// velocity grab_target - grab_prev when grab_target.w is 2 (a toss); otherwise damped Verlet, and
+/// while a grab is held, the hand's pull (handPull).
+SIM_INLINE VerletState integrateParticle(uint i, vec4 pos, vec4 prev, vec4 rest, float u, bool is_grabbed,
+                                         vec4 grab_target, vec4 grab_prev, vec4 hand, vec4 hand_motion, uint flags,
+                                         float gravity, vec4 wind, vec4 wind_twist, float damping, float dt2) {
   bool placed = is_grabbed && grab_target.w > 0.5f;
   bool held = placed && grab_target.w < 1.5f;
   float w = inverseMass(rest, held, flags);
@@ -67,6 +98,7 @@ SIM_INLINE VerletState integrateParticle(vec4 pos, vec4 prev, vec4 rest, float u
     s.previous = vec4(vec3(grab_prev), w);
   } else {
     s = verletStep(pos, prev, externalAccel(gravity, wind, wind_twist, u), damping, dt2, w);
+    s.position = handPull(s.position, s.previous, i, vec3(grab_target), hand, hand_motion);
   }
   return s;
 }

@@ -165,6 +165,8 @@ const std::vector<Param>& params() {
                 {{"zero", ReleaseMode::ZeroVelocity}, {"drag", ReleaseMode::DragVelocity}},
                 "velocity on release: zero, drag"),
       floatParam("grab_radius", &SimParams::grab_radius, 0.0f, 100.0f, "pick radius around the ray"),
+      floatParam("hand_reach", &SimParams::hand_reach, 0.0f, 1000.0f,
+                 "how far around the grab a closing hand draws the sheet in"),
       scoped(uintParam("threads", &SimParams::threads, 0, 255, "CPU solver threads, 0: one per core (same results)"),
              ParamScope::Solver),
       scoped(boolParam("simd", &SimParams::simd,
@@ -201,6 +203,12 @@ float SimParams::hingeCompliance() const {
 
 float SimParams::airFrictionFactor() const {
   return air_density * skin_friction / (2.0f * (paper_weight * 1e-3f) * spacing * spacing);
+}
+
+float SimParams::handBallRadius() const {
+  const double area = double(cols > 1 ? cols - 1 : 1) * double(rows > 1 ? rows - 1 : 1) * spacing * spacing;
+  const double volume = area * collisionRadius() / kHandPacking;
+  return float(std::cbrt(volume * 3.0 / (4.0 * 3.14159265358979323846)));
 }
 
 std::optional<SimParams> presetParams(const std::string& name) {
@@ -259,6 +267,7 @@ std::optional<SimParams> presetParams(const std::string& name) {
     p.friction = 0.6f;
     p.release = ReleaseMode::DragVelocity;
     p.grab_radius = 0.02f;
+    p.hand_reach = 0.08f; // a hand around the receipt
   } else {
     return std::nullopt;
   }

@@ -75,6 +75,7 @@ struct SimParams {
   // Interaction
   ReleaseMode release = ReleaseMode::ZeroVelocity;
   float grab_radius = 0.6f; ///< pick radius around the ray
+  float hand_reach = 3.0f;  /// how far around the grab a closing hand reaches (Simulation::squeeze)
   // Performance
   uint32_t threads = 0; ///< CPU solver worker threads; 0 = one per hardware thread (results do not change)
   bool simd = true;     ///< CPU solver SIMD kernels; off runs the plain scalar reference (same results)
@@ -91,7 +92,13 @@ struct SimParams {
   /// discrete-shell stiffness 3 D |e|^2 / (A1 + A2) = 3 D of a grid hinge, per particle mass
   /// (paper_weight x spacing^2: the solver's masses are 1).
   float hingeCompliance() const;
+  /// The radius of the ball a closed hand presses the sheet into: the sheet's area in layers a
+  /// collision radius thick, packed to kHandPacking.
+  float handBallRadius() const;
 };
+
+/// How much of a ball crumpled by the hand is paper (layers a collision radius thick).
+constexpr float kHandPacking = 0.25f;
 
 /// Thermal receipt paper (README: Paper): 55 g/m^2, 60 um thick, a tensile modulus of about 4 GPa
 /// and a Poisson ratio of 0.3 give D = E t^3 / (12 (1 - nu^2)) = 7.9e-5 N m.

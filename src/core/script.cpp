@@ -41,6 +41,16 @@ std::string readVec(std::istringstream& in, glm::vec3& v) {
   return "";
 }
 
+// Reads a closure of the hand; returns an error message.
+std::optional<std::string> parseClosure(const std::string& w, float& closure) {
+  char* end = nullptr;
+  const double d = std::strtod(w.c_str(), &end);
+  if (end == w.c_str() || *end != 0) return "'" + w + "' is not a number";
+  if (auto err = checkClosure(d)) return err;
+  closure = float(d);
+  return std::nullopt;
+}
+
 const char* toggleName(Toggle t) { return t == Toggle::On ? "on" : t == Toggle::Off ? "off" : "toggle"; }
 
 } // namespace
@@ -99,6 +109,11 @@ std::optional<InputScript> parseScript(const std::string& text, std::string& err
       if (!bad.empty()) return fail("move: " + bad);
     } else if (verb == "release") {
       e.kind = EventKind::Release;
+    } else if (verb == "squeeze") {
+      e.kind = EventKind::Squeeze;
+      std::string word;
+      if (!(in >> word)) return fail("squeeze needs the hand's closure, 0 (open) to 1 (closed)");
+      if (auto err = parseClosure(word, e.closure)) return fail("squeeze: " + *err);
     } else if (verb == "wind" || verb == "pins" || verb == "pause") {
       e.kind = verb == "wind" ? EventKind::Wind : verb == "pins" ? EventKind::Pins : EventKind::Pause;
       if (!readToggle(in, e.toggle)) return fail(verb + " needs on, off or toggle");
@@ -201,6 +216,16 @@ std::optional<std::string> checkScript(const InputScript& script, const SimParam
   return std::nullopt;
 }
 
+std::optional<std::string> checkClosure(double closure) {
+  if (std::isnan(closure)) return std::string("the closure is not a number");
+  if (closure < 0.0 || closure > 1.0) {
+    char buf[96];
+    snprintf(buf, sizeof(buf), "the closure %g is out of range [0, 1] (0: open, 1: closed)", closure);
+    return std::string(buf);
+  }
+  return std::nullopt;
+}
+
 std::string formatEvent(const ScriptEvent& e) {
   std::ostringstream o;
   o.precision(9);
@@ -217,6 +242,9 @@ std::string formatEvent(const ScriptEvent& e) {
     break;
   case EventKind::Release:
     o << "release";
+    break;
+  case EventKind::Squeeze:
+    o << "squeeze " << e.closure;
     break;
   case EventKind::Wind:
     o << "wind " << toggleName(e.toggle);

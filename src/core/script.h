@@ -7,6 +7,7 @@
 ///   <tick> grab ray <ox> <oy> <oz> <dx> <dy> <dz>
 ///   <tick> move <x> <y> <z>          grab target in world units
 ///   <tick> release
+///   <tick> squeeze <closure>         the hand around the grab: 0 open .. 1 closed (Simulation::squeeze)
 ///   <tick> wind on|off|toggle
 ///   <tick> pins on|off|toggle
 ///   <tick> pause on|off|toggle
@@ -35,7 +36,7 @@ constexpr uint64_t kMaxScriptBytes = 256ull << 20;
 /// Largest tick a script line may name (decimal digits only).
 constexpr uint64_t kMaxTick = 1000000000000ull;
 
-enum class EventKind { GrabParticle, GrabRay, Move, Release, Wind, Pins, Pause, Reset, Set };
+enum class EventKind { GrabParticle, GrabRay, Move, Release, Squeeze, Wind, Pins, Pause, Reset, Set };
 /// Value of on/off/toggle events.
 enum class Toggle { Off, On, Flip };
 
@@ -45,6 +46,7 @@ struct ScriptEvent {
   uint32_t particle = 0; ///< GrabParticle
   glm::vec3 a{0.0f};     ///< GrabRay origin, Move target
   glm::vec3 b{0.0f};     ///< GrabRay direction
+  float closure = 0.0f;  ///< Squeeze: 0 (open) .. 1 (closed)
   Toggle toggle = Toggle::Flip;
   std::string key, value; ///< Set: a parameter ("preset": the preset's name) and its value as `--set` takes it
 };
@@ -77,6 +79,8 @@ bool rebuildsSheet(const Settings& settings);
 /// The set events of one tick in a row from `events[i]` (a set event): appends them to `out` and
 /// returns the index after them.
 size_t takeSettings(const std::vector<ScriptEvent>& events, size_t i, Settings& out);
+/// Why `closure` is not a closure of the hand (a number from 0, open, to 1, closed); nullopt when it is.
+std::optional<std::string> checkClosure(double closure);
 /// Formats one event as a script line.
 std::string formatEvent(const ScriptEvent& e);
 

@@ -106,6 +106,9 @@ void Simulation::apply(const ScriptEvent& e) {
   case EventKind::Release:
     release();
     break;
+  case EventKind::Squeeze:
+    squeeze(e.closure);
+    break;
   case EventKind::Wind:
     wind_ = flip(e.toggle, wind_);
     break;
@@ -135,6 +138,7 @@ void Simulation::grabAt(uint32_t i, glm::vec3 p) {
   grab_history_.fill(p);
   grab_ticks_ = 0;
   release_index_ = SIM_NONE;
+  closure_ = 0.0f;
 }
 
 bool Simulation::grabRay(glm::vec3 origin, glm::vec3 dir) {
@@ -163,10 +167,16 @@ void Simulation::release() {
     release_index_ = grab_index_;
   }
   grab_index_ = SIM_NONE;
+  closure_ = 0.0f;
+}
+
+void Simulation::squeeze(float closure) {
+  if (grab_index_ != SIM_NONE) closure_ = std::clamp(closure, 0.0f, 1.0f);
 }
 
 void Simulation::reset() {
   grab_index_ = release_index_ = SIM_NONE;
+  closure_ = 0.0f;
   pins_ = params_.pins != PinMode::None; // the start: pinned as the preset is
   solver_.beginReset();
   reset_frame_ = SIM_RESET_FRAMES;
@@ -209,6 +219,13 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   const double dts = 1.0 / (double(p.tick_hz) * p.substeps);
   const float amp = wind_ ? p.wind_strength * p.wind_scale : 0.0f;
   u.grab_index = grab_index_ != SIM_NONE ? grab_index_ : release_index_;
+  if (grab_index_ != SIM_NONE && closure_ > 0.0f && p.hand_reach > 0.0f) {
+    const double dt = double(u.dt);
+    const float ball = std::min(p.handBallRadius(), p.hand_reach);
+    u.hand = glm::vec4(p.hand_reach - (p.hand_reach - ball) * closure_, p.hand_reach,
+                       float(-std::expm1(-dt / kHandPullSeconds)), float(-std::expm1(-dt / kHandGripSeconds)));
+    u.hand_motion = glm::vec4((grab_to_ - grab_from_) / float(p.substeps), 0.0f);
+  }
   for (uint32_t s = 0; s < p.substeps; ++s) {
     WindSample w = amp > 0.0f ? windAt(p.wind_kind, t0 + double(s + 1) * dts, amp) : WindSample{};
     u.wind[s] = glm::vec4(w.uniform, 0.0f);

@@ -19,6 +19,10 @@ struct WindSample {
 /// Wind of the given kind at time t (seconds), amplitude in units/s^2.
 WindSample windAt(WindKind kind, double t, float amplitude);
 
+/// Time constants of the hand: how fast it draws the sheet into the fist, and how fast its grip
+/// takes a particle's velocity relative to the hand.
+constexpr float kHandPullSeconds = 0.25f, kHandGripSeconds = 0.1f;
+
 class Simulation {
 public:
   /// Builds the sheet and uploads it to the solver (params must be valid).
@@ -49,8 +53,13 @@ public:
   bool grabRay(glm::vec3 origin, glm::vec3 dir);
   /// Moves the grab target (world units).
   void moveGrab(glm::vec3 target);
-  /// Releases the grabbed particle (zero velocity or drag velocity, per params).
+  /// Releases the grabbed particle (zero velocity or drag velocity, per params) and opens the hand.
   void release();
+  /// Closes the hand around the grab to `closure` (0 open .. 1 closed; checkClosure): while the grab
+  /// is held, the free particles within hand_reach of the grab target are gripped (they follow the
+  /// hand) and drawn into a fist whose radius shrinks from hand_reach, open, to the sheet's ball
+  /// (SimParams::handBallRadius), closed. Nothing happens without a grab; a new grab starts open.
+  void squeeze(float closure);
   void setWind(bool on) { wind_ = on; }
   void setPins(bool on) { pins_ = on; }
   void setPaused(bool on) { paused_ = on; }
@@ -63,6 +72,7 @@ public:
   bool resetting() const { return reset_frame_ > 0; }
   uint32_t grabbed() const { return grab_index_; }
   glm::vec3 grabTarget() const { return grab_to_; }
+  float closure() const { return closure_; }
 
   /// Applies the script's events due before the next step (tick() and advance() do this first;
   /// a fleet does it for every sheet before it ticks them, so a grab's read-back comes before the
@@ -103,6 +113,7 @@ private:
   glm::vec3 grab_from_{0.0f}, grab_to_{0.0f};
   std::array<glm::vec3, 4> grab_history_{}; ///< grab target at the last ticks, for the drag velocity
   uint32_t grab_ticks_ = 0;
+  float closure_ = 0.0f;              ///< the hand around the grab: 0 open .. 1 closed
   uint32_t release_index_ = SIM_NONE; ///< particle released with drag velocity at the next tick
   glm::vec3 release_velocity_{0.0f};
   uint32_t reset_frame_ = 0; ///< frames left in the animated reset

@@ -85,6 +85,11 @@ glm::vec3 coordinates(double x, double y, double z, const char* what) {
   return {float(x), float(y), float(z)};
 }
 
+float closureOf(double closure) {
+  if (auto err = checkClosure(closure)) throw py::value_error("squeeze: " + *err);
+  return float(closure);
+}
+
 glm::vec3 sequence3(const py::sequence& s, const char* what) {
   if (py::len(s) != 3) throw py::value_error(std::string(what) + ": expected 3 numbers");
   double v[3];

@@ -38,6 +38,8 @@ void writeOutput(const std::string& path, const std::function<std::optional<std:
 std::string unknownPreset(const std::string& name);
 /// A point within the coordinates an input may name (ValueError naming `what` otherwise).
 glm::vec3 coordinates(double x, double y, double z, const char* what);
+/// A closure of the hand (0 open .. 1 closed; ValueError otherwise).
+float closureOf(double closure);
 /// A sequence of 3 numbers as a point (ValueError naming `what` otherwise).
 glm::vec3 sequence3(const py::sequence& s, const char* what);
 

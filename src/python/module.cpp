@@ -78,6 +78,8 @@ public:
 
   void move(double x, double y, double z) { sim_->moveGrab(coordinates(x, y, z, "move")); }
   void release() { sim_->release(); }
+  void squeeze(double closure) { sim_->squeeze(closureOf(closure)); }
+  double closure() const { return sim_->closure(); }
 
   void set(const std::string& key, const py::handle& value) {
     SimParams p = sim_->params();
@@ -323,6 +325,7 @@ public:
   }
   void move(int64_t sheet, double x, double y, double z) { at(sheet).moveGrab(coordinates(x, y, z, "move")); }
   void release(int64_t sheet) { at(sheet).release(); }
+  void squeeze(int64_t sheet, double closure) { at(sheet).squeeze(closureOf(closure)); }
   uint32_t size() const { return fleet_->size(); }
   std::string backendName() const { return batch_->name(); }
   py::dict params(int64_t sheet) {
@@ -408,6 +411,9 @@ PYBIND11_MODULE(tender, m) {
            "Grabs the nearest particle within grab_radius of the ray; returns whether one was caught.")
       .def("move", &PySimulation::move, py::arg("x"), py::arg("y"), py::arg("z"), "Moves the grab target.")
       .def("release", &PySimulation::release, "Lets go (zero or drag velocity, per the `release` key).")
+      .def("squeeze", &PySimulation::squeeze, py::arg("closure"),
+           "Closes the hand around the grab: 0 open .. 1 closed (a ball); release() opens it.")
+      .def_property_readonly("closure", &PySimulation::closure, "The hand's closure, 0 while open or not grabbing.")
       .def("set", &PySimulation::set, py::arg("key"), py::arg("value"),
            "Sets a parameter; keys that change the sheet or the solver rebuild the sheet at rest.")
       .def("reset", &PySimulation::reset, py::arg("animated") = false,
@@ -448,6 +454,8 @@ PYBIND11_MODULE(tender, m) {
       .def("move", &PyFleet::move, py::arg("sheet"), py::arg("x"), py::arg("y"), py::arg("z"),
            "Moves a sheet's grab target.")
       .def("release", &PyFleet::release, py::arg("sheet"), "Lets go of a sheet's particle.")
+      .def("squeeze", &PyFleet::squeeze, py::arg("sheet"), py::arg("closure"),
+           "Closes the hand around a sheet's grab: 0 open .. 1 closed.")
       .def("params", &PyFleet::params, py::arg("sheet"), "Every key's value of a sheet as `--set` spells it.")
       .def("__len__", &PyFleet::size)
       .def_property_readonly("backend", &PyFleet::backendName);

@@ -155,6 +155,10 @@ expect_msg "damping" sim "${small[@]}" --ticks 1 --set "damping=1
 printf '0 grab particle 5\n1 \377\376\001bad\n' >"$tmp/bytes.txt"
 expect_msg "unknown event" --backend cpu --replay "$tmp/bytes.txt"
 expect_msg "unknown event" sim "${small[@]}" --ticks 1 --script "$tmp/bytes.txt"
+for closure in 2 -0.5 nan x ""; do
+  printf '0 grab particle 5\n1 squeeze %s\n' "$closure" >"$tmp/squeeze.txt"
+  expect_msg "line 2: squeeze" sim "${small[@]}" --ticks 1 --script "$tmp/squeeze.txt"
+done
 printf '{"wi\\u0000nd": true}' >"$tmp/nul.json"
 expect_msg "wi.*nd'" sim --preset-file "$tmp/nul.json" --ticks 1
 printf '{"cols": true}' >"$tmp/boolcols.json"

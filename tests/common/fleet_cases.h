@@ -13,10 +13,10 @@ namespace tender::test {
 
 /// Sheets of a cols x rows grid (12 x 16: small enough for the fused tick); sheet i takes its
 /// parameters and its script from i, so a batch of 37 holds every combination below several times:
-/// tearing yanks and sheets left hanging, a reset, a pause, a ray grab, three pin modes, both
-/// winds, and different stiffness, damping, gravity, tear factor, restitution, floor, substeps,
-/// iterations, release, collision, air and hash cell (sheets 5, 13, ... have cells of 5 spacings,
-/// which a CPU device's fused tick does not take).
+/// tearing yanks and sheets left hanging, a reset, a pause, a ray grab and a hand closing around it, three pin modes,
+/// both winds, and different stiffness, damping, gravity, tear factor, restitution, floor, substeps, iterations,
+/// release, collision, air and hash cell (sheets 5, 13, ... have cells of 5 spacings, which a CPU device's fused tick
+/// does not take).
 inline std::vector<FleetSheet> mixedFleet(uint32_t count, uint32_t cols = 12, uint32_t rows = 16) {
   static const char* kScripts[] = {
       "",
@@ -24,8 +24,8 @@ inline std::vector<FleetSheet> mixedFleet(uint32_t count, uint32_t cols = 12, ui
       "0 grab particle 186\n1 move 4 -4 6\n30 release\n",
       // A grab, a reset while the sheet swings, then a pause
       "0 grab particle 100\n2 move 1 0 1\n10 release\n15 reset\n50 pause on\n54 pause off\n",
-      // A ray grab from in front of the sheet, dragged sideways
-      "3 grab ray 0 1 5 0 0 -1\n4 move 2 1 2\n20 release\n",
+      // A ray grab from in front of the sheet, dragged sideways while the hand closes around it
+      "3 grab ray 0 1 5 0 0 -1\n4 move 2 1 2\n6 squeeze 0.5\n10 squeeze 1\n20 release\n",
   };
   static const char* kPins[] = {"top3", "corners", "none"};
   std::vector<FleetSheet> sheets;

@@ -266,5 +266,83 @@ TEST(Crease, WindCreasesNothing) {
   EXPECT_LE(st.max_crease_deg, 2.0f);
 }
 
+/// The radius of gyration of the particles about their centre.
+double gyration(const SimState& s) {
+  glm::dvec3 c(0.0);
+  for (const glm::vec4& q : s.pos) c += glm::dvec3(q);
+  c /= double(s.pos.size());
+  double sum = 0.0;
+  for (const glm::vec4& q : s.pos) sum += glm::dot(glm::dvec3(q) - c, glm::dvec3(q) - c);
+  return std::sqrt(sum / double(s.pos.size()));
+}
+
+/// The 95th percentile of the hinges' |angle| (degrees).
+double hingeP95(const SimState& s, const SimParams& p) {
+  std::vector<double> a;
+  for (uint32_t k = 0; k < s.hinges.size(); ++k) {
+    const glm::uvec4 q = gridHinge(k, p.cols, p.rows);
+    const HingeAngle g =
+        hingeAngle(glm::vec3(s.pos[q.x]), glm::vec3(s.pos[q.y]), glm::vec3(s.pos[q.z]), glm::vec3(s.pos[q.w]), false);
+    a.push_back(g.valid ? std::abs(double(g.angle)) * kDeg : 0.0);
+  }
+  std::nth_element(a.begin(), a.begin() + a.size() * 95 / 100, a.end());
+  return a[a.size() * 95 / 100];
+}
+
+/// The hand's crumple: the middle of a sheet lying on its floor is grabbed and lifted (1 s), the
+/// hand closes around it (1 s) and holds (1 s), lowers the ball to the floor (1 s) and lets go.
+std::pair<std::string, int> crumpleScript(const SimParams& p, glm::vec3 middle) {
+  const int second = int(p.tick_hz);
+  const float lift = 0.3f * float(p.rows - 1) * p.spacing;
+  std::string text = "0 grab particle " + std::to_string((p.rows / 2) * p.cols + p.cols / 2) + "\n";
+  char line[128];
+  for (int t = 1; t <= second; ++t) {
+    std::snprintf(line, sizeof(line), "%d move %.6f %.6f %.6f\n", t, middle.x,
+                  middle.y + lift * float(t) / float(second), middle.z);
+    text += line;
+  }
+  for (int t = 1; t <= second; ++t) {
+    std::snprintf(line, sizeof(line), "%d squeeze %.6f\n", second + t, float(t) / float(second));
+    text += line;
+  }
+  for (int t = 1; t <= second; ++t) {
+    std::snprintf(line, sizeof(line), "%d move %.6f %.6f %.6f\n", 3 * second + t, middle.x,
+                  middle.y + lift * (1.0f - float(t) / float(second)), middle.z);
+    text += line;
+  }
+  text += std::to_string(4 * second + 1) + " release\n";
+  return {text, 4 * second + 1};
+}
+
+TEST(Hand, ACrumpledBallKeepsItsSizeAndItsFolds) {
+  // Crumpled by the hand and let go on the floor, the ball springs back a little as the hand lets
+  // go of its layers (the first second), then keeps its size and its folds for five seconds.
+  const SimParams p = flatSheet("crumple", {"cols=20", "rows=30"});
+  CpuSolver solver;
+  Simulation sim(p, solver);
+  const SimState flat = run(sim, 0);
+  auto [text, ticks] = crumpleScript(p, glm::vec3(flat.pos[(p.rows / 2) * p.cols + p.cols / 2]));
+  sim.setScript(script(text.c_str()));
+  const SimState held = run(sim, ticks - 2); // the last tick the hand holds
+  EXPECT_GT(sim.closure(), 0.99f);
+  const SimState settled = run(sim, 2 + int(p.tick_hz));
+  const SimState later = run(sim, int(5 * p.tick_hz));
+  EXPECT_EQ(sim.closure(), 0.0f); // letting go opens the hand
+  const double r_flat = gyration(flat), r_held = gyration(held), r0 = gyration(settled), r5 = gyration(later);
+  const double p0 = hingeP95(settled, p), p5 = hingeP95(later, p);
+  std::printf("hand: radius of gyration flat %.3f, in the hand %.3f, let go %.3f, 5 s later %.3f; 95th percentile "
+              "hinge angle %.1f -> %.1f deg\n",
+              r_flat, r_held, r0, r5, p0, p5);
+  EXPECT_EQ(computeStats(later, p.substepDt()).nan_count, 0u);
+  // A ball, not a sheet: the fist of a closed hand holds the sheet's area, in layers a collision
+  // radius thick, at a packing of a quarter (kHandPacking): a radius of gyration of about 0.63 x the
+  // flat sheet's here
+  EXPECT_LT(r_held, 0.65 * r_flat);
+  EXPECT_LT(r0, 0.8 * r_flat);
+  EXPECT_NEAR(r5, r0, 0.03 * r0);
+  EXPECT_GT(p0, 25.0); // folded through
+  EXPECT_NEAR(p5, p0, 0.1 * p0);
+}
+
 } // namespace
 } // namespace tender::test

@@ -49,6 +49,11 @@ TEST(Replay, ARecordedSessionReplaysBitwiseAtAnyFrameRate) {
       m.a = glm::vec3(0.05f * float(frame), -0.07f * float(frame), 0.031f * float(frame));
       live.input(m);
     }
+    if (frame == 20 || frame == 40) {
+      ScriptEvent q = event(EventKind::Squeeze); // the hand closes around the grab
+      q.closure = frame == 20 ? 0.35f : 1.0f;
+      live.input(q);
+    }
     if (frame == 60) live.input(event(EventKind::Release));
     if (frame == 80 || frame == 95) live.input(event(EventKind::Pause));
     if (frame == 120) live.input(event(EventKind::Pins));

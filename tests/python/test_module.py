@@ -77,6 +77,31 @@ def test_grab_move_release_and_reset():
     assert np.allclose(sim.positions, start, atol=1e-4)
 
 
+def test_the_hand_crumples_a_sheet_into_a_ball():
+    sim = tender.Simulation(preset="crumple", backend="cpu", cols=20, rows=30, pins="none", wind=False)
+    spread = lambda p: float(np.sqrt(((p - p.mean(0)) ** 2).sum(1).mean()))
+    flat = spread(sim.positions)
+    sim.squeeze(1.0)  # no grab, no hand
+    assert sim.closure == 0.0
+    sim.grab(15 * 20 + 10)
+    sim.squeeze(1.0)
+    assert sim.closure == 1.0
+    sim.step(120)
+    ball = spread(sim.positions)
+    assert ball < 0.65 * flat, (ball, flat)
+    sim.release()
+    assert sim.closure == 0.0
+    for bad in (-0.1, 1.5, float("nan")):
+        with pytest.raises(ValueError, match="squeeze"):
+            sim.squeeze(bad)
+    fleet = tender.Fleet(2, preset="crumple", backend="cpu", cols=12, rows=16)
+    fleet.grab(1, 100)
+    fleet.squeeze(1, 1.0)
+    fleet.step(30)
+    p = fleet.positions
+    assert spread(p[1]) < spread(p[0])
+
+
 def test_set_live_and_rebuild():
     sim = tender.Simulation(preset="tender-low", backend="cpu")
     sim.step(3)

@@ -27,6 +27,8 @@
 namespace tender {
 
 constexpr uint32_t kFramesInFlight = 2;
+/// How much one wheel step while grabbing closes (or opens) the hand.
+constexpr float kClosurePerWheelStep = 0.25f;
 constexpr const char* kTitle = "Tender \xe2\x80\x94 Receipt Paper Physics";
 
 /// Per frame in flight: command buffer, acquire semaphore, fence.
@@ -68,6 +70,8 @@ private:
   void recreateSwapchain();
   void drawFrame(const render::SceneView& view);
   void apply(ScriptEvent e);
+  /// Closes the hand around the grab to `closure` (clamped to 0..1) as a squeeze event.
+  void squeeze(float closure);
   /// Moves the grab target to where the cursor last dragged it.
   void applyPendingMove();
   void handleActions(const demo::HudActions& a);

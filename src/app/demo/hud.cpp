@@ -135,8 +135,9 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
   ImGui::End();
 
   // Controls hint, bottom-left; above the buttons' row when the window is too narrow for both.
-  const char* hint = "R to Reset \xc2\xb7 W to toggle Wind \xc2\xb7 I to toggle FPS \xc2\xb7 P to toggle Pins "
-                     "\xc2\xb7 Space to Pause \xc2\xb7 F to toggle Follow";
+  const char* hint =
+      "R to Reset \xc2\xb7 W to toggle Wind \xc2\xb7 I to toggle FPS \xc2\xb7 P to toggle Pins "
+      "\xc2\xb7 Space to Pause \xc2\xb7 F to toggle Follow \xc2\xb7 Wheel or H while grabbing to crumple";
   const float hint_size = body * 0.9f;
   const ImVec2 hint_extent = body_->CalcTextSizeA(hint_size, FLT_MAX, 0.0f, hint);
   float hint_y = size.y - m - hint_size;

@@ -20,6 +20,13 @@ void DemoApp::apply(ScriptEvent e) {
   if (!options_.record.empty()) record_text_ += formatEvent(e) + "\n";
 }
 
+void DemoApp::squeeze(float closure) {
+  ScriptEvent e;
+  e.kind = EventKind::Squeeze;
+  e.closure = std::clamp(closure, 0.0f, 1.0f);
+  if (e.closure != sim_->closure()) apply(e);
+}
+
 void DemoApp::applyPendingMove() {
   if (!input_.pending_move) return;
   ScriptEvent m;
@@ -46,7 +53,10 @@ void DemoApp::onMouseButton(GLFWwindow* w, int button, int action, int) {
 
 void DemoApp::resolveMouse() {
   const bool on_hud = ImGui::GetIO().WantCaptureMouse;
-  if (!on_hud && input_.scroll != 0.0) {
+  if (!on_hud && input_.scroll != 0.0 && input_.grabbing) {
+    // The wheel while grabbing closes the hand (away from you) or opens it, a quarter per step.
+    squeeze(sim_->closure() + kClosurePerWheelStep * float(input_.scroll));
+  } else if (!on_hud && input_.scroll != 0.0) {
     camera_.zoom(float(input_.scroll));
     follow_.stop();
   }
@@ -138,6 +148,10 @@ void DemoApp::onKey(GLFWwindow* w, int key, int, int action, int) {
   case GLFW_KEY_SPACE:
     e.kind = EventKind::Pause;
     break;
+  case GLFW_KEY_H:
+    // The hand around the grab: closed into a ball, or open again
+    if (app.input_.grabbing) app.squeeze(app.sim_->closure() < 1.0f ? 1.0f : 0.0f);
+    return;
   case GLFW_KEY_I:
     app.show_fps_ = !app.show_fps_;
     return;
