@@ -34,4 +34,20 @@ struct SceneUniforms {
   vec4 floor;           // x = floor y, y = ground half size, z = grid cell, w = 1 / shadow map size
 };
 
+// A corner's normal turns from the particle's smooth normal to its triangle's own where the two
+// differ by more than this (cos 12 degrees): where the sheet is bent through some 24 degrees at one
+// hinge, a crease, the triangles on either side are shaded as the flat facets they are.
+#define RENDER_CREASE_COS 0.978f
+
+/// The normal of a triangle's corner: the particle's smooth normal, or the triangle's own (of
+/// corners a, b, c, counter-clockwise) across a crease (RENDER_CREASE_COS). A triangle of no area
+/// keeps the smooth normal.
+SIM_INLINE vec3 cornerNormal(vec3 smooth_normal, vec3 a, vec3 b, vec3 c) {
+  vec3 f = cross(b - a, c - a);
+  float len = length(f);
+  if (!(len > 1e-12f)) return smooth_normal;
+  f = f / len;
+  return dot(f, smooth_normal) < RENDER_CREASE_COS ? f : smooth_normal;
+}
+
 #endif

@@ -147,6 +147,17 @@ TEST(Golden, CrumplePresetPrintsItsReceipt) {
   compareWithGolden("crumple_30", r.picture);
 }
 
+TEST(Golden, AHandCrumpledReceiptShowsItsCreases) {
+  // The hand closes around the middle of the crumple sheet hanging from its corners: the creases
+  // show as sharp lines between flat facets (cornerNormal), not as smooth shading.
+  std::string text = "0 grab particle 1220\n1 move 0 0.5 1\n";
+  for (int t = 1; t <= 30; ++t) text += std::to_string(t) + " squeeze " + std::to_string(t / 30.0) + "\n";
+  auto r = renderPreset("crumple", 90, text);
+  SKIP_OR_FAIL_ON_ERROR(r);
+  EXPECT_EQ(r.validation_messages, 0u);
+  compareWithGolden("crumple_hand", r.picture);
+}
+
 // The GPU backend: the renderer binds the solver's own buffers and draws the live triangles with
 // the indirect arguments the tear compaction writes; the solvers agree, so the pictures do too.
 TEST(Golden, GpuSolverBuffersDrawTheSamePicture) {
