@@ -9,6 +9,11 @@
 #include <stb/stb_image_write.h>
 #include <tiny_gltf.h>
 
+namespace shaderio {
+using namespace glm;
+#include "render_types.h"
+} // namespace shaderio
+
 #ifdef TENDER_HAS_RECEIPT
 #include "render/receipt.h"
 #endif
@@ -127,6 +132,53 @@ std::vector<glm::vec3> normals(const MeshFrame& f, size_t n) {
   return out;
 }
 
+constexpr uint32_t kNoTriangle = 0xFFFFFFFFu;
+
+/// The vertices of the export: one per particle, and one more for each corner of a triangle that
+/// takes the triangle's own normal across a crease in some frame (shaderio::cornerNormal, as the
+/// renderer shades it); `corner` holds each triangle corner's vertex.
+struct CreaseVertices {
+  std::vector<uint32_t> particle; ///< the particle of each vertex
+  std::vector<uint32_t> triangle; ///< the triangle of a corner's own vertex; kNoTriangle: a particle's
+  std::vector<uint32_t> corner;   ///< vertex of corner 3 t + c of the last frame's triangles
+};
+
+glm::vec3 cornerNormalOf(const std::vector<glm::vec3>& p, const std::vector<glm::vec3>& nn, glm::uvec3 t, uint32_t i) {
+  return shaderio::cornerNormal(nn[i], p[t.x], p[t.y], p[t.z]);
+}
+
+CreaseVertices creaseVertices(const std::vector<glm::uvec3>& triangles, const std::vector<std::vector<glm::vec3>>& pos,
+                              const std::vector<std::vector<glm::vec3>>& nrm, size_t n) {
+  CreaseVertices v;
+  v.particle.resize(n);
+  v.triangle.assign(n, kNoTriangle);
+  for (size_t i = 0; i < n; ++i) v.particle[i] = uint32_t(i);
+  v.corner.resize(triangles.size() * 3);
+  for (size_t t = 0; t < triangles.size(); ++t)
+    for (uint32_t c = 0; c < 3; ++c) {
+      const uint32_t i = triangles[t][int(c)];
+      bool split = false;
+      for (size_t f = 0; f < pos.size() && !split; ++f)
+        split = cornerNormalOf(pos[f], nrm[f], triangles[t], i) != nrm[f][i];
+      v.corner[t * 3 + c] = split ? uint32_t(v.particle.size()) : i;
+      if (split) v.particle.push_back(i), v.triangle.push_back(uint32_t(t));
+    }
+  return v;
+}
+
+/// Per vertex of `v`: the position and the normal of one frame.
+void frameVertices(const CreaseVertices& v, const std::vector<glm::uvec3>& triangles, const std::vector<glm::vec3>& p,
+                   const std::vector<glm::vec3>& nn, std::vector<glm::vec3>& pos_out,
+                   std::vector<glm::vec3>& normal_out) {
+  pos_out.resize(v.particle.size());
+  normal_out.resize(v.particle.size());
+  for (size_t k = 0; k < v.particle.size(); ++k) {
+    const uint32_t i = v.particle[k];
+    pos_out[k] = p[i];
+    normal_out[k] = v.triangle[k] == kNoTriangle ? nn[i] : cornerNormalOf(p, nn, triangles[v.triangle[k]], i);
+  }
+}
+
 } // namespace
 
 std::optional<MeshFormat> meshFormatFor(const std::string& path) {
@@ -181,20 +233,22 @@ std::optional<std::string> encodeGltf(const MeshScene& scene, const std::vector<
   m.asset.generator = std::string("Tender ") + TENDER_VERSION;
   Builder b(m);
 
-  // Geometry: the first frame's particles, the last frame's triangles.
-  const std::vector<glm::vec3> base_pos = positions(first);
-  const std::vector<glm::vec3> base_normal = normals(first, n);
+  // Geometry: the first frame's particles, the last frame's triangles; a corner across a crease
+  // has a vertex of its own with its triangle's normal (as the renderer shades it).
+  std::vector<std::vector<glm::vec3>> pos(frames.size()), nrm(frames.size());
+  for (size_t k = 0; k < frames.size(); ++k) pos[k] = positions(frames[k]), nrm[k] = normals(frames[k], n);
+  const CreaseVertices cv = creaseVertices(last.triangles, pos, nrm, n);
+  std::vector<glm::vec3> base_pos, base_normal;
+  frameVertices(cv, last.triangles, pos[0], nrm[0], base_pos, base_normal);
   tinygltf::Primitive prim;
   prim.attributes["POSITION"] = b.vec3(base_pos);
   prim.attributes["NORMAL"] = b.vec3(base_normal);
-  std::vector<glm::vec2> uv(n, glm::vec2(0.0f));
-  for (size_t i = 0; i < n && i < scene.uv.size(); ++i) uv[i] = scene.uv[i];
+  std::vector<glm::vec2> uv(cv.particle.size(), glm::vec2(0.0f));
+  for (size_t k = 0; k < uv.size(); ++k)
+    if (cv.particle[k] < scene.uv.size()) uv[k] = scene.uv[cv.particle[k]];
   prim.attributes["TEXCOORD_0"] = b.vec2(uv);
   if (!last.triangles.empty()) {
-    std::vector<uint32_t> idx;
-    idx.reserve(last.triangles.size() * 3);
-    for (const glm::uvec3& t : last.triangles) idx.insert(idx.end(), {t.x, t.y, t.z});
-    prim.indices = b.indices(idx);
+    prim.indices = b.indices(cv.corner);
     prim.mode = TINYGLTF_MODE_TRIANGLES;
   } else {
     prim.mode = TINYGLTF_MODE_POINTS; // every triangle torn: the particles alone
@@ -236,10 +290,9 @@ std::optional<std::string> encodeGltf(const MeshScene& scene, const std::vector<
   const size_t targets = frames.size() - 1;
   if (targets > 0) {
     for (size_t k = 1; k < frames.size(); ++k) {
-      const std::vector<glm::vec3> p = positions(frames[k]);
-      const std::vector<glm::vec3> nn = normals(frames[k], n);
-      std::vector<glm::vec3> dp(n), dn(n);
-      for (size_t i = 0; i < n; ++i) dp[i] = p[i] - base_pos[i], dn[i] = nn[i] - base_normal[i];
+      std::vector<glm::vec3> dp, dn;
+      frameVertices(cv, last.triangles, pos[k], nrm[k], dp, dn);
+      for (size_t i = 0; i < dp.size(); ++i) dp[i] -= base_pos[i], dn[i] -= base_normal[i];
       prim.targets.push_back({{"POSITION", b.vec3(dp)}, {"NORMAL", b.vec3(dn)}});
     }
     mesh.weights.assign(targets, 0.0);

@@ -50,7 +50,8 @@ fi
 if ls -a "$tmp" "$tmp/seq" | grep -q '\.tmp\.'; then fail "temporary files left"; else ok "no temporary files left"; fi
 
 # Read every file back (a reader independent of tinygltf): the structure, counts, index ranges,
-# accessor bounds, the embedded PNG; the animation's frames; the end state against the stats.
+# accessor bounds, the embedded PNG, the corners across a crease (their triangle's normal); the
+# animation's frames; the end state against the stats.
 if python3 - "$tmp" <<'PY'; then ok "every file reads back consistently"; else fail "read-back"; fi
 import base64, json, math, struct, sys, os
 tmp = sys.argv[1]
@@ -72,6 +73,7 @@ def load(path):
     assert uri.startswith("data:application/octet-stream;base64,"), uri[:40]
     return doc, base64.b64decode(uri.split(",", 1)[1])
 
+PARTICLES = 16 * 24
 SIZES = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
 
 def values(doc, binary, index):
@@ -91,10 +93,12 @@ def check(path, frames):
     prim = doc["meshes"][0]["primitives"][0]
     pos = values(doc, binary, prim["attributes"]["POSITION"])
     n = len(pos)
-    assert n == 16 * 24, n
+    # A vertex per particle, then one per triangle corner across a crease (its triangle's normal)
+    assert n >= PARTICLES, n
     for attr in ("NORMAL", "TEXCOORD_0"):
         assert doc["accessors"][prim["attributes"][attr]]["count"] == n, attr
-    for nrm in values(doc, binary, prim["attributes"]["NORMAL"]):
+    normals = values(doc, binary, prim["attributes"]["NORMAL"])
+    for nrm in normals:
         assert abs(math.sqrt(sum(c * c for c in nrm)) - 1) < 1e-4, nrm
     def bounds(index):
         a, vals = doc["accessors"][index], values(doc, binary, index)
@@ -106,6 +110,21 @@ def check(path, frames):
     assert len(idx) % 3 == 0 and idx and max(idx) < n, (len(idx), max(idx))
     ia = doc["accessors"][prim["indices"]]
     assert ia["min"] == [min(idx)] and ia["max"] == [max(idx)]
+    particle_at = {p: i for i, p in enumerate(pos[:PARTICLES])}
+    particle = list(range(PARTICLES)) + [particle_at[p] for p in pos[PARTICLES:]]  # a corner's own: its particle's place
+    own = 0
+    for t in range(0, len(idx), 3):
+        for c in range(3):
+            if idx[t + c] >= PARTICLES:  # the corner's own vertex: its triangle's normal
+                own += 1
+                a, b, d = (pos[idx[t + k]] for k in range(3))
+                e1 = [b[k] - a[k] for k in range(3)]
+                e2 = [d[k] - a[k] for k in range(3)]
+                f = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
+                fl = math.sqrt(sum(x * x for x in f))
+                assert all(abs(f[k] / fl - normals[idx[t + c]][k]) < 1e-4 for k in range(3)), (path, t)
+    assert own == n - PARTICLES, (own, n)  # each used by one corner
+    idx = [particle[i] for i in idx]  # the triangles by their particles
     mat = doc["materials"][prim["material"]]
     assert mat["doubleSided"] is True
     pbr = mat["pbrMetallicRoughness"]
@@ -143,13 +162,15 @@ assert len(seq[0][3]) == 3 * 2 * 15 * 23 and len(seq[3][3]) == 3 * stats["triang
 assert seq[3][2] == check(os.path.join(tmp, "end.glb"), 1)[2]  # the last frame is the end state
 for name in ("anim.glb", "anim.gltf"):
     doc, binary, pos, idx = check(os.path.join(tmp, name), 4)
-    assert pos == seq[0][2] and idx == seq[3][3]  # frame 0's particles, the last frame's triangles
+    # frame 0's particles, the last frame's triangles
+    assert pos[:PARTICLES] == seq[0][2][:PARTICLES] and idx == seq[3][3]
     prim = doc["meshes"][0]["primitives"][0]
     last = values(doc, binary, prim["targets"][2]["POSITION"])
-    for p, d, e in zip(pos, last, seq[3][2]):
+    for p, d, e in zip(pos[:PARTICLES], last, seq[3][2][:PARTICLES]):
         for k in range(3):
             assert abs(p[k] + d[k] - e[k]) < 1e-4 * max(1, abs(e[k])), (p, d, e)
-print("read back:", len(seq[3][3]) // 3, "triangles at the end,", stats["torn"], "constraints torn")
+print("read back:", len(seq[3][3]) // 3, "triangles at the end,", stats["torn"], "constraints torn,",
+      len(seq[3][2]) - PARTICLES, "corners across a crease")
 PY
 
 # A script's set event that rebuilds the sheet with another grid: the end state's texture
