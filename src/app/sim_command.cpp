@@ -164,6 +164,7 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   SimState state;
   solver.readback(state);
   SheetStats st = computeStats(state, common.params.substepDt());
+  judgeIntersections(st, state);
   double median = 0.0, slowest = 0.0;
   nlohmann::json j = runStatsJson(st, solver, {common.params.preset, o.ticks, sim.physicsTicks(), std::move(ms)},
                                   backend.gpu != nullptr, &median, &slowest);
@@ -175,8 +176,9 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
               "triangles; %u creased\n",
               st.constraints[0], st.constraints[1], st.constraints[2], st.constraints[3], st.constraints[4], st.colors,
               st.torn, st.triangles, st.creased);
-  std::printf("  bbox (%.3f %.3f %.3f) .. (%.3f %.3f %.3f), max stretch %.4f, NaN %u\n", st.bbox_min.x, st.bbox_min.y,
-              st.bbox_min.z, st.bbox_max.x, st.bbox_max.y, st.bbox_max.z, st.max_stretch, st.nan_count);
+  std::printf("  bbox (%.3f %.3f %.3f) .. (%.3f %.3f %.3f), max stretch %.4f, NaN %u, intersecting pairs %lld\n",
+              st.bbox_min.x, st.bbox_min.y, st.bbox_min.z, st.bbox_max.x, st.bbox_max.y, st.bbox_max.z, st.max_stretch,
+              st.nan_count, static_cast<long long>(st.pairs));
   std::printf("  %.4f ms/tick (median, slowest %.4f), state hash %s\n", median, slowest,
               j["state_hash"].get<std::string>().c_str());
   std::fflush(stdout);

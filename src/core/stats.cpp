@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "intersections.h"
+
 namespace tender {
 
 const char* kindName(uint32_t kind) {
@@ -56,6 +58,10 @@ SheetStats computeStats(const SimState& s, float substep_dt) {
   return st;
 }
 
+void judgeIntersections(SheetStats& st, const SimState& s) {
+  st.pairs = int64_t(intersectingPairs(s.pos, s.triangles, s.triangle_count).pairs);
+}
+
 nlohmann::json statsJson(const SheetStats& s) {
   nlohmann::json j;
   j["particles"] = s.particles;
@@ -75,6 +81,7 @@ nlohmann::json statsJson(const SheetStats& s) {
   j["max_stretch"] = s.max_stretch;
   j["max_speed"] = s.max_speed;
   j["nan_count"] = s.nan_count;
+  if (s.pairs >= 0) j["pairs"] = s.pairs;
   return j;
 }
 

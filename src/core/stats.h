@@ -26,6 +26,9 @@ struct SheetStats {
   float max_stretch = 0.0f; ///< largest length / rest over alive structural constraints
   uint32_t nan_count = 0;   ///< non-finite position components
   float max_speed = 0.0f;   ///< largest |pos - prev| / substep dt
+  /// Pairs of triangles that share no particle and intersect (intersectingPairs): where the sheet
+  /// has passed through itself; -1 until judged (judgeIntersections)
+  int64_t pairs = -1;
 };
 
 /// Names of the constraint kinds, indexed by kind.
@@ -36,6 +39,8 @@ uint64_t fnv1a(const void* data, size_t size, uint64_t h = 1469598103934665603ul
 uint64_t hashPositions(const std::vector<glm::vec4>& pos);
 /// Computes the summary of a read-back state.
 SheetStats computeStats(const SimState& s, float substep_dt);
+/// Judges the state's triangles for the sheet passing through itself (SheetStats::pairs).
+void judgeIntersections(SheetStats& st, const SimState& s);
 /// The stats as JSON (the caller adds timing fields).
 nlohmann::json statsJson(const SheetStats& s);
 /// A 64-bit hash as the 16 hex digits the stats print.

@@ -124,6 +124,7 @@ public:
   py::object stats() {
     SimState s = state();
     SheetStats st = computeStats(s, sim_->params().substepDt());
+    judgeIntersections(st, s);
     nlohmann::json j =
         runStatsJson(st, *backend_.solver, {sim_->params().preset, sim_->frameCount(), sim_->physicsTicks(), ms_},
                      backend_.gpu != nullptr);
@@ -300,6 +301,7 @@ public:
     Simulation& sim = at(*sheet);
     SimState s = state(uint32_t(*sheet));
     SheetStats st = computeStats(s, sim.params().substepDt());
+    judgeIntersections(st, s);
     nlohmann::json j = runStatsJson(st, sim.solver(), {sim.params().preset, sim.frameCount(), sim.physicsTicks(), ms_},
                                     batch_->name() == "gpu");
     return py::module_::import("json").attr("loads")(j.dump());

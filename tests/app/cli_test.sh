@@ -92,9 +92,10 @@ if "$T" sim --backend cpu --ticks 30 --script "$tmp/yank.txt" --stats "$tmp/s.js
 import json, sys
 s = json.load(open(sys.argv[1]))
 for k in ["particles", "constraints", "colors", "torn", "triangles", "ticks", "ms_per_tick", "state_hash",
-          "bbox_min", "bbox_max", "max_stretch", "nan_count"]:
+          "bbox_min", "bbox_max", "max_stretch", "nan_count", "pairs"]:
     assert k in s, k
 assert s["particles"] == 1536 and s["ticks"] == 30 and s["nan_count"] == 0, s
+assert isinstance(s["pairs"], int) and s["pairs"] >= 0, s["pairs"]  # the exact judge of self-intersection
 head = open(sys.argv[2], "rb").read(400).split(b"end_header")[0].decode()
 assert "element vertex 1536" in head and f"element face {s['triangles']}" in head, head
 print("ok: stats and PLY agree:", s["triangles"], "triangles,", s["torn"], "torn")
