@@ -2,7 +2,8 @@
 # The demo's mouse and camera under Xvfb: a click on a HUD button never also grabs the sheet, even
 # when the cursor reaches the button in the same event batch as the click; and the camera follow
 # keeps a tossed crumple sheet in view (on by default there), while with it off (F) the camera
-# stays where it was; the HUD's parameter edits are recorded as set events and replay bitwise. Exits
+# stays where it was; the HUD's parameter edits and the hand's squeezes are recorded as events and
+# replay bitwise. Exits
 # 77 (skipped) without Xvfb or xdotool.
 set -u
 source "$(dirname "$0")/demo_lib.sh"
@@ -69,6 +70,31 @@ hash=$(sed -n 's/^tender-demo: \([0-9]*\) steps, state hash \([0-9a-f]*\)$/\2/p'
 "$(dirname "$DEMO")/tender" sim --backend cpu --script "$tmp/hud.txt" --ticks "${steps:-0}" | grep -q "state hash $hash$" ||
   fail "the recording of the HUD edits does not replay to the demo's state $hash"
 echo "ok: HUD edits recorded as set events replay to the demo's state ($steps steps)"
+
+# The hand: while the left button holds the sheet, four wheel steps close the hand (squeeze
+# events of a quarter each), H opens it again, and letting go releases; the recording replays
+# bitwise.
+start_demo --backend cpu --ui-scale 1 --width 800 --height 600 --record "$tmp/hand.txt"
+sleep 3
+alive "start-up before the hand"
+xdotool mousemove --sync 400 300 mousedown 1
+sleep 0.3
+for _ in 1 2 3 4; do xdotool click 4; sleep 0.2; done
+sleep 0.5
+xdotool key --window "$wid" h
+sleep 0.3
+xdotool mouseup 1
+sleep 0.5
+alive "the hand"
+stop_demo
+squeezes=$(grep -o ' squeeze [0-9.]*' "$tmp/hand.txt" | tr '\n' ' ')
+[ "$squeezes" = " squeeze 0.25  squeeze 0.5  squeeze 0.75  squeeze 1  squeeze 0 " ] ||
+  fail "the wheel and H did not close and open the hand: $(cat "$tmp/hand.txt")"
+steps=$(sed -n 's/^tender-demo: \([0-9]*\) steps, state hash \([0-9a-f]*\)$/\1/p' "$tmp/demo.log")
+hash=$(sed -n 's/^tender-demo: \([0-9]*\) steps, state hash \([0-9a-f]*\)$/\2/p' "$tmp/demo.log")
+"$(dirname "$DEMO")/tender" sim --backend cpu --script "$tmp/hand.txt" --ticks "${steps:-0}" | grep -q "state hash $hash$" ||
+  fail "the recording of the hand does not replay to the demo's state $hash"
+echo "ok: the wheel closes the hand a quarter a step, H opens it; the recording replays ($steps steps)"
 
 # A toss to the left, from tick 120: far out of the crumple start view (target 0, -1.8, 0). The grab
 # lifts its particle from the floor at once, which tears paper: tearing is off, so that the whole

@@ -352,6 +352,7 @@ int DemoApp::run() {
       glfwGetWindowSize(window_, &ww, &wh);
       if (auto v = camera_.viewPoint(sim_->grabTarget(), aspect()))
         hs.grab_point = (*v * 0.5f + 0.5f) * glm::vec2(float(ww), float(wh));
+      hs.closure = sim_->closure();
     }
 
     demo::HudActions actions = hud_->draw(hs, panel_params_);

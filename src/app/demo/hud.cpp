@@ -54,13 +54,15 @@ Hud::Hud(float scale) : scale_(scale) {
 
 namespace {
 
-// A hand sprite of size `u` (about a finger's length) with its fingertips at `p`.
-void drawHand(ImDrawList* dl, ImVec2 p, float u) {
+// A hand sprite of size `u` (about a finger's length) with its fingertips at `p`, its fingers
+// curled into the palm as it closes (closure 0 open .. 1 a fist).
+void drawHand(ImDrawList* dl, ImVec2 p, float u, float closure) {
   const ImU32 fill = IM_COL32(255, 236, 214, 235), line = IM_COL32(90, 70, 60, 255);
   const float fw = 0.42f * u; // finger width
   ImVec2 palm_min{p.x - 1.0f * u, p.y + 0.9f * u}, palm_max{p.x + 0.9f * u, p.y + 2.2f * u};
   for (int k = 0; k < 4; ++k) {
-    const float x = p.x - 0.95f * u + float(k) * 0.47f * u, top = p.y + (k == 1 ? 0.0f : 0.25f * u);
+    const float x = p.x - 0.95f * u + float(k) * 0.47f * u,
+                top = p.y + (k == 1 ? 0.0f : 0.25f * u) + closure * 0.8f * u;
     dl->AddRectFilled({x, top}, {x + fw, palm_min.y + 0.3f * u}, fill, fw * 0.5f);
     dl->AddRect({x, top}, {x + fw, palm_min.y + 0.3f * u}, line, fw * 0.5f, 0, 1.2f);
   }
@@ -212,7 +214,8 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
   ImGui::End();
 
   // While grabbing: a small hand at the grab point (palm, four fingers, a thumb)
-  if (s.grab_point) drawHand(ImGui::GetForegroundDrawList(), {s.grab_point->x, s.grab_point->y}, 9.0f * scale_);
+  if (s.grab_point)
+    drawHand(ImGui::GetForegroundDrawList(), {s.grab_point->x, s.grab_point->y}, 9.0f * scale_, s.closure);
 
   // Paused: 50% overlay with "PAUSED" centred.
   if (s.paused) {

@@ -25,6 +25,7 @@ struct HudState {
   uint32_t triangles = 0; ///< live triangles (0 when unknown)
   /// Where the grab holds the paper, in window pixels, while grabbing: the hand sprite's place
   std::optional<glm::vec2> grab_point;
+  float closure = 0.0f; ///< the hand around the grab: 0 open .. 1 closed (its fingers curl)
 };
 
 /// What the user asked for through the HUD this frame.
