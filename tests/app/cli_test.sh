@@ -104,6 +104,21 @@ else
   echo "FAIL: good sim run exited $?"; failures=$((failures + 1))
 fi
 
+# The example of the hand (examples/hand_crumple.txt, as its comment runs it): the ball in the hand
+hand=(sim --backend cpu --preset crumple --set tilt=90 --set pins=none --set wind=off --set floor_y=-3
+  --set top_y=-2.925 --script "$(dirname "$0")/../../examples/hand_crumple.txt" --ticks 45 --stats "$tmp/hand.json")
+if "$T" "${hand[@]}" >/dev/null; then
+  python3 - "$tmp/hand.json" <<'PY' || failures=$((failures + 1))
+import json, sys
+s = json.load(open(sys.argv[1]))
+size = [s["bbox_max"][k] - s["bbox_min"][k] for k in range(3)]
+assert max(size) < 4.5 and s["nan_count"] == 0, size  # the 5.9 x 8.9 sheet: a ball in the hand, half its length
+print("ok: the hand's example crumples the sheet to", ["%.2f" % v for v in size], "with", s["pairs"], "pairs")
+PY
+else
+  echo "FAIL: the hand's example exited $?"; failures=$((failures + 1))
+fi
+
 "$T" --help >/dev/null && "$T" --version | grep -q '^tender ' || { echo "FAIL: --help/--version"; failures=$((failures + 1)); }
 echo "$failures failed"
 [ "$failures" -eq 0 ]
