@@ -267,7 +267,7 @@ std::optional<SimParams> presetParams(const std::string& name) {
     p.friction = 0.6f;
     p.release = ReleaseMode::DragVelocity;
     p.grab_radius = 0.02f;
-    p.hand_reach = 0.08f; // a hand around the receipt
+    p.hand_reach = 0.16f; // a hand gathering the receipt from its middle: half its length
   } else {
     return std::nullopt;
   }
