@@ -70,10 +70,10 @@ SIM_INLINE vec3 handFinger(uint i) {
 /// then the particle is drawn hand.z of its way toward the fist (a ball of radius hand.x around the
 /// centre, moved by handFinger(i) x hand.x). Returns the particle's new position.
 SIM_INLINE vec4 handPull(vec4 position, vec4 previous, uint i, vec3 centre, vec4 hand, vec4 motion) {
+  if (!(hand.y > 0.0f) || !(position.w > 0.0f)) return position; // an open hand: nothing to do
   vec3 p = vec3(position);
   vec3 d = p - centre;
-  float dist2 = dot3(d, d);
-  if (hand.y > 0.0f && position.w > 0.0f && dist2 < hand.y * hand.y) {
+  if (dot3(d, d) < hand.y * hand.y) {
     p = p - (p - vec3(previous) - vec3(motion)) * hand.w;
     d = p - (centre + handFinger(i) * hand.x);
     float dist = simSqrt(dot3(d, d));
