@@ -1,7 +1,7 @@
 # Shared by the windowed demo tests (sourced): starts Xvfb on a free display and removes it and
 # `tmp` at exit (exits 77, skipped, without the X tools); `fail MESSAGE` prints the demo's output
 # and exits 1; `start_demo ARGS...` runs tender-demo with ARGS (output in $tmp/demo.log) and sets
-# `demo` and `wid` once its window is up; `stop_demo` presses Escape and checks a clean exit.
+# `demo` and `wid` once its window is up; `stop_demo` presses Escape and checks a clean exit (a demo stuck for 20 s fails the test).
 DEMO=${TENDER_DEMO:?set TENDER_DEMO to the tender-demo binary}
 for tool in Xvfb xdotool xwd convert xdpyinfo; do
   if ! command -v "$tool" >/dev/null; then
@@ -42,8 +42,25 @@ start_demo() {
 }
 
 stop_demo() {
-  xdotool key --window "$wid" Escape
-  for _ in $(seq 100); do kill -0 "$demo" 2>/dev/null || break; sleep 0.1; done
+  # Escape again each second, in case one is lost; a demo still running after 20 s is stuck: the
+  # threads' kernel wait channels say where, and it is stopped (TERM, then KILL) so that the test
+  # fails rather than hangs.
+  local i
+  for i in $(seq 200); do
+    kill -0 "$demo" 2>/dev/null || break
+    [ $((i % 10)) -eq 1 ] && xdotool key --window "$wid" Escape 2>/dev/null
+    sleep 0.1
+  done
+  if kill -0 "$demo" 2>/dev/null; then
+    local where
+    where=$(for t in /proc/"$demo"/task/*; do echo "$(cat "$t/comm" 2>/dev/null): $(cat "$t/wchan" 2>/dev/null)"; done | sort | uniq -c)
+    kill -TERM "$demo" 2>/dev/null
+    for i in $(seq 50); do kill -0 "$demo" 2>/dev/null || break; sleep 0.1; done
+    kill -KILL "$demo" 2>/dev/null
+    wait "$demo"
+    demo=
+    fail "tender-demo did not exit within 20 s of Escape; its threads were waiting in: $where"
+  fi
   wait "$demo"
   local rc=$?
   demo=
