@@ -33,6 +33,7 @@ SIM_INLINE void projectHinge(uint k, uint iteration) {
 /// no particle, so no races): a hinge by projectHinge, any other both ends by solveDistance,
 /// weighted by inverse mass.
 SIM_INLINE void projectConstraint(Constraint c, uint iteration) {
+  if (!projectsInIteration(c.kind_id, iteration)) return;
   if ((c.kind_id & SIM_KIND_MASK) == SIM_KIND_HINGE) {
     projectHinge((c.kind_id >> SIM_KIND_BITS) - u.hinge.x, iteration);
     return;

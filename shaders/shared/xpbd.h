@@ -103,6 +103,16 @@ SIM_INLINE VerletState integrateParticle(uint i, vec4 pos, vec4 prev, vec4 rest,
   return s;
 }
 
+/// Whether a constraint (its packed kind and id) projects in iteration `iteration` of a substep: a
+/// hinge in the first only, so that the bending is one XPBD step per substep whatever the
+/// iteration count (its stiffness is its compliance alone) and the distance constraints, projected
+/// in every iteration, have the last word on the stretch; every other constraint in each. Hinges
+/// have colours of their own, so a whole colour projects or not: every path asks this of a
+/// colour's first constraint and skips the colour.
+SIM_INLINE bool projectsInIteration(uint kind_id, uint iteration) {
+  return iteration == 0u || (kind_id & SIM_KIND_MASK) != SIM_KIND_HINGE;
+}
+
 /// Projects one distance constraint; corrections are weighted by inverse mass (pos.w).
 SIM_INLINE PairDelta solveDistance(vec4 pa, vec4 pb, float rest, float stiffness) {
   PairDelta r;

@@ -122,12 +122,15 @@ void main() {
     // A new substep: no constraint torn in it yet (every invocation read the count of the last
     // substep before the barrier above).
     if (lid == 0u) counters.torn_new = 0u;
-    // 2. Gauss-Seidel over colours (as project.comp), a barrier after each colour
+    // 2. Gauss-Seidel over colours (as project.comp), a barrier after each colour that projects
+    // in this iteration (projectsInIteration: the same for every invocation)
     for (uint it = 0u; it < u.iterations; ++it)
       for (uint c = 0u; c < u.color_count; ++c) {
         uvec2 range = color_range[c];
-        for (uint t = lid; t < range.y; t += kInvocations) projectConstraint(constraints[range.x + t], it);
-        sync();
+        if (range.y > 0u && projectsInIteration(constraints[range.x].kind_id, it)) {
+          for (uint t = lid; t < range.y; t += kInvocations) projectConstraint(constraints[range.x + t], it);
+          sync();
+        }
         if (stopsAfter(first_pass + project_pass + it * u.color_count + c)) {
           storePositions(n);
           return;

@@ -138,11 +138,18 @@ void CpuSolver::projectColors(const SimUniforms& u, uint32_t first, uint32_t cou
   uint32_t largest = 0;
   for (const ColorRange& range : colors_) largest = std::max(largest, range.count);
   const uint32_t chunks = pool_->chunksFor(largest, grain_(kGrainConstraints));
-  // Gauss-Seidel over colours: one phase per colour, as many iterations per job as fit.
-  const uint32_t per_job = std::max(1u, WorkerPool::kMaxPhases / colors) * colors;
-  for (uint32_t done = 0; done < count; done += per_job)
-    pool_->runPhases(std::min(per_job, count - done), chunks, [&](uint32_t phase, uint32_t chunk) {
-      const uint32_t pass = first + done + phase;
+  // Gauss-Seidel over colours: one phase per colour that projects in its iteration
+  // (projectsInIteration), as many phases per job as fit.
+  std::vector<uint32_t>& passes = project_passes_;
+  passes.clear();
+  for (uint32_t pass = first; pass < first + count; ++pass) {
+    const ColorRange& range = colors_[pass % colors];
+    if (range.count > 0 && projectsInIteration(con_kind_[range.first], pass / colors)) passes.push_back(pass);
+  }
+  const uint32_t total = uint32_t(passes.size());
+  for (uint32_t done = 0; done < total; done += WorkerPool::kMaxPhases)
+    pool_->runPhases(std::min(WorkerPool::kMaxPhases, total - done), chunks, [&](uint32_t phase, uint32_t chunk) {
+      const uint32_t pass = passes[done + phase];
       const ColorRange& range = colors_[pass % colors];
       const uint32_t begin = WorkerPool::chunkBound(range.count, chunks, chunk);
       const uint32_t end = WorkerPool::chunkBound(range.count, chunks, chunk + 1);

@@ -126,10 +126,11 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
     record(sink, p, d.grid, n, SimPush{0, n, s, 0}, s, d.gate);
     break;
   case Elements::COLOUR: {
-    // Pass k: colour k % colours of iteration k / colours; an empty colour records nothing
+    // Pass k: colour k % colours of iteration k / colours; an empty colour, or one that does not
+    // project in this iteration (projectsInIteration), records nothing
     const uint32_t c = k % topo.colorCount(), iteration = k / topo.colorCount();
     const ColorRange& range = topo.colors[c];
-    if (range.count == 0) return;
+    if (range.count == 0 || !projectsInIteration(topo.constraints[range.first].kind_id, iteration)) return;
     record(sink, p, d.grid, range.count, SimPush{iteration, range.count, s, c}, s, d.gate, iteration);
     break;
   }
