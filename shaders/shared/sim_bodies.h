@@ -13,20 +13,18 @@
 #define SIM_POSITION(j) pos[j]
 #endif
 
-/// Projects hinge k (SIM_KIND_HINGE) in iteration `iteration` of the substep: one XPBD step of its
-/// four corners toward its rest angle (solveHinge), its multiplier starting from zero in the first
-/// iteration.
-SIM_INLINE void projectHinge(uint k, uint iteration) {
+/// Projects hinge k (SIM_KIND_HINGE), once per substep (projectsInIteration): one XPBD step of its
+/// four corners toward its rest angle (solveHinge) from a zero multiplier, which no later step
+/// reads, so it is not kept.
+SIM_INLINE void projectHinge(uint k) {
   uvec4 q = gridHinge(k, u.cols, u.rows);
   vec4 pu = SIM_POSITION(q.x), pv = SIM_POSITION(q.y), pa = SIM_POSITION(q.z), pb = SIM_POSITION(q.w);
-  HingeState st = hinges[k];
   float alpha = hingeIsDiagonal(k, u.cols, u.rows) ? 0.5f * u.crease.x : u.crease.x;
-  HingeDelta d = solveHinge(pu, pv, pa, pb, st.x, alpha, iteration == 0u ? 0.0f : st.z);
+  HingeDelta d = solveHinge(pu, pv, pa, pb, hinges[k].x, alpha, 0.0f);
   SIM_POSITION(q.x) = pu + vec4(d.du, 0.0f);
   SIM_POSITION(q.y) = pv + vec4(d.dv, 0.0f);
   SIM_POSITION(q.z) = pa + vec4(d.da, 0.0f);
   SIM_POSITION(q.w) = pb + vec4(d.db, 0.0f);
-  hinges[k].z = d.lambda;
 }
 
 /// Projects constraint c in iteration `iteration` of the substep (one colour's constraints share
@@ -35,7 +33,7 @@ SIM_INLINE void projectHinge(uint k, uint iteration) {
 SIM_INLINE void projectConstraint(Constraint c, uint iteration) {
   if (!projectsInIteration(c.kind_id, iteration)) return;
   if ((c.kind_id & SIM_KIND_MASK) == SIM_KIND_HINGE) {
-    projectHinge((c.kind_id >> SIM_KIND_BITS) - u.hinge.x, iteration);
+    projectHinge((c.kind_id >> SIM_KIND_BITS) - u.hinge.x);
     return;
   }
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b); // a != b: each end is read once

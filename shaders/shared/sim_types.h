@@ -75,8 +75,8 @@ struct SimUniforms {
 #define SIM_FLAG_AIR 8u
 
 /// The state of one hinge (SIM_BIND_HINGES, SheetState::hinges): x its rest angle (radians, in
-/// (-pi, pi]; 0 on a flat sheet, moved by creasing), y the yield its hardening has added, z the
-/// multiplier of its XPBD projection in this substep, w unused.
+/// (-pi, pi]; 0 on a flat sheet, moved by creasing), y the yield its hardening has added, z and w
+/// unused (0).
 #define HingeState vec4
 
 /// Push constants of every simulation dispatch.

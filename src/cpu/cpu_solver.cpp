@@ -124,7 +124,7 @@ void CpuSolver::projectRange(SheetElements& e, const float stiffness[4], uint32_
   if (simd_ && hinges) {
     k = simd::projectHinges(reinterpret_cast<float*>(pos_.data()), reinterpret_cast<float*>(hinges_.data()),
                             hinge_corners_.data(), con_hinge_.data(), firstDiagonalHinge(topo_->cols, topo_->rows),
-                            e.u.crease.x, iteration, begin, end);
+                            e.u.crease.x, begin, end);
   }
   for (; k < end; ++k)
     e.projectConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]}, iteration);

@@ -217,8 +217,7 @@ uint32_t creaseHinges(float* pos, float* state, const uint32_t* corners, const u
   return k;
 }
 
-uint32_t projectHinges(float* pos, float* state, const HingeSlots& slots, uint32_t iteration, uint32_t begin,
-                       uint32_t end) {
+uint32_t projectHinges(float* pos, float* state, const HingeSlots& slots, uint32_t begin, uint32_t end) {
   uint32_t k = begin;
   for (; k + 8 <= end; k += 8) {
     // Lane l is slot k + l (load puts rows 0-3 in the low half, 4-7 in the high half)
@@ -246,18 +245,17 @@ uint32_t projectHinges(float* pos, float* state, const HingeSlots& slots, uint32
                 neg(add(mul(ga.z, oa), mul(gb.z, ob)))};
     const V3 gv{neg(add(mul(ga.x, sa), mul(gb.x, sb))), neg(add(mul(ga.y, sa), mul(gb.y, sb))),
                 neg(add(mul(ga.z, sa), mul(gb.z, sb)))};
-    // solveHinge, with the edge or diagonal compliance of each lane and the multiplier so far
+    // solveHinge, with the edge or diagonal compliance of each lane, from a zero multiplier
     alignas(32) float lane_alpha[8];
     for (uint32_t l = 0; l < 8; ++l)
       lane_alpha[l] = lane_hinge[l] >= slots.first_diagonal ? 0.5f * slots.alpha : slots.alpha;
     const V alpha = _mm256_load_ps(lane_alpha);
-    const V lambda = iteration == 0 ? all(0.0f) : st.z;
     const V c = wrap(sub(angle, st.x));
     const V denom = add(
         add(add(add(mul(u.w, dot3(gu, gu)), mul(v.w, dot3(gv, gv))), mul(a.w, dot3(ga, ga))), mul(b.w, dot3(gb, gb))),
         alpha);
     const V ok = _mm256_and_ps(valid, gt(denom, all(0.0f)));
-    const V dl = div(sub(neg(c), mul(alpha, lambda)), denom);
+    const V dl = div(sub(neg(c), mul(alpha, all(0.0f))), denom);
     auto step = [&](Rows& r, const V3& g) {
       const V s = mul(dl, r.w);
       storeAdded(r, _mm256_and_ps(mul(g.x, s), ok), _mm256_and_ps(mul(g.y, s), ok), _mm256_and_ps(mul(g.z, s), ok));
@@ -266,10 +264,6 @@ uint32_t projectHinges(float* pos, float* state, const HingeSlots& slots, uint32
     step(v, gv);
     step(a, ga);
     step(b, gb);
-    // The multiplier (z) of each hinge's state; the rest stays
-    alignas(32) float out[8];
-    _mm256_store_ps(out, pick(ok, add(lambda, dl), lambda));
-    for (uint32_t l = 0; l < 8; ++l) state[4 * size_t(lane_hinge[l]) + 2] = out[l];
   }
   return k;
 }

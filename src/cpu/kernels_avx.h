@@ -26,8 +26,7 @@ struct HingeSlots {
 /// Projects the hinges of slots [begin, end) of one colour, eight at a time, with the exact
 /// operations of projectHinge (hingeAngle, simAtan2, solveHinge); `state` is the HingeState array as
 /// floats. Returns the first slot it did not project (fewer than 8 are left).
-uint32_t projectHinges(float* pos, float* state, const HingeSlots& slots, uint32_t iteration, uint32_t begin,
-                       uint32_t end);
+uint32_t projectHinges(float* pos, float* state, const HingeSlots& slots, uint32_t begin, uint32_t end);
 
 /// The creases of hinges [begin, end), eight at a time, with the exact operations of creaseHinge
 /// (hingeAngle without the gradient, creaseReturn): `corners` holds each hinge's gridHinge (4

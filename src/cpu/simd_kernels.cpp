@@ -39,10 +39,10 @@ uint32_t project8([[maybe_unused]] float* pos, [[maybe_unused]] const uint32_t* 
 
 uint32_t projectHinges([[maybe_unused]] float* pos, [[maybe_unused]] float* state,
                        [[maybe_unused]] const uint32_t* corners, [[maybe_unused]] const uint32_t* hinge,
-                       [[maybe_unused]] uint32_t first_diagonal, [[maybe_unused]] float alpha,
-                       [[maybe_unused]] uint32_t iteration, uint32_t begin, [[maybe_unused]] uint32_t end) {
+                       [[maybe_unused]] uint32_t first_diagonal, [[maybe_unused]] float alpha, uint32_t begin,
+                       [[maybe_unused]] uint32_t end) {
 #if defined(TENDER_CPU_AVX)
-  if (hasAvx()) return avx::projectHinges(pos, state, {corners, hinge, first_diagonal, alpha}, iteration, begin, end);
+  if (hasAvx()) return avx::projectHinges(pos, state, {corners, hinge, first_diagonal, alpha}, begin, end);
 #endif
   return begin;
 }

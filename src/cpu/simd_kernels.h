@@ -43,7 +43,7 @@ uint32_t project(float* pos, const uint32_t* a, const uint32_t* b, const float* 
 /// hinges from `first_diagonal` on are diagonals, `alpha` is an edge hinge's compliance over dt^2.
 /// Returns the first slot it did not project (`begin` without AVX); the caller projects the rest.
 uint32_t projectHinges(float* pos, float* state, const uint32_t* corners, const uint32_t* hinge,
-                       uint32_t first_diagonal, float alpha, uint32_t iteration, uint32_t begin, uint32_t end);
+                       uint32_t first_diagonal, float alpha, uint32_t begin, uint32_t end);
 
 /// The creases of hinges [begin, end) eight at a time with AVX, with the operations of creaseHinge:
 /// `corners` holds each hinge's gridHinge (4 words), `torn` each hinge's torn flag. Returns the
