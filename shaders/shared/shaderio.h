@@ -56,6 +56,7 @@ static_assert(offsetof(SimUniforms, grab_index) == 96);
 static_assert(offsetof(SimUniforms, air) == 112);
 static_assert(offsetof(SimUniforms, hinge) == 128);
 static_assert(offsetof(SimUniforms, hand) == 160);
-static_assert(offsetof(SimUniforms, wind) == 192);
-static_assert(sizeof(SimUniforms) == 192 + 4 * 16 * SIM_MAX_SUBSTEPS);
+static_assert(offsetof(SimUniforms, contact) == 192);
+static_assert(offsetof(SimUniforms, wind) == 208);
+static_assert(sizeof(SimUniforms) == 208 + 4 * 16 * SIM_MAX_SUBSTEPS);
 } // namespace shaderio

@@ -179,6 +179,15 @@
 // substep that sums from the lists
 #define SIM_HASH_DISPATCHES 16u
 
+// Penetration-free contact (contact.h): the part of the distance to its nearest primitive a particle
+// may move in a substep; below 1/2, with room for rounding
+#define SIM_CONTACT_FRACTION 0.4f
+// The least distance of two primitives, per unit of contact radius: far above the rounding of the
+// positions, so that the bound of a step (stepBound in contact.h) holds in floats
+#define SIM_CONTACT_MARGIN 1e-3f
+// The thickness of the contact, per unit of contact radius: closer pairs are pushed apart
+#define SIM_CONTACT_THICKNESS 0.5f
+
 // Largest workgroup count in X of one dispatch; bigger grids spill into Y
 #define SIM_MAX_GROUPS_X 65535u
 

@@ -59,6 +59,10 @@ struct SimUniforms {
   // substep, w the part of its velocity relative to the hand the grip takes per substep
   vec4 hand;
   vec4 hand_motion; // xyz the hand's displacement per substep
+  // Penetration-free contact (contact.h): x the contact radius (0: off), y the part of its distance
+  // to the nearest primitive a particle may move in a substep (below 1/2), z the thickness (closer
+  // pairs are pushed apart)
+  vec4 contact;
 
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
   vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet

@@ -410,5 +410,6 @@ SIM_INLINE vec2 rayPointDistance2(vec3 o, vec3 d, vec3 p) {
 }
 
 #include "collision.h"
+#include "contact.h"
 
 #endif

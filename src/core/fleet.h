@@ -93,6 +93,7 @@ public:
   void readback(SimState& out) override;
   void finish() override;
   uint32_t dispatchesPerTick() const override { return inner_.dispatchesPerTick(); }
+  int64_t contacts() const override { return inner_.contacts(); }
   uint64_t memoryBytes() const override { return inner_.memoryBytes(); }
   Arithmetic arithmetic() const override { return inner_.arithmetic(); }
   void stopNextTickAfter(uint32_t last_pass) override;

@@ -158,6 +158,8 @@ const std::vector<Param>& params() {
       floatParam("collision_factor", &SimParams::collision_factor, 0.0f, 10.0f,
                  "repulsion radius as a multiple of spacing"),
       floatParam("collision_stiffness", &SimParams::collision_stiffness, 0.0f, 1.0f, "repulsion strength"),
+      floatParam("contact_factor", &SimParams::contact_factor, 0.0f, 10.0f,
+                 "penetration-free contact radius as a multiple of spacing (0: off)"),
       floatParam("floor_y", &SimParams::floor_y, -1e4f, 1e4f, "ground height"),
       floatParam("restitution", &SimParams::restitution, 0.0f, 1.0f, "bounce off the ground"),
       floatParam("friction", &SimParams::friction, 0.0f, 1.0f, "ground friction"),

@@ -68,6 +68,8 @@ struct SimParams {
   float cell_size = 0.45f;       ///< spatial hash cell
   float collision_factor = 1.2f; ///< repulsion radius = factor x spacing
   float collision_stiffness = 1.0f;
+  /// Contact radius of the penetration-free self-contact (contact.h) as a multiple of spacing; 0: off
+  float contact_factor = 0.0f;
   // Ground
   float floor_y = -6.0f;
   float restitution = 0.2f;
@@ -84,6 +86,7 @@ struct SimParams {
   float tickDt() const { return 1.0f / tick_hz; }
   float substepDt() const { return 1.0f / (tick_hz * float(substeps)); }
   float collisionRadius() const { return collision_factor * spacing; }
+  float contactRadius() const { return contact_factor * spacing; }
   /// Factors of the air on a triangle of the rest area spacing^2 / 2 (SimUniforms::air): pressure
   /// and friction, rho C / (2 sigma spacing^2).
   float airPressureFactor() const;

@@ -214,6 +214,7 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   u.reset_active = reset_frame_ > 0 ? 1u : 0u;
   u.reset_alpha = reset_frame_ > 0 ? float(SIM_RESET_FRAMES - reset_frame_ + 1) / float(SIM_RESET_FRAMES) : 0.0f;
   u.iterations = p.iterations;
+  u.contact = glm::vec4(p.contactRadius(), SIM_CONTACT_FRACTION, p.contactRadius() * SIM_CONTACT_THICKNESS, 0.0f);
 
   const double t0 = double(physics_ticks_) / double(p.tick_hz);
   const double dts = 1.0 / (double(p.tick_hz) * p.substeps);

@@ -70,6 +70,9 @@ public:
   virtual PassTimes passTimes() const { return {}; }
   /// Dispatches (or pass invocations) recorded per tick.
   virtual uint32_t dispatchesPerTick() const { return 0; }
+  /// With contact on: the particles within the contact radius of a primitive at the start of the
+  /// last substep (-1: the solver has no contact, or it is off).
+  virtual int64_t contacts() const { return -1; }
   /// Bytes of device (or host) memory the solver's arrays take.
   virtual uint64_t memoryBytes() const { return 0; }
   /// How its float arithmetic runs (the CPU reference: IEEE, round to nearest even, denormals kept).

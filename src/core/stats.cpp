@@ -110,6 +110,7 @@ nlohmann::json runStatsJson(const SheetStats& s, const Solver& solver, RunRecord
   j["ms_per_tick"] = median;
   j["ms_slowest_tick"] = slowest;
   j["dispatches_per_tick"] = solver.dispatchesPerTick();
+  if (solver.contacts() >= 0) j["contacts"] = solver.contacts();
   const Arithmetic arith = solver.arithmetic();
   j["arithmetic"] = {{"rounding", arith.rounding}, {"denormals", arith.denormals}, {"corrected", arith.corrected}};
   j["inexact_math_emulated"] = arith.inexact_math_emulated;

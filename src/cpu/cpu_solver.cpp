@@ -15,7 +15,7 @@ using namespace shaderio;
 CpuSolver::CpuSolver(CpuOptions options)
     : options_(options), simd_(options.simd && simd::kBuilt),
       pool_(std::make_unique<WorkerPool>(options.threads, options.flush_denormals)),
-      collision_(*pool_, options.simd, options.candidate_lists) {}
+      collision_(*pool_, options.simd, options.candidate_lists), contact_(*pool_) {}
 
 // The constraints of each colour, reordered by their first particle, into one array per field
 // (the SIMD kernels load them four or eight at a time). Constraints of one colour share no
@@ -74,6 +74,7 @@ void CpuSolver::upload(const SheetTopology& topo) {
     for (uint32_t j = 0; j < 4; ++j) hinge_corners_[4 * size_t(k) + j] = q[j];
   }
   triangles_ = topo.triangles;
+  contact_.invalidate();
   triangle_count_ = topo.triangleCount();
   ticks_ = 0;
   counters_ = {};
@@ -169,14 +170,23 @@ void CpuSolver::creasePass(const SimUniforms& u) {
   });
 }
 
-void CpuSolver::floorPass(const SimUniforms& u) {
+void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
   const bool collide = (u.flags & SIM_FLAG_COLLISION) != 0u;
+  const bool contact = u.contact.x > 0.0f;
+  const bool placed = u.grab_target[s].w > 0.5f; // the grabbed particle goes where the user puts it
   pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
     vec4* pos = pos_.data();
     vec4* prev = prev_.data();
     for (uint32_t i = begin; i < end; ++i) {
       const vec3 d = collide ? collision_.delta(i) : vec3(0.0f);
-      const VerletState st = floorParticle(pos[i], prev[i], d, u.flags, u.floor_y, u.restitution, u.friction);
+      VerletState st = floorParticle(pos[i], prev[i], d, u.flags, u.floor_y, u.restitution, u.friction);
+      if (contact && st.position.w > 0.0f && !(placed && i == u.grab_index)) {
+        const vec3 x0 = vec3(start_[i]), x = boundedStep(x0, vec3(st.position) + vec3(push_[i]), bound_[i]);
+        if (x != vec3(st.position)) {
+          st.position = vec4(x, st.position.w);
+          st.previous = vec4(x0, st.position.w); // the velocity of the step it made
+        }
+      }
       pos[i] = st.position;
       prev[i] = st.previous;
     }
@@ -318,6 +328,12 @@ void CpuSolver::tick(const SimUniforms& u) {
 void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint32_t first, uint32_t count) {
   switch (stage) {
   case PassKind::integrate:
+    contact_on_ = u.contact.x > 0.0f;
+    if (contact_on_) {
+      // The step bounds of the substep, from where the particles start it
+      contact_.computeBounds(pos_, triangles_, triangle_count_, u.contact.x, u.contact.y, u.contact.z, bound_, push_);
+      start_ = pos_;
+    }
     integrate(u, s); // the air, then damped Verlet, gravity, wind; pins and the grab hold
     break;
   case PassKind::project:
@@ -330,7 +346,7 @@ void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint3
     collide(u); // repulsion of unconnected neighbours (Jacobi)
     break;
   case PassKind::floor:
-    floorPass(u); // apply the repulsion, then the ground contact
+    floorPass(u, s); // apply the repulsion, then the ground contact; bound the steps
     break;
   case PassKind::tear:
     // Tear, let go of what stood on the triangles lost, compact the colours and triangles
@@ -353,6 +369,7 @@ void CpuSolver::beginReset() {
   std::fill(torn_.begin(), torn_.end(), 0u);
   std::fill(hinges_.begin(), hinges_.end(), vec4(0.0f));
   triangles_ = topo_->triangles;
+  contact_.invalidate();
   triangle_count_ = topo_->triangleCount();
 }
 
@@ -389,7 +406,8 @@ uint64_t CpuSolver::memoryBytes() const {
          capacityBytes(reset_from_) + capacityBytes(uv_) + capacityBytes(constraints_) + capacityBytes(colors_) +
          capacityBytes(torn_) + capacityBytes(hinges_) + capacityBytes(con_a_) + capacityBytes(con_b_) +
          capacityBytes(con_kind_) + capacityBytes(con_id_) + capacityBytes(con_rest_) + capacityBytes(con_hinge_) +
-         capacityBytes(hinge_corners_) + capacityBytes(triangles_) + collision_.memoryBytes();
+         capacityBytes(hinge_corners_) + capacityBytes(triangles_) + collision_.memoryBytes() + contact_.memoryBytes() +
+         capacityBytes(start_) + capacityBytes(bound_) + capacityBytes(push_);
 }
 
 } // namespace tender

@@ -17,6 +17,7 @@
 #include "core/passes.h"
 #include "core/solver.h"
 #include "cpu_collision.h"
+#include "cpu_contact.h"
 #include "sheet_elements.h"
 
 namespace tender {
@@ -60,6 +61,7 @@ public:
   void readDeltas(std::vector<glm::vec4>& out) override;
   Arithmetic arithmetic() const override;
   uint32_t dispatchesPerTick() const override { return passes_per_tick_; }
+  int64_t contacts() const override { return contact_on_ ? int64_t(contact_.contacts()) : -1; }
   /// Bytes of host memory of the solver's own arrays (capacity, not size).
   uint64_t memoryBytes() const override;
   /// Worker threads in use, the caller included.
@@ -90,8 +92,9 @@ public:
   void creasePass(const shaderio::SimUniforms& u);
   /// The collision of one substep (CpuCollision::substep); returns the mode (SIM_CANDIDATE_*).
   uint32_t collide(const shaderio::SimUniforms& u) { return collision_.substep(u, pos_.data()); }
-  /// Applies the collision deltas, then the ground contact.
-  void floorPass(const shaderio::SimUniforms& u);
+  /// Applies the collision deltas, then the ground contact; with contact on (SimUniforms::contact),
+  /// no free particle ends farther from where it started the substep than its bound (contact.h).
+  void floorPass(const shaderio::SimUniforms& u, uint32_t substep);
   /// Marks constraints beyond the tear threshold; returns how many tore.
   uint32_t markTears(const shaderio::SimUniforms& u);
   /// After a tear: marks the shear and tri-bend constraints whose triangles are gone (unsupported
@@ -130,6 +133,11 @@ private:
   std::unique_ptr<WorkerPool> pool_;
   Grain grain_;
   CpuCollision collision_;
+  CpuContact contact_;
+  bool contact_on_ = false;      ///< the last tick had contact on
+  std::vector<glm::vec4> start_; ///< with contact on: the positions at the start of the substep
+  std::vector<float> bound_;     ///< with contact on: each particle's step bound in this substep
+  std::vector<glm::vec4> push_;  ///< with contact on: the push parting its contacts (CpuContact)
   const SheetTopology* topo_ = nullptr;
   std::vector<glm::vec4> pos_, prev_, rest_, normal_, reset_from_;
   std::vector<glm::vec4> air_; ///< the air on each particle in this substep (SIM_FLAG_AIR)

@@ -213,6 +213,7 @@ void GpuBatch::flush() {
     auto& q = queued_[i]->queued();
     if (!q) continue;
     SimUniforms u = *q;
+    requireNoContact(u);
     q.reset();
     if (keepsCandidateLists(sizes_, candidates_allowed_)) u.flags |= SIM_FLAG_CANDIDATES; // as the solver does
     std::memcpy(inputs + uniforms_at + stride_[SIM_BIND_UNIFORMS] * i, &u, sizeof(u));

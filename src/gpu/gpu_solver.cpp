@@ -128,7 +128,13 @@ void GpuSolver::collectTimes(const InFlight& flight) const {
   last_ms_ = ms;
 }
 
+void requireNoContact(const SimUniforms& u) {
+  if (u.contact.x > 0.0f)
+    throw std::runtime_error("contact_factor needs --backend cpu: the GPU solver has no penetration-free contact yet");
+}
+
 void GpuSolver::tick(const SimUniforms& u) {
+  requireNoContact(u);
   const uint32_t index = next_in_flight_;
   next_in_flight_ = (next_in_flight_ + 1) % kInFlight;
   InFlight& flight = in_flight_[index];

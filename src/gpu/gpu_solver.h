@@ -39,6 +39,9 @@ float structuralSpacing(const SheetTopology& topo);
 /// True when a sheet of this topology is small enough for the fused tick: at most
 /// SIM_FUSED_MAX_PARTICLES particles and SIM_FUSED_MAX_BUCKETS hash buckets.
 bool fusedTickFits(const SheetTopology& topo);
+/// Throws when `u` asks for the penetration-free contact (SimUniforms::contact), which only the
+/// CPU solver has so far.
+void requireNoContact(const shaderio::SimUniforms& u);
 
 /// True when a tick with these uniforms, of a sheet of grid spacing `spacing` that fits the fused
 /// tick, takes it on a device whose fused tick takes hash cells of at most `max_cell_spacings`

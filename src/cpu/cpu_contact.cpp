@@ -1,0 +1,235 @@
+#include "cpu_contact.h"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <mutex>
+
+#include "cpu_collision.h"
+#include "worker_pool.h"
+
+namespace tender {
+
+using namespace shaderio;
+using glm::ivec3;
+using glm::uvec2;
+using glm::uvec4;
+using glm::vec3;
+
+namespace {
+
+/// Lowers `slot`, the bits of a non-negative float, to the bits of d2: such floats order as their
+/// bits, so the smallest wins whatever the order of the calls.
+void lower(uint32_t& slot, float d2) {
+  std::atomic_ref<uint32_t> a(slot);
+  const uint32_t v = std::bit_cast<uint32_t>(d2);
+  uint32_t seen = a.load(std::memory_order_relaxed);
+  while (v < seen && !a.compare_exchange_weak(seen, v, std::memory_order_relaxed)) {
+  }
+}
+
+/// Calls f(entry) once for each entry of `grid` whose box overlaps the box [lo, hi]: in the cell
+/// that holds the lowest corner of the two boxes' overlap (both boxes are in that cell).
+template <typename Grid, typename F>
+void visitBox(const Grid& grid, const std::vector<vec3>& lows, const std::vector<vec3>& highs, vec3 lo, vec3 hi,
+              float inv_cell, F&& f) {
+  const ivec3 a = cellOf(lo, inv_cell), b = cellOf(hi, inv_cell);
+  for (int z = a.z; z <= b.z; ++z)
+    for (int y = a.y; y <= b.y; ++y)
+      for (int x = a.x; x <= b.x; ++x) {
+        const ivec3 cell(x, y, z);
+        const uint32_t h = hashCell(cell, grid.mask);
+        for (uint32_t k = grid.start[h]; k < grid.start[h + 1]; ++k) {
+          const uint32_t e = grid.entry[k];
+          const vec3 elo = lows[e], ehi = highs[e];
+          if (!(lo.x <= ehi.x && elo.x <= hi.x && lo.y <= ehi.y && elo.y <= hi.y && lo.z <= ehi.z && elo.z <= hi.z))
+            continue;
+          if (cellOf(glm::max(lo, elo), inv_cell) == cell) f(e);
+        }
+      }
+}
+
+float length2(vec3 a) { return dot3(a, a); }
+
+bool less4(uvec4 a, uvec4 b) {
+  if (a.x != b.x) return a.x < b.x;
+  if (a.y != b.y) return a.y < b.y;
+  if (a.z != b.z) return a.z < b.z;
+  return a.w < b.w;
+}
+
+} // namespace
+
+void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3>& hi, float inv_cell) {
+  const uint32_t n = uint32_t(lo.size());
+  const uint32_t size = std::bit_ceil(std::max(2u * n, 16u));
+  mask = size - 1;
+  start.assign(size + 1, 0);
+  auto cells = [&](uint32_t i, auto&& f) {
+    const ivec3 a = cellOf(lo[i], inv_cell), b = cellOf(hi[i], inv_cell);
+    for (int z = a.z; z <= b.z; ++z)
+      for (int y = a.y; y <= b.y; ++y)
+        for (int x = a.x; x <= b.x; ++x) f(hashCell(ivec3(x, y, z), mask));
+  };
+  for (uint32_t i = 0; i < n; ++i) cells(i, [&](uint32_t h) { ++start[h + 1]; });
+  for (uint32_t h = 0; h < size; ++h) start[h + 1] += start[h];
+  entry.resize(start[size]);
+  fill.assign(start.begin(), start.end() - 1);
+  for (uint32_t i = 0; i < n; ++i) cells(i, [&](uint32_t h) { entry[fill[h]++] = i; });
+}
+
+void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
+                               float radius, float fraction, float thickness, std::vector<float>& bound,
+                               std::vector<glm::vec4>& push) {
+  const uint32_t n = uint32_t(pos.size());
+  bound.resize(n);
+  push.assign(n, glm::vec4(0.0f));
+  if (edges_key_ != count) {
+    edges_.clear();
+    for (uint32_t t = 0; t < count; ++t) {
+      const uvec4 tri = triangles[t];
+      for (uvec2 e : {uvec2(tri.x, tri.y), uvec2(tri.y, tri.z), uvec2(tri.z, tri.x)})
+        edges_.push_back(uvec2(std::min(e.x, e.y), std::max(e.x, e.y)));
+    }
+    std::sort(edges_.begin(), edges_.end(), [](uvec2 a, uvec2 b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
+    edges_.erase(std::unique(edges_.begin(), edges_.end()), edges_.end());
+    edges_key_ = count;
+    lists_ = false;
+  }
+  const float r = radius, r2 = r * r, skin = kSkin * radius;
+  // The pair lists hold every pair that can be closer than r while no particle is skin / 2 or more
+  // from where it was when they were built
+  bool fresh = lists_ && list_radius_ == radius && base_.size() == n;
+  for (uint32_t i = 0; fresh && i < n; ++i) {
+    const vec3 d = vec3(pos[i]) - vec3(base_[i]);
+    fresh = dot3(d, d) < 0.25f * skin * skin;
+  }
+  if (!fresh) buildLists(pos, triangles, count, radius);
+  const uint32_t none = std::bit_cast<uint32_t>(r2);
+  nearest2_.assign(n, lists_ ? none : 0u); // positions gone wrong (no lists): nothing moves
+  auto at = [&](uint32_t i) { return vec3(pos[i]); };
+  pool_.parallelFor(uint32_t(vf_.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
+    for (uint32_t k = begin; k < end; ++k) {
+      const uvec4 q = vf_[k];
+      const float d2 = pointTriangleDistance2(at(q.x), at(q.y), at(q.z), at(q.w));
+      if (!(d2 < r2)) continue;
+      for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], d2);
+    }
+  });
+  pool_.parallelFor(uint32_t(ee_.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
+    for (uint32_t k = begin; k < end; ++k) {
+      const uvec4 q = ee_[k];
+      const float d2 = segmentDistance2(at(q.x), at(q.y), at(q.z), at(q.w));
+      if (!(d2 < r2)) continue;
+      for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], d2);
+    }
+  });
+  // The pushes that part the pairs closer than the thickness, summed in the lists' order and
+  // averaged over each particle's pushes (w: how many)
+  auto part = [&](const std::vector<uvec4>& list, auto&& nearest) {
+    for (const uvec4 q : list) {
+      const glm::vec4 x[4] = {pos[q.x], pos[q.y], pos[q.z], pos[q.w]};
+      const ContactPair c = nearest(vec3(x[0]), vec3(x[1]), vec3(x[2]), vec3(x[3]));
+      if (!(c.d2 < thickness * thickness)) continue;
+      for (uint32_t k = 0; k < 4; ++k)
+        push[q[k]] += glm::vec4(contactPush(x[0], x[1], x[2], x[3], c, thickness, k), 1.0f);
+    }
+  };
+  part(vf_, [](vec3 p, vec3 a, vec3 b, vec3 c) { return pointTriangle(p, a, b, c); });
+  part(ee_, [](vec3 a, vec3 b, vec3 c, vec3 d) { return segmentSegment(a, b, c, d); });
+  for (glm::vec4& d : push)
+    if (d.w > 0.0f) d = glm::vec4(vec3(d) * (1.0f / d.w), 0.0f);
+  uint64_t contacts = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    contacts += nearest2_[i] < none ? 1u : 0u;
+    bound[i] = stepBound(std::bit_cast<float>(nearest2_[i]), radius, fraction);
+  }
+  contacts_ = contacts;
+}
+
+void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
+                            float radius) {
+  const float reach = radius * (1.0f + kSkin);
+  const uint32_t n = uint32_t(pos.size()), edge_count = uint32_t(edges_.size());
+  auto at = [&](uint32_t i) { return vec3(pos[i]); };
+  vf_.clear();
+  ee_.clear();
+  lists_ = false;
+  // Cells as wide as the reach and the mean edge, and at least an eighth of the longest edge, so
+  // that no box spans more than a few cells
+  double sum = 0.0;
+  float longest = 0.0f;
+  for (const uvec2 e : edges_) {
+    const float l = std::sqrt(length2(at(e.y) - at(e.x)));
+    sum += double(l);
+    longest = std::max(longest, l);
+  }
+  const float mean = edge_count > 0 ? float(sum / double(edge_count)) : 0.0f;
+  const float inv_cell = 1.0f / std::max(reach + mean, (reach + longest) * 0.125f);
+  if (!(std::isfinite(inv_cell) && inv_cell > 0.0f && longest < 1e30f)) return;
+  const float reach2 = reach * reach;
+  std::mutex merge;
+  // Particles against the triangles that do not hold them: the boxes of the triangles in the grid,
+  // each particle's box of half-width `reach` against them
+  lo_.resize(count);
+  hi_.resize(count);
+  for (uint32_t t = 0; t < count; ++t) {
+    const vec3 a = at(triangles[t].x), b = at(triangles[t].y), c = at(triangles[t].z);
+    lo_[t] = glm::min(a, glm::min(b, c));
+    hi_[t] = glm::max(a, glm::max(b, c));
+  }
+  grid_.build(lo_, hi_, inv_cell);
+  pool_.parallelFor(n, kGrainCollide, [&](uint32_t begin, uint32_t end) {
+    std::vector<uvec4> found;
+    for (uint32_t v = begin; v < end; ++v) {
+      const vec3 p = at(v), plo = p - vec3(reach), phi = p + vec3(reach);
+      visitBox(grid_, lo_, hi_, plo, phi, inv_cell, [&](uint32_t t) {
+        const uvec4 tri = triangles[t];
+        if (v == tri.x || v == tri.y || v == tri.z) return;
+        if (pointTriangleDistance2(p, at(tri.x), at(tri.y), at(tri.z)) < reach2)
+          found.push_back(uvec4(v, tri.x, tri.y, tri.z));
+      });
+    }
+    const std::lock_guard<std::mutex> lock(merge);
+    vf_.insert(vf_.end(), found.begin(), found.end());
+  });
+  // Edges against the edges that share no particle with them, each pair once
+  lo_.resize(edge_count);
+  hi_.resize(edge_count);
+  for (uint32_t k = 0; k < edge_count; ++k) {
+    const vec3 a = at(edges_[k].x), b = at(edges_[k].y);
+    lo_[k] = glm::min(a, b);
+    hi_[k] = glm::max(a, b);
+  }
+  grid_.build(lo_, hi_, inv_cell);
+  pool_.parallelFor(edge_count, kGrainCollide, [&](uint32_t begin, uint32_t end) {
+    std::vector<uvec4> found;
+    for (uint32_t k = begin; k < end; ++k) {
+      const uvec2 e = edges_[k];
+      const vec3 elo = lo_[k] - vec3(reach), ehi = hi_[k] + vec3(reach);
+      visitBox(grid_, lo_, hi_, elo, ehi, inv_cell, [&](uint32_t j) {
+        if (j <= k) return;
+        const uvec2 f = edges_[j];
+        if (f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
+        if (segmentDistance2(at(e.x), at(e.y), at(f.x), at(f.y)) < reach2) found.push_back(uvec4(e, f));
+      });
+    }
+    const std::lock_guard<std::mutex> lock(merge);
+    ee_.insert(ee_.end(), found.begin(), found.end());
+  });
+  // The same lists whatever the threads' order
+  std::sort(vf_.begin(), vf_.end(), less4);
+  std::sort(ee_.begin(), ee_.end(), less4);
+  base_ = pos;
+  list_radius_ = radius;
+  lists_ = true;
+}
+
+uint64_t CpuContact::memoryBytes() const {
+  return capacityBytes(edges_) + capacityBytes(vf_) + capacityBytes(ee_) + capacityBytes(base_) + capacityBytes(lo_) +
+         capacityBytes(hi_) + capacityBytes(nearest2_) + capacityBytes(grid_.start) + capacityBytes(grid_.entry) +
+         capacityBytes(grid_.fill);
+}
+
+} // namespace tender

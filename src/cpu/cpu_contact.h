@@ -1,0 +1,66 @@
+#pragma once
+/// Penetration-free self-contact of the CPU solver: the step bound of every particle at the start
+/// of a substep (contact.h: the smallest of the contact radius and its distances to the triangles
+/// and edges near it, times SIM_CONTACT_FRACTION), found through a uniform grid that holds the
+/// triangles, then the edges, in every cell their boxes overlap. Each distance lowers the bounds of the particles of
+/// its pair by an atomic minimum, so the bounds are the same whatever the thread count or order.
+#include <cstdint>
+#include <vector>
+
+#include "shaderio.h"
+
+namespace tender {
+
+class WorkerPool;
+
+class CpuContact {
+public:
+  explicit CpuContact(WorkerPool& pool) : pool_(pool) {}
+
+  /// The step bound of each particle at `pos` (xyz; w inverse mass) of the sheet made of the
+  /// first `count` triangles of `triangles` (xyz: their particles) for contact radius `radius`,
+  /// into `bound`, and in `push` the push that parts the pairs closer than `thickness`
+  /// (contactPush, averaged over a particle's pairs). The edges are worked out again when the
+  /// triangles change (a tear).
+  void computeBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
+                     float radius, float fraction, float thickness, std::vector<float>& bound,
+                     std::vector<glm::vec4>& push);
+  /// Pairs of primitives (particle-triangle, edge-edge) closer than the radius at the last call.
+  uint64_t contacts() const { return contacts_; }
+  /// Forgets the edges (a new sheet or a reset).
+  void invalidate() {
+    edges_key_ = ~0ull;
+    lists_ = false;
+  }
+  uint64_t memoryBytes() const;
+
+private:
+  /// A uniform grid of boxes hashed into a power-of-two table: a box is an entry of every cell it
+  /// overlaps; the entries of bucket h at [start[h], start[h + 1]).
+  struct Grid {
+    std::vector<uint32_t> start, entry, fill;
+    uint32_t mask = 0;
+    void build(const std::vector<glm::vec3>& lo, const std::vector<glm::vec3>& hi, float inv_cell);
+  };
+
+  /// The pair lists' skin, per unit of contact radius
+  static constexpr float kSkin = 0.25f;
+  /// Lists the particle-triangle and edge-edge pairs closer than radius + skin at `pos`.
+  void buildLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
+                  float radius);
+
+  WorkerPool& pool_;
+  std::vector<glm::uvec4> vf_;     ///< particle, then the triangle's three: pairs within radius + skin
+  std::vector<glm::uvec4> ee_;     ///< two edges' particles: pairs within radius + skin
+  std::vector<glm::vec4> base_;    ///< where the particles were when the lists were built
+  bool lists_ = false;             ///< the lists are usable
+  float list_radius_ = 0.0f;       ///< the contact radius they were built for
+  std::vector<glm::uvec2> edges_;  ///< the sheet's edges, each once (a < b)
+  uint64_t edges_key_ = ~0ull;     ///< the triangle count the edges were worked out for
+  std::vector<glm::vec3> lo_, hi_; ///< scratch: the boxes of the triangles, then of the edges
+  std::vector<uint32_t> nearest2_; ///< the bits of each particle's smallest squared distance
+  Grid grid_;
+  uint64_t contacts_ = 0;
+};
+
+} // namespace tender

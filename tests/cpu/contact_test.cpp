@@ -1,0 +1,244 @@
+// Penetration-free self-contact (shaders/shared/contact.h, cpu/cpu_contact.h): the distances it
+// is built on against closed forms and brute force, the bounded step, and scripted scenes judged
+// from outside by the exact triangle-triangle intersection count (core/intersections.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "common/sim_helpers.h"
+#include "core/intersections.h"
+#include "cpu/cpu_solver.h"
+#include "cpu_runs.h"
+#include "shaderio.h"
+
+namespace tender::test {
+namespace {
+
+using glm::vec3;
+using shaderio::ContactPair;
+
+/// The vector between the nearest points a ContactPair names.
+vec3 separation(const ContactPair& c, vec3 x0, vec3 x1, vec3 x2, vec3 x3) {
+  return x0 * c.w.x + x1 * c.w.y + x2 * c.w.z + x3 * c.w.w;
+}
+
+TEST(ContactDistance, ClosedForms) {
+  const vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  // Over the inside: the height; beyond a corner: to the corner; beyond an edge: to the edge
+  EXPECT_FLOAT_EQ(shaderio::pointTriangle(vec3(0.25f, 0.25f, 0.5f), a, b, c).d2, 0.25f);
+  EXPECT_FLOAT_EQ(shaderio::pointTriangle(vec3(2, 0, 0), a, b, c).d2, 1.0f);
+  EXPECT_FLOAT_EQ(shaderio::pointTriangle(vec3(0.5f, -1, 1), a, b, c).d2, 2.0f);
+  // Skew segments crossing 0.5 apart; parallel ones side by side; collinear ones with a gap
+  EXPECT_FLOAT_EQ(shaderio::segmentSegment(vec3(-1, 0, 0), vec3(1, 0, 0), vec3(0, -1, 0.5f), vec3(0, 1, 0.5f)).d2,
+                  0.25f);
+  EXPECT_FLOAT_EQ(shaderio::segmentSegment(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0.5f, 0.3f, 0), vec3(2, 0.3f, 0)).d2,
+                  0.09f);
+  EXPECT_FLOAT_EQ(shaderio::segmentSegment(vec3(0, 0, 0), vec3(1, 0, 0), vec3(1.5f, 0, 0), vec3(3, 0, 0)).d2, 0.25f);
+  // Zero-length segments and triangles of no area are points and segments
+  EXPECT_FLOAT_EQ(shaderio::segmentSegment(vec3(0, 0, 0), vec3(0, 0, 0), vec3(0, 2, 0), vec3(0, 2, 0)).d2, 4.0f);
+  EXPECT_FLOAT_EQ(shaderio::pointTriangle(vec3(0.5f, 1, 0), a, b, vec3(2, 0, 0)).d2, 1.0f);
+  EXPECT_FLOAT_EQ(shaderio::pointTriangle(vec3(0, 3, 0), a, a, a).d2, 9.0f);
+}
+
+TEST(ContactDistance, NeverAboveTheNearestSampledPointsAndTheWeightsNameThem) {
+  // Random triangles and segments, thin and degenerate ones among them: the distance is at most
+  // the nearest of a fine sampling of the primitives (it is a minimum), at least that less the
+  // sampling's spacing, and the weights give a vector of that length.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  auto point = [&] { return vec3(u(rng), u(rng), u(rng)); };
+  constexpr int kSteps = 64;
+  for (int trial = 0; trial < 400; ++trial) {
+    vec3 a = point(), b = point(), c = point(), p = point();
+    if (trial % 10 == 0) c = a + (b - a) * 0.3f; // no area
+    const ContactPair vf = shaderio::pointTriangle(p, a, b, c);
+    float sampled = 1e30f, longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+    for (int i = 0; i <= kSteps; ++i)
+      for (int j = 0; i + j <= kSteps; ++j) {
+        const vec3 q = a + (b - a) * (float(i) / kSteps) + (c - a) * (float(j) / kSteps);
+        sampled = std::min(sampled, glm::dot(p - q, p - q));
+      }
+    ASSERT_TRUE(std::isfinite(vf.d2));
+    EXPECT_LE(vf.d2, sampled * 1.0001f + 1e-9f) << trial;
+    EXPECT_GE(std::sqrt(vf.d2), std::sqrt(sampled) - 2.0f * longest / kSteps) << trial;
+    EXPECT_NEAR(glm::length(separation(vf, p, a, b, c)), std::sqrt(vf.d2), 1e-4f) << trial;
+
+    vec3 q0 = point(), q1 = point();
+    if (trial % 10 == 1) q1 = q0 + (b - a) * 0.5f; // parallel
+    const ContactPair ee = shaderio::segmentSegment(a, b, q0, q1);
+    sampled = 1e30f;
+    for (int i = 0; i <= kSteps; ++i)
+      for (int j = 0; j <= kSteps; ++j) {
+        const vec3 d = (a + (b - a) * (float(i) / kSteps)) - (q0 + (q1 - q0) * (float(j) / kSteps));
+        sampled = std::min(sampled, glm::dot(d, d));
+      }
+    longest = std::max(glm::length(b - a), glm::length(q1 - q0));
+    ASSERT_TRUE(std::isfinite(ee.d2));
+    EXPECT_LE(ee.d2, sampled * 1.0001f + 1e-9f) << trial;
+    EXPECT_GE(std::sqrt(ee.d2), std::sqrt(sampled) - 2.0f * longest / kSteps) << trial;
+    EXPECT_NEAR(glm::length(separation(ee, a, b, q0, q1)), std::sqrt(ee.d2), 1e-4f) << trial;
+  }
+}
+
+TEST(ContactDistance, ABoundedStepGoesNoFartherThanItsBound) {
+  const vec3 x0(1.0f, 2.0f, 3.0f);
+  EXPECT_EQ(shaderio::boundedStep(x0, x0 + vec3(0.1f, 0, 0), 0.2f), x0 + vec3(0.1f, 0, 0)); // within: unchanged
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-5.0f, 5.0f);
+  for (int k = 0; k < 1000; ++k) {
+    const vec3 x(u(rng), u(rng), u(rng));
+    const float bound = 0.01f * float(k % 100);
+    const vec3 y = shaderio::boundedStep(x0, x, bound);
+    EXPECT_LE(glm::length(y - x0), bound * 1.000001f + 1e-6f);
+    if (bound == 0.0f) {
+      EXPECT_EQ(y, x0);
+      continue;
+    }
+    // Along the step it was to make, not back
+    EXPECT_LE(glm::length(glm::cross(y - x0, x - x0)), 1e-4f * glm::length(y - x0) * glm::length(x - x0));
+    EXPECT_GT(glm::dot(y - x0, x - x0), 0.0f);
+  }
+  // The margin: nothing moves at or below it, and beyond it the bound grows with the distance
+  EXPECT_EQ(shaderio::stepBound(1e-8f, 1.0f, 0.4f), 0.0f);
+  EXPECT_NEAR(shaderio::stepBound(0.25f, 1.0f, 0.4f), 0.4f * (0.5f - SIM_CONTACT_MARGIN), 1e-7f);
+}
+
+/// A sheet of the `crumple` preset lying flat on its floor, 20 x 30, with contact on (or off).
+SimParams flatCrumple(bool contact, std::vector<std::string> sets = {}) {
+  sets.insert(sets.begin(), {"cols=20", "rows=30", "tilt=90", "pins=none", "wind=off",
+                             contact ? "contact_factor=0.5" : "contact_factor=0"});
+  SimParams p = preset(std::string("crumple"), sets);
+  p.top_y = p.floor_y + 0.5f * p.spacing;
+  return p;
+}
+
+/// The most intersecting pairs of triangles seen every `every` ticks of `ticks` ticks of `text`.
+uint64_t mostPairs(const SimParams& p, const std::string& text, int ticks, int every, uint32_t threads = 2) {
+  CpuOptions o;
+  o.threads = threads;
+  CpuSolver solver(o);
+  Simulation sim(p, solver);
+  sim.setScript(script(text.c_str()));
+  uint64_t most = 0;
+  for (int t = 0; t < ticks; t += every) {
+    const SimState s = run(sim, every);
+    most = std::max(most, intersectingPairs(s.pos, s.triangles, s.triangle_count).pairs);
+  }
+  return most;
+}
+
+/// A crumple at a hand's speed: the middle of the flat sheet is snatched up (a third of the sheet's
+/// length in a twelfth of a second) as the hand closes, swung round in circles and let go.
+std::string fastCrumple(const SimParams& p, const SimState& flat) {
+  const uint32_t middle = (p.rows / 2) * p.cols + p.cols / 2;
+  const vec3 m(flat.pos[middle]);
+  const float length = float(p.rows - 1) * p.spacing;
+  std::string text = "0 grab particle " + std::to_string(middle) + "\n";
+  char line[160];
+  for (int t = 1; t <= 5; ++t) {
+    std::snprintf(line, sizeof(line), "%d move %.6f %.6f %.6f\n%d squeeze %.6f\n", t, m.x,
+                  m.y + length * 0.07f * float(t), m.z, t, 0.2f * float(t));
+    text += line;
+  }
+  for (int t = 6; t < 40; ++t) {
+    const float a = 0.35f * float(t - 6);
+    std::snprintf(line, sizeof(line), "%d move %.6f %.6f %.6f\n", t, m.x + 0.14f * length * std::cos(a),
+                  m.y + length * (0.35f - 0.09f * std::sin(a)), m.z + 0.14f * length * std::sin(a));
+    text += line;
+  }
+  return text + "40 release\n";
+}
+
+TEST(Contact, AFastCrumpleNeverPassesTheSheetThroughItself) {
+  const SimParams on = flatCrumple(true), off = flatCrumple(false);
+  CpuSolver solver;
+  Simulation sim(on, solver);
+  const std::string text = fastCrumple(on, run(sim, 0));
+  const uint64_t without = mostPairs(off, text, 80, 5), with = mostPairs(on, text, 80, 5);
+  std::printf("fast crumple: %llu intersecting pairs at most without contact, %llu with\n", (unsigned long long)without,
+              (unsigned long long)with);
+  EXPECT_GT(without, 0u); // the scene does pass the repulsion's sheet through itself
+  EXPECT_EQ(with, 0u);
+}
+
+TEST(Contact, AFastFoldAndAYankNeverPassTheSheetThroughItself) {
+  // A corner carried across the sheet in a quarter of a second and pressed down, then yanked away
+  // hard enough to tear
+  const SimParams p = flatCrumple(true);
+  CpuSolver solver;
+  Simulation sim(p, solver);
+  const SimState flat = run(sim, 0);
+  const vec3 far(flat.pos[p.cols * p.rows - 1]);
+  std::string text = "0 grab particle 0\n";
+  char line[160];
+  const vec3 from(flat.pos[0]);
+  for (int t = 1; t <= 15; ++t) {
+    const float f = float(t) / 15.0f;
+    const vec3 q = from + (far - from) * f + vec3(0.0f, 0.5f * std::sin(3.14159265f * f), 0.0f);
+    std::snprintf(line, sizeof(line), "%d move %.6f %.6f %.6f\n", t, q.x, q.y, q.z);
+    text += line;
+  }
+  for (int t = 1; t <= 10; ++t) {
+    const vec3 q = far + vec3(0.0f, 0.3f * float(t), -0.6f * float(t));
+    std::snprintf(line, sizeof(line), "%d move %.6f %.6f %.6f\n", 30 + t, q.x, q.y, q.z);
+    text += line;
+  }
+  text += "41 release\n";
+  const uint64_t without = mostPairs(flatCrumple(false), text, 90, 5), with = mostPairs(p, text, 90, 5);
+  std::printf("fold and yank: %llu intersecting pairs at most without contact, %llu with\n",
+              (unsigned long long)without, (unsigned long long)with);
+  EXPECT_GT(without, 0u);
+  EXPECT_EQ(with, 0u);
+}
+
+TEST(Contact, TheHandCrumplesItIntoABallWithoutPassingItThroughItself) {
+  // The middle lifted (half a second), the hand closing round it (half a second), holding, lowering
+  // it to the floor and letting go
+  const SimParams p = flatCrumple(true);
+  CpuSolver solver;
+  Simulation sim(p, solver);
+  const SimState flat = run(sim, 0);
+  const uint32_t middle = (p.rows / 2) * p.cols + p.cols / 2;
+  const vec3 m(flat.pos[middle]);
+  const float lift = 0.3f * float(p.rows - 1) * p.spacing;
+  std::string text = "0 grab particle " + std::to_string(middle) + "\n";
+  char line[160];
+  for (int t = 1; t <= 30; ++t) {
+    std::snprintf(line, sizeof(line), "%d move %.6f %.6f %.6f\n", t, m.x, m.y + lift * float(t) / 30.0f, m.z);
+    text += line;
+  }
+  for (int t = 1; t <= 30; ++t) {
+    std::snprintf(line, sizeof(line), "%d squeeze %.6f\n", 30 + t, float(t) / 30.0f);
+    text += line;
+  }
+  for (int t = 1; t <= 30; ++t) {
+    std::snprintf(line, sizeof(line), "%d move %.6f %.6f %.6f\n", 90 + t, m.x, m.y + lift * (1.0f - float(t) / 30.0f),
+                  m.z);
+    text += line;
+  }
+  text += "121 release\n";
+  EXPECT_EQ(mostPairs(p, text, 180, 10), 0u);
+}
+
+TEST(Contact, TheBoundsDoNotDependOnTheThreadCount) {
+  const SimParams p = flatCrumple(true);
+  CpuSolver probe;
+  Simulation sim(p, probe);
+  const std::string text = fastCrumple(p, run(sim, 0));
+  CpuOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  two.min_chunk = 1; // split every loop
+  CpuSolver a(one), b(two);
+  Simulation sa(p, a), sb(p, b);
+  sa.setScript(script(text.c_str()));
+  sb.setScript(script(text.c_str()));
+  expectIdentical(run(sa, 30), run(sb, 30));
+}
+
+} // namespace
+} // namespace tender::test
