@@ -119,6 +119,23 @@ else
   echo "FAIL: the hand's example exited $?"; failures=$((failures + 1))
 fi
 
+# The fast crumple (examples/fast_crumple.txt, as its comment runs it): through itself without the
+# contact, never with it, and the stats count the contacts
+fast=(sim --backend cpu --preset crumple --set tilt=90 --set pins=none --set wind=off --set floor_y=-3
+  --set top_y=-2.925 --script "$(dirname "$0")/../../examples/fast_crumple.txt" --ticks 20)
+if "$T" "${fast[@]}" --stats "$tmp/loose.json" >/dev/null &&
+  "$T" "${fast[@]}" --set contact_factor=0.5 --stats "$tmp/contact.json" >/dev/null; then
+  python3 - "$tmp/loose.json" "$tmp/contact.json" <<'PY' || failures=$((failures + 1))
+import json, sys
+loose, contact = (json.load(open(f)) for f in sys.argv[1:3])
+assert loose["pairs"] > 0 and "contacts" not in loose, loose
+assert contact["pairs"] == 0 and contact["contacts"] > 0 and contact["nan_count"] == 0, contact
+print("ok: the fast crumple:", loose["pairs"], "pairs without contact, 0 with,", contact["contacts"], "contacts")
+PY
+else
+  echo "FAIL: the fast crumple's example exited $?"; failures=$((failures + 1))
+fi
+
 "$T" --help >/dev/null && "$T" --version | grep -q '^tender ' || { echo "FAIL: --help/--version"; failures=$((failures + 1)); }
 echo "$failures failed"
 [ "$failures" -eq 0 ]
