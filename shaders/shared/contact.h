@@ -16,7 +16,8 @@
 // a triangle or an edge passing an edge, so a sheet that starts a substep without crossing itself
 // ends it without. Pairs farther apart than r are not searched: they move at most 2 fraction r < r
 // towards each other. Particles held by a pin or the grab are moved by the user, not bounded.
-// Floats round: stepBound keeps every pair farther apart than a margin well above the rounding.
+// Floats round: stepBound keeps pairs from closing in on each other below a margin well above the
+// rounding.
 #ifndef SIM_CONTACT_H
 #define SIM_CONTACT_H
 #include "exact_math.h"
@@ -135,11 +136,15 @@ SIM_INLINE vec3 contactPush(vec4 x0, vec4 x1, vec4 x2, vec4 x3, ContactPair c, f
   return sep * simDiv((thickness - len) * wk, len * wsum);
 }
 
-/// The step bound of a particle whose nearest primitive is sqrt(nearest2) away (at most the
-/// contact radius): `fraction` of that distance less SIM_CONTACT_MARGIN x radius. Pairs then never
-/// come closer than the margin, which keeps them far above the rounding of the positions.
+/// The step bound of a particle whose nearest primitive is d = sqrt(nearest2) away (at most the
+/// contact radius): `fraction` of d less the margin m = SIM_CONTACT_MARGIN x radius, and never
+/// below a quarter of d. Pairs close in on the margin without reaching it while they are farther
+/// than 4/3 m, where the bound is all it is (the rounding of the positions is far below m);
+/// nearer, a pair still moves (never held still, so a push can part it), and comes no closer
+/// than 0.8 times its distance in a substep.
 SIM_INLINE float stepBound(float nearest2, float radius, float fraction) {
-  return fraction * max(simSqrt(nearest2) - SIM_CONTACT_MARGIN * radius, 0.0f);
+  float d = simSqrt(nearest2);
+  return fraction * max(d - SIM_CONTACT_MARGIN * radius, 0.25f * d);
 }
 
 /// Where a particle that moved from x0 to x this substep ends when its step may not exceed

@@ -136,9 +136,10 @@ bool trianglesIntersect(const glm::vec3 a[3], const glm::vec3 b[3]) {
 }
 
 IntersectionCount intersectingPairs(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles,
-                                    uint32_t count) {
+                                    uint32_t count, std::vector<uint8_t>* crossing) {
   IntersectionCount result;
   count = std::min<uint32_t>(count, uint32_t(triangles.size()));
+  if (crossing) crossing->assign(count, 0);
   std::vector<uint32_t> live; // triangles with finite corners on the sheet
   std::vector<Box> box(count);
   double extent = 0.0;
@@ -188,7 +189,9 @@ IntersectionCount intersectingPairs(const std::vector<glm::vec4>& pos, const std
     ++result.candidates;
     const glm::vec3 a[3] = {glm::vec3(pos[ti.x]), glm::vec3(pos[ti.y]), glm::vec3(pos[ti.z])};
     const glm::vec3 b[3] = {glm::vec3(pos[tj.x]), glm::vec3(pos[tj.y]), glm::vec3(pos[tj.z])};
-    if (trianglesIntersect(a, b)) ++result.pairs;
+    if (!trianglesIntersect(a, b)) return;
+    ++result.pairs;
+    if (crossing) (*crossing)[i] = (*crossing)[j] = 1;
   };
   for (auto& [key, list] : grid) {
     std::sort(list.begin(), list.end()); // a triangle once, even where two of its cells share a key

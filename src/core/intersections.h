@@ -26,8 +26,9 @@ struct IntersectionCount {
 };
 
 /// The intersecting pairs among the first `count` triangles (xyz: their particles) of a sheet at
-/// `pos`; pairs that share a particle are neighbours on the sheet and are not counted.
+/// `pos`; pairs that share a particle are neighbours on the sheet and are not counted. With
+/// `crossing`, also which triangles intersect another (1), by index.
 IntersectionCount intersectingPairs(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles,
-                                    uint32_t count);
+                                    uint32_t count, std::vector<uint8_t>* crossing = nullptr);
 
 } // namespace tender

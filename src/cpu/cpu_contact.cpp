@@ -6,6 +6,7 @@
 #include <cmath>
 #include <mutex>
 
+#include "core/intersections.h"
 #include "cpu_collision.h"
 #include "worker_pool.h"
 
@@ -109,41 +110,55 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   const uint32_t none = std::bit_cast<uint32_t>(r2);
   nearest2_.assign(n, lists_ ? none : 0u); // positions gone wrong (no lists): nothing moves
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
-  pool_.parallelFor(uint32_t(vf_.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
-    for (uint32_t k = begin; k < end; ++k) {
-      const uvec4 q = vf_[k];
-      const float d2 = pointTriangleDistance2(at(q.x), at(q.y), at(q.z), at(q.w));
-      if (!(d2 < r2)) continue;
-      for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], d2);
-    }
-  });
-  pool_.parallelFor(uint32_t(ee_.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
-    for (uint32_t k = begin; k < end; ++k) {
-      const uvec4 q = ee_[k];
-      const float d2 = segmentDistance2(at(q.x), at(q.y), at(q.z), at(q.w));
-      if (!(d2 < r2)) continue;
-      for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], d2);
-    }
-  });
+  auto vf = [](vec3 p, vec3 a, vec3 b, vec3 c) { return pointTriangle(p, a, b, c); };
+  auto ee = [](vec3 a, vec3 b, vec3 c, vec3 d) { return segmentSegment(a, b, c, d); };
+  // Each pair closer than r lowers the bounds of its four particles
+  auto nearest = [&](const std::vector<uvec4>& list, auto&& pair) {
+    pool_.parallelFor(uint32_t(list.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
+      for (uint32_t k = begin; k < end; ++k) {
+        const uvec4 q = list[k];
+        if (free_[q.x] | free_[q.y] | free_[q.z] | free_[q.w]) continue;
+        const float d2 = pair(at(q.x), at(q.y), at(q.z), at(q.w)).d2;
+        if (!(d2 < r2)) continue;
+        for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], d2);
+      }
+    });
+  };
+  // Where the sheet already crosses itself (the user forced it through: the grab is not bounded;
+  // or it started so), no bound can undo it and bounds would hold it there: the particles of the
+  // triangles that cross another are let free, and every pair with one of them is left out, so the
+  // sheet untangles there as the repulsion alone lets it. Only the unbounded can cross the sheet,
+  // so it is looked for when the lists are rebuilt (something moved a skin's part) and while it
+  // lasts.
+  if (!fresh || tangles_) {
+    free_.assign(n, 0);
+    tangles_ = intersectingPairs(pos, triangles, count, &crossing_).pairs > 0;
+    for (uint32_t t = 0; t < count && tangles_; ++t)
+      if (crossing_[t]) free_[triangles[t].x] = free_[triangles[t].y] = free_[triangles[t].z] = 1;
+  }
+  free_.resize(n, 0);
+  nearest(vf_, vf);
+  nearest(ee_, ee);
   // The pushes that part the pairs closer than the thickness, summed in the lists' order and
   // averaged over each particle's pushes (w: how many)
-  auto part = [&](const std::vector<uvec4>& list, auto&& nearest) {
+  auto part = [&](const std::vector<uvec4>& list, auto&& pair) {
     for (const uvec4 q : list) {
+      if (free_[q.x] | free_[q.y] | free_[q.z] | free_[q.w]) continue;
       const glm::vec4 x[4] = {pos[q.x], pos[q.y], pos[q.z], pos[q.w]};
-      const ContactPair c = nearest(vec3(x[0]), vec3(x[1]), vec3(x[2]), vec3(x[3]));
+      const ContactPair c = pair(vec3(x[0]), vec3(x[1]), vec3(x[2]), vec3(x[3]));
       if (!(c.d2 < thickness * thickness)) continue;
       for (uint32_t k = 0; k < 4; ++k)
         push[q[k]] += glm::vec4(contactPush(x[0], x[1], x[2], x[3], c, thickness, k), 1.0f);
     }
   };
-  part(vf_, [](vec3 p, vec3 a, vec3 b, vec3 c) { return pointTriangle(p, a, b, c); });
-  part(ee_, [](vec3 a, vec3 b, vec3 c, vec3 d) { return segmentSegment(a, b, c, d); });
+  part(vf_, vf);
+  part(ee_, ee);
   for (glm::vec4& d : push)
     if (d.w > 0.0f) d = glm::vec4(vec3(d) * (1.0f / d.w), 0.0f);
   uint64_t contacts = 0;
   for (uint32_t i = 0; i < n; ++i) {
     contacts += nearest2_[i] < none ? 1u : 0u;
-    bound[i] = stepBound(std::bit_cast<float>(nearest2_[i]), radius, fraction);
+    bound[i] = free_[i] ? INFINITY : stepBound(std::bit_cast<float>(nearest2_[i]), radius, fraction);
   }
   contacts_ = contacts;
 }
@@ -227,9 +242,9 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
 }
 
 uint64_t CpuContact::memoryBytes() const {
-  return capacityBytes(edges_) + capacityBytes(vf_) + capacityBytes(ee_) + capacityBytes(base_) + capacityBytes(lo_) +
-         capacityBytes(hi_) + capacityBytes(nearest2_) + capacityBytes(grid_.start) + capacityBytes(grid_.entry) +
-         capacityBytes(grid_.fill);
+  return capacityBytes(edges_) + capacityBytes(free_) + capacityBytes(crossing_) + capacityBytes(vf_) +
+         capacityBytes(ee_) + capacityBytes(base_) + capacityBytes(lo_) + capacityBytes(hi_) +
+         capacityBytes(nearest2_) + capacityBytes(grid_.start) + capacityBytes(grid_.entry) + capacityBytes(grid_.fill);
 }
 
 } // namespace tender

@@ -25,8 +25,11 @@ public:
   void computeBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                      float radius, float fraction, float thickness, std::vector<float>& bound,
                      std::vector<glm::vec4>& push);
-  /// Pairs of primitives (particle-triangle, edge-edge) closer than the radius at the last call.
+  /// Particles within the radius of a primitive at the last call.
   uint64_t contacts() const { return contacts_; }
+  /// True when the sheet crossed itself at the last call (the particles of the crossing triangles
+  /// went unbounded to untangle it).
+  bool crossedItself() const { return tangles_; }
   /// Forgets the edges (a new sheet or a reset).
   void invalidate() {
     edges_key_ = ~0ull;
@@ -54,6 +57,9 @@ private:
   std::vector<glm::uvec4> ee_;     ///< two edges' particles: pairs within radius + skin
   std::vector<glm::vec4> base_;    ///< where the particles were when the lists were built
   bool lists_ = false;             ///< the lists are usable
+  std::vector<uint8_t> free_;      ///< particles of triangles crossing another: not bounded
+  std::vector<uint8_t> crossing_;  ///< scratch: the triangles crossing another
+  bool tangles_ = false;           ///< the sheet crossed itself at the last call
   float list_radius_ = 0.0f;       ///< the contact radius they were built for
   std::vector<glm::uvec2> edges_;  ///< the sheet's edges, each once (a < b)
   uint64_t edges_key_ = ~0ull;     ///< the triangle count the edges were worked out for
