@@ -1,5 +1,5 @@
 // Penetration-free self-contact, shared by GLSL and C++: the distances between the sheet's
-// primitives and the bounded step of a particle (included by xpbd.h).
+// primitives and the bounded step of a particle (included at the end of xpbd.h, after VerletState).
 //
 // The guarantee (the conservative bound of Offset Geometric Contact, Chen et al. 2025): at the
 // start of a substep every particle v gets a bound b(v) = fraction x d(v), fraction < 1/2, where
@@ -154,6 +154,24 @@ SIM_INLINE vec3 boundedStep(vec3 x0, vec3 x, float bound) {
   float l2 = dot3(d, d);
   if (!(l2 > bound * bound)) return x;
   return x0 + d * simDiv(bound, simSqrt(l2));
+}
+
+/// A free particle's substep with contact (st: where it ends after the floor and its previous
+/// position; x0: where it started; push: contactPush's average over its pairs): the push moves it
+/// without speeding it up, then the step is cut to `bound` (boundedStep). A step cut short keeps the
+/// particle's speed at most, along the step it made: the contact never adds energy.
+SIM_INLINE VerletState contactStep(VerletState st, vec3 x0, vec3 push, float bound) {
+  vec3 p = vec3(st.position) + push, q = vec3(st.previous) + push;
+  vec3 x = boundedStep(x0, p, bound);
+  if (x != p) {
+    vec3 step = x - x0, v = p - q;
+    float s2 = dot3(step, step), v2 = dot3(v, v);
+    q = s2 > v2 ? x - step * simDiv(simSqrt(v2), simSqrt(s2)) : x0;
+  }
+  VerletState r;
+  r.position = vec4(x, st.position.w);
+  r.previous = vec4(q, st.previous.w);
+  return r;
 }
 
 #endif

@@ -180,13 +180,8 @@ void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
     for (uint32_t i = begin; i < end; ++i) {
       const vec3 d = collide ? collision_.delta(i) : vec3(0.0f);
       VerletState st = floorParticle(pos[i], prev[i], d, u.flags, u.floor_y, u.restitution, u.friction);
-      if (contact && st.position.w > 0.0f && !(placed && i == u.grab_index)) {
-        const vec3 x0 = vec3(start_[i]), x = boundedStep(x0, vec3(st.position) + vec3(push_[i]), bound_[i]);
-        if (x != vec3(st.position)) {
-          st.position = vec4(x, st.position.w);
-          st.previous = vec4(x0, st.position.w); // the velocity of the step it made
-        }
-      }
+      if (contact && st.position.w > 0.0f && !(placed && i == u.grab_index))
+        st = contactStep(st, vec3(start_[i]), vec3(push_[i]), bound_[i]);
       pos[i] = st.position;
       prev[i] = st.previous;
     }
