@@ -81,7 +81,7 @@ void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3
 }
 
 void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
-                               float radius, float fraction, float thickness, std::vector<float>& bound,
+                               float radius, float fraction, float thickness, bool forced, std::vector<float>& bound,
                                std::vector<glm::vec4>& push) {
   const uint32_t n = uint32_t(pos.size());
   bound.resize(n);
@@ -101,7 +101,8 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   const float r = radius, r2 = r * r, skin = kSkin * radius;
   // The pair lists hold every pair that can be closer than r while no particle is skin / 2 or more
   // from where it was when they were built
-  bool fresh = lists_ && list_radius_ == radius && base_.size() == n;
+  const bool listed = lists_ && list_radius_ == radius && base_.size() == n;
+  bool fresh = listed;
   for (uint32_t i = 0; fresh && i < n; ++i) {
     const vec3 d = vec3(pos[i]) - vec3(base_[i]);
     fresh = dot3(d, d) < 0.25f * skin * skin;
@@ -127,10 +128,10 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   // Where the sheet already crosses itself (the user forced it through: the grab is not bounded;
   // or it started so), no bound can undo it and bounds would hold it there: the particles of the
   // triangles that cross another are let free, and every pair with one of them is left out, so the
-  // sheet untangles there as the repulsion alone lets it. Only the unbounded can cross the sheet,
-  // so it is looked for when the lists are rebuilt (something moved a skin's part) and while it
-  // lasts.
-  if (!fresh || tangles_) {
+  // sheet untangles there as the repulsion alone lets it. Only what is not bounded can cross the
+  // sheet, so it is looked for when contact starts (lists built anew), when the lists are rebuilt
+  // after the user moved something (`forced`), and while it lasts.
+  if (tangles_ || (!fresh && (forced || !listed))) {
     free_.assign(n, 0);
     tangles_ = intersectingPairs(pos, triangles, count, &crossing_).pairs > 0;
     for (uint32_t t = 0; t < count && tangles_; ++t)

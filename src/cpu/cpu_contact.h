@@ -20,10 +20,11 @@ public:
   /// The step bound of each particle at `pos` (xyz; w inverse mass) of the sheet made of the
   /// first `count` triangles of `triangles` (xyz: their particles) for contact radius `radius`,
   /// into `bound`, and in `push` the push that parts the pairs closer than `thickness`
-  /// (contactPush, averaged over a particle's pairs). The edges are worked out again when the
-  /// triangles change (a tear).
+  /// (contactPush, averaged over a particle's pairs). `forced`: the user moved a particle without
+  /// a bound since the last call (the grab), which may have pulled the sheet through itself. The
+  /// edges are worked out again when the triangles change (a tear).
   void computeBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
-                     float radius, float fraction, float thickness, std::vector<float>& bound,
+                     float radius, float fraction, float thickness, bool forced, std::vector<float>& bound,
                      std::vector<glm::vec4>& push);
   /// Particles within the radius of a primitive at the last call.
   uint64_t contacts() const { return contacts_; }
