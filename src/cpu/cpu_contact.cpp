@@ -113,15 +113,18 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
   auto vf = [](vec3 p, vec3 a, vec3 b, vec3 c) { return pointTriangle(p, a, b, c); };
   auto ee = [](vec3 a, vec3 b, vec3 c, vec3 d) { return segmentSegment(a, b, c, d); };
-  // Each pair closer than r lowers the bounds of its four particles
-  auto nearest = [&](const std::vector<uvec4>& list, auto&& pair) {
+  // Each pair's nearest points (kept for the pushes); a pair closer than r lowers the bounds of
+  // its four particles
+  auto nearest = [&](const std::vector<uvec4>& list, std::vector<ContactPair>& found, auto&& pair) {
+    found.resize(list.size());
     pool_.parallelFor(uint32_t(list.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
       for (uint32_t k = begin; k < end; ++k) {
         const uvec4 q = list[k];
+        found[k].d2 = INFINITY;
         if (free_[q.x] | free_[q.y] | free_[q.z] | free_[q.w]) continue;
-        const float d2 = pair(at(q.x), at(q.y), at(q.z), at(q.w)).d2;
-        if (!(d2 < r2)) continue;
-        for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], d2);
+        found[k] = pair(at(q.x), at(q.y), at(q.z), at(q.w));
+        if (!(found[k].d2 < r2)) continue;
+        for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], found[k].d2);
       }
     });
   };
@@ -138,22 +141,22 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
       if (crossing_[t]) free_[triangles[t].x] = free_[triangles[t].y] = free_[triangles[t].z] = 1;
   }
   free_.resize(n, 0);
-  nearest(vf_, vf);
-  nearest(ee_, ee);
+  nearest(vf_, vf_near_, vf);
+  nearest(ee_, ee_near_, ee);
   // The pushes that part the pairs closer than the thickness, summed in the lists' order and
   // averaged over each particle's pushes (w: how many)
-  auto part = [&](const std::vector<uvec4>& list, auto&& pair) {
-    for (const uvec4 q : list) {
-      if (free_[q.x] | free_[q.y] | free_[q.z] | free_[q.w]) continue;
-      const glm::vec4 x[4] = {pos[q.x], pos[q.y], pos[q.z], pos[q.w]};
-      const ContactPair c = pair(vec3(x[0]), vec3(x[1]), vec3(x[2]), vec3(x[3]));
+  auto part = [&](const std::vector<uvec4>& list, const std::vector<ContactPair>& found) {
+    for (size_t e = 0; e < list.size(); ++e) {
+      const uvec4 q = list[e];
+      const ContactPair& c = found[e];
       if (!(c.d2 < thickness * thickness)) continue;
+      const glm::vec4 x[4] = {pos[q.x], pos[q.y], pos[q.z], pos[q.w]};
       for (uint32_t k = 0; k < 4; ++k)
         push[q[k]] += glm::vec4(contactPush(x[0], x[1], x[2], x[3], c, thickness, k), 1.0f);
     }
   };
-  part(vf_, vf);
-  part(ee_, ee);
+  part(vf_, vf_near_);
+  part(ee_, ee_near_);
   for (glm::vec4& d : push)
     if (d.w > 0.0f) d = glm::vec4(vec3(d) * (1.0f / d.w), 0.0f);
   uint64_t contacts = 0;

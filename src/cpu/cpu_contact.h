@@ -54,18 +54,19 @@ private:
                   float radius);
 
   WorkerPool& pool_;
-  std::vector<glm::uvec4> vf_;     ///< particle, then the triangle's three: pairs within radius + skin
-  std::vector<glm::uvec4> ee_;     ///< two edges' particles: pairs within radius + skin
-  std::vector<glm::vec4> base_;    ///< where the particles were when the lists were built
-  bool lists_ = false;             ///< the lists are usable
-  std::vector<uint8_t> free_;      ///< particles of triangles crossing another: not bounded
-  std::vector<uint8_t> crossing_;  ///< scratch: the triangles crossing another
-  bool tangles_ = false;           ///< the sheet crossed itself at the last call
-  float list_radius_ = 0.0f;       ///< the contact radius they were built for
-  std::vector<glm::uvec2> edges_;  ///< the sheet's edges, each once (a < b)
-  uint64_t edges_key_ = ~0ull;     ///< the triangle count the edges were worked out for
-  std::vector<glm::vec3> lo_, hi_; ///< scratch: the boxes of the triangles, then of the edges
-  std::vector<uint32_t> nearest2_; ///< the bits of each particle's smallest squared distance
+  std::vector<glm::uvec4> vf_; ///< particle, then the triangle's three: pairs within radius + skin
+  std::vector<shaderio::ContactPair> vf_near_, ee_near_; ///< scratch: the lists' nearest points
+  std::vector<glm::uvec4> ee_;                           ///< two edges' particles: pairs within radius + skin
+  std::vector<glm::vec4> base_;                          ///< where the particles were when the lists were built
+  bool lists_ = false;                                   ///< the lists are usable
+  std::vector<uint8_t> free_;                            ///< particles of triangles crossing another: not bounded
+  std::vector<uint8_t> crossing_;                        ///< scratch: the triangles crossing another
+  bool tangles_ = false;                                 ///< the sheet crossed itself at the last call
+  float list_radius_ = 0.0f;                             ///< the contact radius they were built for
+  std::vector<glm::uvec2> edges_;                        ///< the sheet's edges, each once (a < b)
+  uint64_t edges_key_ = ~0ull;                           ///< the triangle count the edges were worked out for
+  std::vector<glm::vec3> lo_, hi_;                       ///< scratch: the boxes of the triangles, then of the edges
+  std::vector<uint32_t> nearest2_;                       ///< the bits of each particle's smallest squared distance
   Grid grid_;
   uint64_t contacts_ = 0;
 };
