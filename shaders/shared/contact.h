@@ -174,4 +174,48 @@ SIM_INLINE VerletState contactStep(VerletState st, vec3 x0, vec3 push, float bou
   return r;
 }
 
+/// Six times the signed volume of the tetrahedron a, b, c, d: positive when d lies on the side of
+/// the triangle a, b, c that (b - a) x (c - a) points to.
+SIM_INLINE float orient3(vec3 a, vec3 b, vec3 c, vec3 d) { return dot3(cross3(b - a, c - a), d - a); }
+
+/// True when the segment p-q passes through the triangle a, b, c: its ends strictly on either side
+/// of the triangle's plane and its line strictly inside the triangle's three edges.
+SIM_INLINE bool segmentCrossesTriangle(vec3 p, vec3 q, vec3 a, vec3 b, vec3 c) {
+  float sp = orient3(a, b, c, p), sq = orient3(a, b, c, q);
+  if (!((sp > 0.0f && sq < 0.0f) || (sp < 0.0f && sq > 0.0f))) return false;
+  float e0 = orient3(p, q, a, b), e1 = orient3(p, q, b, c), e2 = orient3(p, q, c, a);
+  return (e0 > 0.0f && e1 > 0.0f && e2 > 0.0f) || (e0 < 0.0f && e1 < 0.0f && e2 < 0.0f);
+}
+
+/// True when the triangles a0, a1, a2 and b0, b1, b2 cross: an edge of one passes through the
+/// other (two triangles that cut each other do so along a segment whose ends are such crossings).
+/// In floats, the same bits on every device: it says which triangles untangle (`free` particles),
+/// not whether the sheet is whole; the outside judge (core/intersections.h) is exact.
+SIM_INLINE bool trianglesCross(vec3 a0, vec3 a1, vec3 a2, vec3 b0, vec3 b1, vec3 b2) {
+  return segmentCrossesTriangle(a0, a1, b0, b1, b2) || segmentCrossesTriangle(a1, a2, b0, b1, b2) ||
+         segmentCrossesTriangle(a2, a0, b0, b1, b2) || segmentCrossesTriangle(b0, b1, a0, a1, a2) ||
+         segmentCrossesTriangle(b1, b2, a0, a1, a2) || segmentCrossesTriangle(b2, b0, a0, a1, a2);
+}
+
+/// A pair's push on one particle in fixed point (`scale`: SimUniforms::contact.w units per unit of
+/// length), clamped to +-SIM_CONTACT_FIXED_MAX: integers sum to the same bits in any order, so a
+/// particle's pushes need no fixed order (atomic adds on the GPU).
+SIM_INLINE ivec3 contactFixed(vec3 push, float scale) {
+  return ivec3(roundEven(clamp(push * scale, vec3(-SIM_CONTACT_FIXED_MAX), vec3(SIM_CONTACT_FIXED_MAX))));
+}
+
+/// The average of a particle's pushes from their fixed-point sum (xyz) and count (w).
+SIM_INLINE vec3 contactAverage(ivec4 sum, float scale) {
+  return sum.w > 0 ? vec3(sum.x, sum.y, sum.z) * simDiv(1.0f, scale * float(sum.w)) : vec3(0.0f);
+}
+
+/// True when triangle t (particles tri) is looked at for crossing the sheet this substep: every
+/// triangle when the check is `all`, else those that hold a particle that moved unbounded (one
+/// the grab holds or held last tick, `grab_now` and `grab_last`, or one let free in the last
+/// substep, `was_free`). Only unbounded motion can carry a triangle through another.
+SIM_INLINE bool crossingChecked(bool all, uvec3 tri, uint grab_now, uint grab_last, bool was_free) {
+  return all || was_free || tri.x == grab_now || tri.y == grab_now || tri.z == grab_now || tri.x == grab_last ||
+         tri.y == grab_last || tri.z == grab_last;
+}
+
 #endif

@@ -40,6 +40,7 @@ inline uint atomicAdd(SharedWords::Word word, uint value) { return atomicAdd(*wo
 #include "xpbd.h"
 
 static_assert(sizeof(Constraint) == 16);
+static_assert(sizeof(ContactParticle) == 64);
 static_assert(sizeof(SimPush) == 16);
 static_assert(sizeof(Counters) == 80);
 static_assert(sizeof(FusedPush) == 16);
@@ -57,6 +58,7 @@ static_assert(offsetof(SimUniforms, air) == 112);
 static_assert(offsetof(SimUniforms, hinge) == 128);
 static_assert(offsetof(SimUniforms, hand) == 160);
 static_assert(offsetof(SimUniforms, contact) == 192);
-static_assert(offsetof(SimUniforms, wind) == 208);
-static_assert(sizeof(SimUniforms) == 208 + 4 * 16 * SIM_MAX_SUBSTEPS);
+static_assert(offsetof(SimUniforms, contact_check) == 208);
+static_assert(offsetof(SimUniforms, wind) == 240);
+static_assert(sizeof(SimUniforms) == 240 + 4 * 16 * SIM_MAX_SUBSTEPS);
 } // namespace shaderio

@@ -72,21 +72,31 @@
 #define SIM_BIND_HASH_ARGS 28
 // Per hinge (HingeState): its plastic rest angle, the yield its hardening added, its XPBD multiplier
 #define SIM_BIND_HINGES 29
+// Penetration-free contact (contact.h, the contact_* passes): the sheet's edges, each once (uvec4:
+// its particles a < b, then the ids of the one or two triangles that hold it, SIM_NONE for none),
+// sorted by (a, b)
+#define SIM_BIND_CONTACT_EDGES 30
+// Per particle (ContactParticle): where it starts the substep, its bound and push, its nearest
+// distance and whether it is free, its pushes in fixed point
+#define SIM_BIND_CONTACT 31
+// The contact grid's words: SIM_CONTACT_HEADER words (ContactHeader), then a crossing flag per
+// triangle slot, then the grid's entries (SIM_CONTACT_CELLS_PER_BOX per triangle and edge at most)
+#define SIM_BIND_CONTACT_GRID 32
 // A fleet's shaders (tick_batch.comp, and the per-colour passes built with SIM_BATCH_PASS) reach
 // each binding's buffer through its device address instead: the fleet's table (BatchArgs.table)
 // holds, per binding (SIM_BIND_*; the uniforms are one SimUniforms per sheet), the address of sheet
 // 0's slice and the bytes from one sheet's slice to the next, then at SIM_BATCH_QUEUE the list of
 // sheets to tick (one per workgroup of tick_batch, one per workgroup z of a pass)
-#define SIM_BATCH_QUEUE 30
+#define SIM_BATCH_QUEUE 33
 // ... and at SIM_BATCH_ARGS the indirect arguments of the per-colour passes of a batch (uvec4 each,
 // workgroup counts x, y and z = the batch's sheets): the full grids of the hash passes (a slot per
 // pass, as SIM_BIND_HASH_ARGS) and of the compaction, which the host writes, then per substep the
 // live ones, which the host writes with x = 0 and a sheet's candidates_decide (hash) or tear_mark
 // (compaction) raises to the full grid's x when that sheet needs them: a pass that no sheet of the
 // batch needs runs zero workgroups, as it does for a sheet alone
-#define SIM_BATCH_ARGS 31
+#define SIM_BATCH_ARGS 34
 // Entries of the fleet's table
-#define SIM_BATCH_ENTRIES 32
+#define SIM_BATCH_ENTRIES 35
 #define SIM_BATCH_ARGS_FULL_COMPACT SIM_HASH_DISPATCHES
 #define SIM_BATCH_ARGS_LIVE_HASH (SIM_BATCH_ARGS_FULL_COMPACT + 1u)
 #define SIM_BATCH_ARGS_LIVE_COMPACT (SIM_BATCH_ARGS_LIVE_HASH + SIM_MAX_SUBSTEPS * SIM_HASH_DISPATCHES)
@@ -187,6 +197,21 @@
 #define SIM_CONTACT_MARGIN 1e-3f
 // The thickness of the contact, per unit of contact radius: closer pairs are pushed apart
 #define SIM_CONTACT_THICKNESS 0.5f
+// Fixed-point units of the contact pushes per unit of thickness (contactFixed), and the largest
+// magnitude of one pair's push on one particle in those units: 2^11 such pushes sum within an int
+#define SIM_CONTACT_FIXED 262144.0f
+#define SIM_CONTACT_FIXED_MAX 1048576.0f
+// SimUniforms::contact_check.x: every triangle is checked for crossing the sheet in the first substep
+#define SIM_CONTACT_CHECK_ALL 1u
+// Ticks between two checks of every triangle for crossing the sheet (and the first tick with contact on)
+#define SIM_CONTACT_AUDIT_TICKS 60u
+// The GPU's contact grid: words of its header in SIM_BIND_CONTACT_GRID (x the bits of the longest
+// live edge's squared length, y 1 when a triangle crosses another, z the particles in contact), and
+// the cells a box spans at most (cells as wide as the longest edge and the contact diameter, with
+// room to spare for rounding: two a side)
+#define SIM_CONTACT_HEADER 4u
+#define SIM_CONTACT_CELLS_PER_BOX 8u
+#define SIM_CONTACT_CELL_ROOM 1.01f
 
 // Largest workgroup count in X of one dispatch; bigger grids spill into Y
 #define SIM_MAX_GROUPS_X 65535u

@@ -23,6 +23,14 @@
 //   per_invocation  elements one invocation covers
 //   batched         1: a fleet runs it once for the whole batch (built again with SIM_BATCH_PASS)
 #define SIM_KERNELS(X)                                                                                                 \
+  X(contact_begin, SIM, 1, 0)                                                                                          \
+  X(contact_clear, SIM, 1, 0)                                                                                          \
+  X(contact_count, SIM, 1, 0)                                                                                          \
+  X(contact_scatter, SIM, 1, 0)                                                                                        \
+  X(contact_cross, SIM, 1, 0)                                                                                          \
+  X(contact_free, SIM, 1, 0)                                                                                           \
+  X(contact_near, SIM, 1, 0)                                                                                           \
+  X(contact_bound, SIM, 1, 0)                                                                                          \
   X(air, SIM, 1, 1)                                                                                                    \
   X(integrate, SIM, 1, 1)                                                                                              \
   X(project, SIM, 1, 1)                                                                                                \
@@ -69,14 +77,27 @@
 //   elements  what it covers and its push constants: PARTICLES, COLOUR (the stage's colour),
 //             HINGES, CONSTRAINTS, ONE (one invocation), HASH_ARGS (one invocation, the hash's
 //             arguments), HASH_CELLS and TEAR_SLOTS (a scan of the hash's cells or of the
-//             compaction's slots), INDIRECT (the grid's arguments, no push constants)
+//             compaction's slots), INDIRECT (the grid's arguments, no push constants); contact's:
+//             TRIANGLES (the triangle slots), CONTACT_SLOTS (whatever its clearing covers),
+//             CONTACT_BOXES (triangle slots, then edges), CONTACT_QUERIES (particles, then
+//             edges), CONTACT_CELLS (a scan of its grid's buckets)
 //   grid      Threads (from the elements), Hash (the live hash arguments candidates_decide
 //             copies) or Compaction (the tear compaction's arguments): gpu::Grid
 //   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)
-//   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases) or
-//             CONSTRAINTS (the sheet has constraints)
+//   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases),
+//             CONSTRAINTS (the sheet has constraints) or CONTACT (contact is on: the sheet alone
+//             runs it so far, not a fleet nor the fused tick)
 //   category  its timestamp category (gpu::PassCategory k<category>)
 #define SIM_DISPATCHES(X)                                                                                              \
+  X(integrate, contact_begin, ONE, Threads, TICK, CONTACT, Contact)                                                    \
+  X(integrate, contact_clear, CONTACT_SLOTS, Threads, TICK, CONTACT, Contact)                                          \
+  X(integrate, contact_count, CONTACT_BOXES, Threads, TICK, CONTACT, Contact)                                          \
+  X(integrate, scan, CONTACT_CELLS, Threads, TICK, CONTACT, Contact)                                                   \
+  X(integrate, contact_scatter, CONTACT_BOXES, Threads, TICK, CONTACT, Contact)                                        \
+  X(integrate, contact_cross, TRIANGLES, Threads, TICK, CONTACT, Contact)                                              \
+  X(integrate, contact_free, TRIANGLES, Threads, TICK, CONTACT, Contact)                                               \
+  X(integrate, contact_near, CONTACT_QUERIES, Threads, TICK, CONTACT, Contact)                                         \
+  X(integrate, contact_bound, PARTICLES, Threads, TICK, CONTACT, Contact)                                              \
   X(integrate, air, PARTICLES, Threads, AIR, AIR, Integrate)                                                           \
   X(integrate, integrate, PARTICLES, Threads, TICK, ALWAYS, Integrate)                                                 \
   X(project, project, COLOUR, Threads, ITERATION, ALWAYS, Project)                                                     \

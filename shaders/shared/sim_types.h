@@ -61,8 +61,15 @@ struct SimUniforms {
   vec4 hand_motion; // xyz the hand's displacement per substep
   // Penetration-free contact (contact.h): x the contact radius (0: off), y the part of its distance
   // to the nearest primitive a particle may move in a substep (below 1/2), z the thickness (closer
-  // pairs are pushed apart)
+  // pairs are pushed apart), w the fixed-point units of a push per unit of length (contactFixed)
   vec4 contact;
+  // Which triangles are checked for crossing the sheet (crossingChecked): x SIM_CONTACT_CHECK_*, y
+  // the particle the grab holds this tick, z the one it held the last tick (or SIM_NONE)
+  uvec4 contact_check;
+  // The GPU's contact grid (the solver fills it in): x the hash mask of each half, y the scratch offset of its
+  // bucket counts (then starts), z of its bucket fills, w the sheet's edges (SIM_BIND_CONTACT_EDGES);
+  // the triangles' buckets are the first x + 1, the edges' the next x + 1
+  uvec4 contact_grid;
 
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
   vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet
@@ -168,6 +175,17 @@ struct PickPush {
   uint pad0;
   uint pad1;
   uint pad2;
+};
+
+/// A particle's contact in a substep (SIM_BIND_CONTACT): xyz where it starts the substep and w its
+/// step bound (contact_bound); xyz the push that parts its close pairs (contactAverage); x the
+/// bits of its squared distance to the nearest primitive, y 1 when it is free (its triangle crosses
+/// another) and 2 when it was in the last substep; its pushes in fixed point and their count.
+struct ContactParticle {
+  vec4 start;
+  vec4 push;
+  uvec4 state;
+  ivec4 sum;
 };
 
 #endif

@@ -56,6 +56,7 @@ layout(buffer_reference, std430, buffer_reference_align = 8) SIM_COHERENT buffer
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer Vec2Ref { vec2 v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) SIM_COHERENT buffer UintRef { uint v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) SIM_COHERENT buffer ConstraintRef { Constraint v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) SIM_COHERENT buffer ContactRef { ContactParticle v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) SIM_COHERENT buffer CountersRef { Counters v; };
 UniformsRef g_u;
 Vec4Ref g_pos, g_prev, g_rest_pos, g_delta, g_candidate_base, g_reset_from;
@@ -66,7 +67,9 @@ Vec4Ref g_hinges;
 UintRef g_adj_offsets, g_adj_list, g_adj_mask, g_cell_count, g_cell_start, g_cell_particles, g_particle_cell, g_torn,
     g_scratch, g_cell_scatter, g_candidates;
 Uvec4Ref g_triangles, g_compact_tmp, g_cell_pos;
-Uvec4Ref g_hash_args;
+Uvec4Ref g_hash_args, g_contact_edges;
+UintRef g_contact_grid;
+ContactRef g_contact;
 CountersRef g_counters;
 
 // The sheet workgroup `group` ticks, and the address of its slice of binding `binding`.
@@ -108,6 +111,9 @@ void bindSheet(uint sheet) {
   g_hash_args = Uvec4Ref(batchSlice(SIM_BIND_HASH_ARGS, sheet));
   g_counters = CountersRef(batchSlice(SIM_BIND_COUNTERS, sheet));
   g_hinges = Vec4Ref(batchSlice(SIM_BIND_HINGES, sheet));
+  g_contact_edges = Uvec4Ref(batchSlice(SIM_BIND_CONTACT_EDGES, sheet));
+  g_contact = ContactRef(batchSlice(SIM_BIND_CONTACT, sheet));
+  g_contact_grid = UintRef(batchSlice(SIM_BIND_CONTACT_GRID, sheet));
 }
 #define u g_u.v
 #define pos g_pos.v
@@ -137,6 +143,9 @@ void bindSheet(uint sheet) {
 #define hash_args g_hash_args.v
 #define counters g_counters.v
 #define hinges g_hinges.v
+#define contact_edges g_contact_edges.v
+#define contact_particles g_contact.v
+#define contact_grid g_contact_grid.v
 #else
 layout(std140, set = 0, binding = SIM_BIND_UNIFORMS) uniform UniformsBlock { SimUniforms u; };
 layout(std430, set = 0, binding = SIM_BIND_POS) SIM_COHERENT buffer PosBuffer { vec4 pos[]; };
@@ -180,6 +189,12 @@ layout(std430, set = 0, binding = SIM_BIND_CANDIDATE_BASE) SIM_COHERENT buffer C
 // Indirect arguments of the separate hash passes: SIM_HASH_DISPATCHES live, then as many full
 layout(std430, set = 0, binding = SIM_BIND_HASH_ARGS) SIM_COHERENT buffer HashArgsBuffer { uvec4 hash_args[]; };
 layout(std430, set = 0, binding = SIM_BIND_HINGES) SIM_COHERENT buffer HingeBuffer { HingeState hinges[]; };
+// Penetration-free contact (contact.glsl)
+layout(std430, set = 0, binding = SIM_BIND_CONTACT_EDGES) readonly buffer ContactEdgeBuffer { uvec4 contact_edges[]; };
+layout(std430, set = 0, binding = SIM_BIND_CONTACT) SIM_COHERENT buffer ContactBuffer {
+  ContactParticle contact_particles[];
+};
+layout(std430, set = 0, binding = SIM_BIND_CONTACT_GRID) SIM_COHERENT buffer ContactGridBuffer { uint contact_grid[]; };
 
 #endif
 

@@ -69,7 +69,8 @@ void Simulation::rebuild(const SimParams& p) {
   solver_.upload(topo_);
   wind_ = params_.wind;
   pins_ = params_.pins != PinMode::None;
-  grab_index_ = release_index_ = SIM_NONE;
+  grab_index_ = release_index_ = contact_grab_last_ = SIM_NONE;
+  contact_on_last_ = false;
   reset_frame_ = 0;
   physics_ticks_ = 0;
   accumulator_ = 0.0;
@@ -175,7 +176,8 @@ void Simulation::squeeze(float closure) {
 }
 
 void Simulation::reset() {
-  grab_index_ = release_index_ = SIM_NONE;
+  grab_index_ = release_index_ = contact_grab_last_ = SIM_NONE;
+  contact_on_last_ = false;
   closure_ = 0.0f;
   pins_ = params_.pins != PinMode::None; // the start: pinned as the preset is
   solver_.beginReset();
@@ -214,7 +216,10 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   u.reset_active = reset_frame_ > 0 ? 1u : 0u;
   u.reset_alpha = reset_frame_ > 0 ? float(SIM_RESET_FRAMES - reset_frame_ + 1) / float(SIM_RESET_FRAMES) : 0.0f;
   u.iterations = p.iterations;
-  u.contact = glm::vec4(p.contactRadius(), SIM_CONTACT_FRACTION, p.contactRadius() * SIM_CONTACT_THICKNESS, 0.0f);
+  if (p.contactRadius() > 0.0f) {
+    const float thickness = p.contactRadius() * SIM_CONTACT_THICKNESS;
+    u.contact = glm::vec4(p.contactRadius(), SIM_CONTACT_FRACTION, thickness, SIM_CONTACT_FIXED / thickness);
+  }
 
   const double t0 = double(physics_ticks_) / double(p.tick_hz);
   const double dts = 1.0 / (double(p.tick_hz) * p.substeps);
@@ -245,6 +250,12 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
       u.grab_prev[s] = glm::vec4(prev, 1.0f);
     }
   }
+  // Every triangle is checked for crossing the sheet in the first substep of a tick when contact
+  // starts (a new sheet, a reset, the key turned on) and once every SIM_CONTACT_AUDIT_TICKS ticks;
+  // otherwise those the grab moves and those already crossing (crossingChecked in contact.h)
+  const bool audit = !contact_on_last_ || physics_ticks_ % SIM_CONTACT_AUDIT_TICKS == 0;
+  if (u.contact.x > 0.0f)
+    u.contact_check = glm::uvec4(audit ? SIM_CONTACT_CHECK_ALL : 0u, u.grab_index, contact_grab_last_, 0u);
   return u;
 }
 
@@ -252,6 +263,8 @@ void Simulation::runPhysicsTick() {
   last_uniforms_ = makeUniforms();
   solver_.tick(last_uniforms_);
   ++physics_ticks_;
+  contact_grab_last_ = last_uniforms_.grab_index;
+  contact_on_last_ = last_uniforms_.contact.x > 0.0f;
   release_index_ = SIM_NONE;
   if (grab_index_ != SIM_NONE) {
     grab_from_ = grab_to_;

@@ -6,7 +6,8 @@
 #include <cmath>
 #include <mutex>
 
-#include "core/intersections.h"
+#include <glm/gtx/component_wise.hpp>
+
 #include "cpu_collision.h"
 #include "worker_pool.h"
 
@@ -81,11 +82,12 @@ void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3
 }
 
 void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
-                               float radius, float fraction, float thickness, bool forced, std::vector<float>& bound,
+                               const SimUniforms& u, uint32_t s, std::vector<float>& bound,
                                std::vector<glm::vec4>& push) {
   const uint32_t n = uint32_t(pos.size());
+  const float radius = u.contact.x, thickness = u.contact.z, scale = u.contact.w;
   bound.resize(n);
-  push.assign(n, glm::vec4(0.0f));
+  push.resize(n);
   if (edges_key_ != count) {
     edges_.clear();
     for (uint32_t t = 0; t < count; ++t) {
@@ -100,71 +102,123 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   }
   const float r = radius, r2 = r * r, skin = kSkin * radius;
   // The pair lists hold every pair that can be closer than r while no particle is skin / 2 or more
-  // from where it was when they were built
-  const bool listed = lists_ && list_radius_ == radius && base_.size() == n;
-  bool fresh = listed;
+  // from where it was when they were built (a little less, so that rounding cannot lose a pair)
+  bool fresh = lists_ && list_radius_ == radius && base_.size() == n;
+  const float travel = 0.45f * skin;
   for (uint32_t i = 0; fresh && i < n; ++i) {
     const vec3 d = vec3(pos[i]) - vec3(base_[i]);
-    fresh = dot3(d, d) < 0.25f * skin * skin;
+    fresh = dot3(d, d) < travel * travel;
   }
   if (!fresh) buildLists(pos, triangles, count, radius);
+  findCrossings(pos, triangles, count, s == 0 && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u, u.contact_check.y,
+                u.contact_check.z);
   const uint32_t none = std::bit_cast<uint32_t>(r2);
   nearest2_.assign(n, lists_ ? none : 0u); // positions gone wrong (no lists): nothing moves
+  sums_.assign(n, glm::ivec4(0));
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
   auto vf = [](vec3 p, vec3 a, vec3 b, vec3 c) { return pointTriangle(p, a, b, c); };
   auto ee = [](vec3 a, vec3 b, vec3 c, vec3 d) { return segmentSegment(a, b, c, d); };
-  // Each pair's nearest points (kept for the pushes); a pair closer than r lowers the bounds of
-  // its four particles
-  auto nearest = [&](const std::vector<uvec4>& list, std::vector<ContactPair>& found, auto&& pair) {
-    found.resize(list.size());
+  // Each pair closer than r lowers the bounds of its four particles; one closer than the thickness
+  // pushes them apart (contactPush), summed in fixed point. Pairs with a free particle are left
+  // out: the sheet untangles there as the repulsion alone lets it. Neither the minimum nor the
+  // integer sums depend on the order of the pairs, so nothing depends on the thread count.
+  auto nearest = [&](const std::vector<uvec4>& list, auto&& pair) {
     pool_.parallelFor(uint32_t(list.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
       for (uint32_t k = begin; k < end; ++k) {
         const uvec4 q = list[k];
-        found[k].d2 = INFINITY;
         if (free_[q.x] | free_[q.y] | free_[q.z] | free_[q.w]) continue;
-        found[k] = pair(at(q.x), at(q.y), at(q.z), at(q.w));
-        if (!(found[k].d2 < r2)) continue;
-        for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], found[k].d2);
+        const ContactPair c = pair(at(q.x), at(q.y), at(q.z), at(q.w));
+        if (!(c.d2 < r2)) continue;
+        for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], c.d2);
+        if (!(c.d2 < thickness * thickness)) continue;
+        const glm::vec4 x[4] = {pos[q.x], pos[q.y], pos[q.z], pos[q.w]};
+        for (uint32_t j = 0; j < 4; ++j) {
+          const glm::ivec3 f = contactFixed(contactPush(x[0], x[1], x[2], x[3], c, thickness, j), scale);
+          int32_t* sum = &sums_[q[j]].x;
+          for (uint32_t a = 0; a < 3; ++a) std::atomic_ref<int32_t>(sum[a]).fetch_add(f[a], std::memory_order_relaxed);
+          std::atomic_ref<int32_t>(sum[3]).fetch_add(1, std::memory_order_relaxed);
+        }
       }
     });
   };
-  // Where the sheet already crosses itself (the user forced it through: the grab is not bounded;
-  // or it started so), no bound can undo it and bounds would hold it there: the particles of the
-  // triangles that cross another are let free, and every pair with one of them is left out, so the
-  // sheet untangles there as the repulsion alone lets it. Only what is not bounded can cross the
-  // sheet, so it is looked for when contact starts (lists built anew), when the lists are rebuilt
-  // after the user moved something (`forced`), and while it lasts.
-  if (tangles_ || (!fresh && (forced || !listed))) {
-    free_.assign(n, 0);
-    tangles_ = intersectingPairs(pos, triangles, count, &crossing_).pairs > 0;
-    for (uint32_t t = 0; t < count && tangles_; ++t)
-      if (crossing_[t]) free_[triangles[t].x] = free_[triangles[t].y] = free_[triangles[t].z] = 1;
-  }
-  free_.resize(n, 0);
-  nearest(vf_, vf_near_, vf);
-  nearest(ee_, ee_near_, ee);
-  // The pushes that part the pairs closer than the thickness, summed in the lists' order and
-  // averaged over each particle's pushes (w: how many)
-  auto part = [&](const std::vector<uvec4>& list, const std::vector<ContactPair>& found) {
-    for (size_t e = 0; e < list.size(); ++e) {
-      const uvec4 q = list[e];
-      const ContactPair& c = found[e];
-      if (!(c.d2 < thickness * thickness)) continue;
-      const glm::vec4 x[4] = {pos[q.x], pos[q.y], pos[q.z], pos[q.w]};
-      for (uint32_t k = 0; k < 4; ++k)
-        push[q[k]] += glm::vec4(contactPush(x[0], x[1], x[2], x[3], c, thickness, k), 1.0f);
-    }
-  };
-  part(vf_, vf_near_);
-  part(ee_, ee_near_);
-  for (glm::vec4& d : push)
-    if (d.w > 0.0f) d = glm::vec4(vec3(d) * (1.0f / d.w), 0.0f);
+  nearest(vf_, vf);
+  nearest(ee_, ee);
   uint64_t contacts = 0;
   for (uint32_t i = 0; i < n; ++i) {
     contacts += nearest2_[i] < none ? 1u : 0u;
-    bound[i] = free_[i] ? INFINITY : stepBound(std::bit_cast<float>(nearest2_[i]), radius, fraction);
+    bound[i] = free_[i] ? INFINITY : stepBound(std::bit_cast<float>(nearest2_[i]), radius, u.contact.y);
+    push[i] = glm::vec4(contactAverage(sums_[i], scale), 0.0f);
   }
   contacts_ = contacts;
+}
+
+void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
+                               bool all, uint32_t grab_now, uint32_t grab_last) {
+  // Where the sheet already crosses itself (the user forced it through: the grab is not bounded;
+  // or it started so), no bound can undo it and bounds would hold it there: the particles of the
+  // triangles that cross another go free until it untangles. Only what moved unbounded can have
+  // crossed the sheet: the triangles crossingChecked names are tested against every triangle
+  // whose box meets theirs.
+  const uint32_t n = uint32_t(pos.size());
+  was_free_.swap(free_);
+  was_free_.resize(n, 0);
+  free_.assign(n, 0);
+  tangles_ = false;
+  checked_.clear();
+  if (!lists_) return; // positions gone wrong: nothing is looked for (nothing moves)
+  for (uint32_t t = 0; t < count; ++t) {
+    const uvec4 tri = triangles[t];
+    if (crossingChecked(all, uvec3(tri), grab_now, grab_last,
+                        (was_free_[tri.x] | was_free_[tri.y] | was_free_[tri.z]) != 0))
+      checked_.push_back(t);
+  }
+  if (checked_.empty()) return;
+  auto at = [&](uint32_t i) { return vec3(pos[i]); };
+  lo_.resize(count);
+  hi_.resize(count);
+  float longest = 0.0f;
+  for (uint32_t t = 0; t < count; ++t) {
+    const vec3 a = at(triangles[t].x), b = at(triangles[t].y), c = at(triangles[t].z);
+    lo_[t] = glm::min(a, glm::min(b, c));
+    hi_[t] = glm::max(a, glm::max(b, c));
+    longest = std::max(longest, glm::compMax(hi_[t] - lo_[t]));
+  }
+  crossing_.assign(count, 0);
+  auto test = [&](uint32_t t, uint32_t o) {
+    const uvec4 a = triangles[t], b = triangles[o];
+    if (a.x == b.x || a.x == b.y || a.x == b.z || a.y == b.x || a.y == b.y || a.y == b.z || a.z == b.x || a.z == b.y ||
+        a.z == b.z)
+      return;
+    if (trianglesCross(at(a.x), at(a.y), at(a.z), at(b.x), at(b.y), at(b.z))) {
+      std::atomic_ref<uint8_t>(crossing_[t]).store(1, std::memory_order_relaxed);
+      std::atomic_ref<uint8_t>(crossing_[o]).store(1, std::memory_order_relaxed);
+    }
+  };
+  const uint32_t checked = uint32_t(checked_.size());
+  const float inv_cell = 1.0f / (1.01f * longest);
+  if (uint64_t(checked) * count > kBruteForceTests && std::isfinite(inv_cell) && longest < 1e30f) {
+    // Many: through a grid of the triangles' boxes
+    grid_.build(lo_, hi_, inv_cell);
+    pool_.parallelFor(checked, kGrainCollide, [&](uint32_t begin, uint32_t end) {
+      for (uint32_t k = begin; k < end; ++k) {
+        const uint32_t t = checked_[k];
+        visitBox(grid_, lo_, hi_, lo_[t], hi_[t], inv_cell, [&](uint32_t o) { test(t, o); });
+      }
+    });
+  } else {
+    // A few (the grab's): against every triangle
+    for (uint32_t t : checked_)
+      for (uint32_t o = 0; o < count; ++o) {
+        const vec3 lo = lo_[t], hi = hi_[t], elo = lo_[o], ehi = hi_[o];
+        if (lo.x <= ehi.x && elo.x <= hi.x && lo.y <= ehi.y && elo.y <= hi.y && lo.z <= ehi.z && elo.z <= hi.z)
+          test(t, o);
+      }
+  }
+  for (uint32_t t = 0; t < count; ++t)
+    if (crossing_[t]) {
+      free_[triangles[t].x] = free_[triangles[t].y] = free_[triangles[t].z] = 1;
+      tangles_ = true;
+    }
 }
 
 void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
@@ -237,18 +291,22 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
     const std::lock_guard<std::mutex> lock(merge);
     ee_.insert(ee_.end(), found.begin(), found.end());
   });
-  // The same lists whatever the threads' order
+  // The same lists whatever the threads' order, each pair once (a box may meet another in two
+  // cells of one bucket)
   std::sort(vf_.begin(), vf_.end(), less4);
   std::sort(ee_.begin(), ee_.end(), less4);
+  vf_.erase(std::unique(vf_.begin(), vf_.end()), vf_.end());
+  ee_.erase(std::unique(ee_.begin(), ee_.end()), ee_.end());
   base_ = pos;
   list_radius_ = radius;
   lists_ = true;
 }
 
 uint64_t CpuContact::memoryBytes() const {
-  return capacityBytes(edges_) + capacityBytes(free_) + capacityBytes(crossing_) + capacityBytes(vf_) +
-         capacityBytes(ee_) + capacityBytes(base_) + capacityBytes(lo_) + capacityBytes(hi_) +
-         capacityBytes(nearest2_) + capacityBytes(grid_.start) + capacityBytes(grid_.entry) + capacityBytes(grid_.fill);
+  return capacityBytes(edges_) + capacityBytes(free_) + capacityBytes(was_free_) + capacityBytes(checked_) +
+         capacityBytes(sums_) + capacityBytes(crossing_) + capacityBytes(vf_) + capacityBytes(ee_) +
+         capacityBytes(base_) + capacityBytes(lo_) + capacityBytes(hi_) + capacityBytes(nearest2_) +
+         capacityBytes(grid_.start) + capacityBytes(grid_.entry) + capacityBytes(grid_.fill);
 }
 
 } // namespace tender

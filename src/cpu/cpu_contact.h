@@ -17,14 +17,13 @@ class CpuContact {
 public:
   explicit CpuContact(WorkerPool& pool) : pool_(pool) {}
 
-  /// The step bound of each particle at `pos` (xyz; w inverse mass) of the sheet made of the
-  /// first `count` triangles of `triangles` (xyz: their particles) for contact radius `radius`,
-  /// into `bound`, and in `push` the push that parts the pairs closer than `thickness`
-  /// (contactPush, averaged over a particle's pairs). `forced`: the user moved a particle without
-  /// a bound since the last call (the grab), which may have pulled the sheet through itself. The
-  /// edges are worked out again when the triangles change (a tear).
+  /// The step bound of each particle at `pos` (xyz; w inverse mass) in substep `s`, of the sheet
+  /// made of the first `count` triangles of `triangles` (xyz: their particles), for the contact of
+  /// `u` (SimUniforms::contact, contact_check), into `bound`, and in `push` the push that parts
+  /// the pairs closer than the thickness (contactPush, averaged over a particle's pairs). The edges
+  /// are worked out again when the triangles change (a tear).
   void computeBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
-                     float radius, float fraction, float thickness, bool forced, std::vector<float>& bound,
+                     const shaderio::SimUniforms& u, uint32_t s, std::vector<float>& bound,
                      std::vector<glm::vec4>& push);
   /// Particles within the radius of a primitive at the last call.
   uint64_t contacts() const { return contacts_; }
@@ -35,6 +34,8 @@ public:
   void invalidate() {
     edges_key_ = ~0ull;
     lists_ = false;
+    free_.clear();
+    tangles_ = false;
   }
   uint64_t memoryBytes() const;
 
@@ -49,24 +50,32 @@ private:
 
   /// The pair lists' skin, per unit of contact radius
   static constexpr float kSkin = 0.25f;
+  /// Box tests below which the crossing check tests its triangles against every triangle
+  static constexpr uint64_t kBruteForceTests = 1u << 20;
+  /// Sets free_ to the particles of the triangles that cross another, among the pairs with one of
+  /// the triangles crossingChecked names (contact.h); the last call's free_ is was_free_.
+  void findCrossings(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
+                     bool all, uint32_t grab_now, uint32_t grab_last);
   /// Lists the particle-triangle and edge-edge pairs closer than radius + skin at `pos`.
   void buildLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                   float radius);
 
   WorkerPool& pool_;
-  std::vector<glm::uvec4> vf_; ///< particle, then the triangle's three: pairs within radius + skin
-  std::vector<shaderio::ContactPair> vf_near_, ee_near_; ///< scratch: the lists' nearest points
-  std::vector<glm::uvec4> ee_;                           ///< two edges' particles: pairs within radius + skin
-  std::vector<glm::vec4> base_;                          ///< where the particles were when the lists were built
-  bool lists_ = false;                                   ///< the lists are usable
-  std::vector<uint8_t> free_;                            ///< particles of triangles crossing another: not bounded
-  std::vector<uint8_t> crossing_;                        ///< scratch: the triangles crossing another
-  bool tangles_ = false;                                 ///< the sheet crossed itself at the last call
-  float list_radius_ = 0.0f;                             ///< the contact radius they were built for
-  std::vector<glm::uvec2> edges_;                        ///< the sheet's edges, each once (a < b)
-  uint64_t edges_key_ = ~0ull;                           ///< the triangle count the edges were worked out for
-  std::vector<glm::vec3> lo_, hi_;                       ///< scratch: the boxes of the triangles, then of the edges
-  std::vector<uint32_t> nearest2_;                       ///< the bits of each particle's smallest squared distance
+  std::vector<glm::uvec4> vf_;     ///< particle, then the triangle's three: pairs within radius + skin
+  std::vector<glm::ivec4> sums_;   ///< each particle's pushes in fixed point, and their count
+  std::vector<glm::uvec4> ee_;     ///< two edges' particles: pairs within radius + skin
+  std::vector<glm::vec4> base_;    ///< where the particles were when the lists were built
+  bool lists_ = false;             ///< the lists are usable
+  std::vector<uint8_t> free_;      ///< particles of triangles crossing another: not bounded
+  std::vector<uint8_t> was_free_;  ///< free_ of the last call
+  std::vector<uint32_t> checked_;  ///< scratch: the triangles checked for crossing
+  std::vector<uint8_t> crossing_;  ///< scratch: the triangles crossing another
+  bool tangles_ = false;           ///< the sheet crossed itself at the last call
+  float list_radius_ = 0.0f;       ///< the contact radius they were built for
+  std::vector<glm::uvec2> edges_;  ///< the sheet's edges, each once (a < b)
+  uint64_t edges_key_ = ~0ull;     ///< the triangle count the edges were worked out for
+  std::vector<glm::vec3> lo_, hi_; ///< scratch: the boxes of the triangles, then of the edges
+  std::vector<uint32_t> nearest2_; ///< the bits of each particle's smallest squared distance
   Grid grid_;
   uint64_t contacts_ = 0;
 };

@@ -324,15 +324,8 @@ void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint3
   switch (stage) {
   case PassKind::integrate:
     contact_on_ = u.contact.x > 0.0f;
-    if (contact_on_) {
-      // The grab moves its particle without a bound: in this substep and the last, it may have
-      // pulled the sheet through itself
-      const bool placed = u.grab_index != SIM_NONE && u.grab_target[s].w > 0.5f;
-      const bool forced = placed || grab_placed_;
-      grab_placed_ = placed;
-      // The step bounds of the substep, from where the particles start it
-      contact_.computeBounds(pos_, triangles_, triangle_count_, u.contact.x, u.contact.y, u.contact.z, forced, bound_,
-                             push_);
+    if (contact_on_) { // the step bounds of the substep, from where the particles start it
+      contact_.computeBounds(pos_, triangles_, triangle_count_, u, s, bound_, push_);
       start_ = pos_;
     }
     integrate(u, s); // the air, then damped Verlet, gravity, wind; pins and the grab hold

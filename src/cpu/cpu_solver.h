@@ -135,7 +135,6 @@ private:
   CpuCollision collision_;
   CpuContact contact_;
   bool contact_on_ = false;      ///< the last tick had contact on
-  bool grab_placed_ = false;     ///< the grab moved its particle in the last substep
   std::vector<glm::vec4> start_; ///< with contact on: the positions at the start of the substep
   std::vector<float> bound_;     ///< with contact on: each particle's step bound in this substep
   std::vector<glm::vec4> push_;  ///< with contact on: the push parting its contacts (CpuContact)

@@ -97,6 +97,60 @@ void GpuSolver::upload(const SheetTopology& topo) {
   uploaded_ = true;
 }
 
+void GpuSolver::sizeContact() {
+  VkDevice dev = ctx_.device();
+  finish();
+  VK_CHECK(vkDeviceWaitIdle(dev));
+  const VkDeviceSize max_range = ctx_.properties().limits.maxStorageBufferRange;
+  const SheetLayout sizes = SheetLayout::of(topo_, max_range, true);
+  StartData start;
+  std::vector<BindingSpec> table = sheetBindings(topo_, sizes, start, false);
+  std::erase_if(table, [](const BindingSpec& b) {
+    return b.binding != SIM_BIND_SCRATCH && b.binding != SIM_BIND_CONTACT_EDGES && b.binding != SIM_BIND_CONTACT &&
+           b.binding != SIM_BIND_CONTACT_GRID;
+  });
+  for (const BindingSpec& b : table)
+    if (b.bytes > max_range)
+      throw std::runtime_error("contact on a " + std::to_string(topo_.cols) + "x" + std::to_string(topo_.rows) +
+                               " sheet needs a " + std::to_string(b.bytes >> 20) + " MiB buffer (binding " +
+                               std::to_string(b.binding) + "); this Vulkan device binds at most " +
+                               std::to_string(max_range >> 20) + " MiB (try a smaller sheet or --backend cpu)");
+  // New buffers for these bindings (their old ones are idle), their start contents, and the
+  // descriptor set pointed at them: the command buffers recorded over it are recorded again
+  std::vector<Buffer> made;
+  try {
+    for (const BindingSpec& b : table) made.push_back(ctx_.createDeviceBuffer(b.bytes, kStorageUsage));
+  } catch (const VulkanError&) {
+    for (Buffer& b : made) ctx_.destroyBuffer(b);
+    throw std::runtime_error("contact on a " + std::to_string(topo_.cols) + "x" + std::to_string(topo_.rows) +
+                             " sheet does not fit the memory of Vulkan device " + ctx_.info().name +
+                             " (try a smaller sheet or --backend cpu)");
+  }
+  for (size_t k = 0; k < table.size(); ++k) {
+    ctx_.destroyBuffer(buf_[table[k].binding]);
+    buf_[table[k].binding] = made[k];
+  }
+  uploadStart(ctx_, place(), table);
+  layout_sizes_ = sizes;
+  std::array<VkDescriptorBufferInfo, kSheetBindingCount> where{};
+  for (uint32_t b = 0; b < kBindingCount; ++b)
+    where[b] = {buf_[b].buffer, 0, b == SIM_BIND_UNIFORMS ? VkDeviceSize(sizeof(SimUniforms)) : VK_WHOLE_SIZE};
+  writeSheetSet(dev, set_, where);
+  for (uint32_t s = 0; s < kInFlight; ++s) {
+    in_flight_[s].recorded.reset();
+    recordReset(in_flight_[s], s);
+  }
+  recordNormals();
+}
+
+int64_t GpuSolver::contacts() const {
+  if (!last_contact_ || !layout_sizes_.contact) return -1;
+  const_cast<GpuSolver*>(this)->finish();
+  uint32_t header[SIM_CONTACT_HEADER];
+  ctx_.download(buf_[SIM_BIND_CONTACT_GRID], header, sizeof(header));
+  return header[2];
+}
+
 SheetPlace GpuSolver::place() const {
   SheetPlace where;
   for (uint32_t b = 0; b < kBindingCount; ++b) {

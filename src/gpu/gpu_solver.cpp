@@ -130,11 +130,14 @@ void GpuSolver::collectTimes(const InFlight& flight) const {
 
 void requireNoContact(const SimUniforms& u) {
   if (u.contact.x > 0.0f)
-    throw std::runtime_error("contact_factor needs --backend cpu: the GPU solver has no penetration-free contact yet");
+    throw std::runtime_error("contact_factor needs a sheet alone on the GPU (or --backend cpu): a fleet has no "
+                             "penetration-free contact yet");
 }
 
 void GpuSolver::tick(const SimUniforms& u) {
-  requireNoContact(u);
+  const bool contact = u.contact.x > 0.0f;
+  if (contact && !layout_sizes_.contact) sizeContact();
+  last_contact_ = contact;
   const uint32_t index = next_in_flight_;
   next_in_flight_ = (next_in_flight_ + 1) % kInFlight;
   InFlight& flight = in_flight_[index];
@@ -142,6 +145,9 @@ void GpuSolver::tick(const SimUniforms& u) {
   waitFor(flight);
   SimUniforms gpu_u = u;
   if (usesCandidateLists()) gpu_u.flags |= SIM_FLAG_CANDIDATES;
+  if (contact)
+    gpu_u.contact_grid = glm::uvec4(layout_sizes_.contact_buckets / 2 - 1, layout_sizes_.contact_counts,
+                                    layout_sizes_.contact_fill, layout_sizes_.contact_edges);
   std::memcpy(static_cast<char*>(buf_[SIM_BIND_UNIFORMS].mapped) + index * uniform_stride_, &gpu_u, sizeof(gpu_u));
   if (u.reset_active) {
     ctx_.submit(flight.reset, flight.fence);
@@ -155,7 +161,8 @@ void GpuSolver::tick(const SimUniforms& u) {
                 usesFusedPath(u),
                 stop_after_,
                 (u.flags & SIM_FLAG_AIR) != 0u,
-                creasing(u.hinge.y, u.crease.y)};
+                creasing(u.hinge.y, u.crease.y),
+                contact};
   stop_after_ = SIM_NONE;
   if (flight.recorded != key) recordTick(flight, index, key);
   ctx_.submit(flight.tick, flight.fence);
@@ -249,8 +256,8 @@ PassTimes GpuSolver::passTimes() const {
     last_ms_[kNormals] = double(ts[1] - ts[0]) * ctx_.timestampPeriod() * 1e-6;
     normals_pending_ = false;
   }
-  static const char* kNames[kCategoryCount] = {"integrate", "project", "hash",    "collide",
-                                               "floor",     "tear",    "normals", "fused_tick"};
+  static const char* kNames[kCategoryCount] = {"contact", "integrate", "project", "hash",      "collide",
+                                               "floor",   "tear",      "normals", "fused_tick"};
   PassTimes t;
   for (int c = 0; c < kCategoryCount; ++c) t.ms.emplace_back(kNames[c], last_ms_[size_t(c)]);
   return t;
@@ -290,6 +297,7 @@ bool fusedTickFits(const SheetTopology& topo) {
 }
 
 bool fusedTickTakes(const SimUniforms& u, float spacing, float max_cell_spacings) {
+  if (u.contact.x > 0.0f) return false; // the contact passes run on the per-colour path
   if ((u.flags & SIM_FLAG_COLLISION) == 0u || max_cell_spacings < 0.0f) return true;
   return u.inv_cell * max_cell_spacings * spacing >= 1.0f;
 }

@@ -68,6 +68,7 @@ public:
 
   std::string name() const override { return "gpu"; }
   void upload(const SheetTopology& topo) override;
+  int64_t contacts() const override;
   void tick(const shaderio::SimUniforms& u) override;
   void beginReset() override;
   void computeNormals() override;
@@ -130,6 +131,7 @@ private:
     uint32_t stop = SIM_NONE; ///< last pass recorded (stopNextTickAfter)
     bool air = false;         ///< the air pass runs before integration (SIM_FLAG_AIR)
     bool crease = false;      ///< the crease pass runs after the projection (creasing)
+    bool contact = false;     ///< the contact passes run (SimUniforms::contact)
     bool operator==(const RecordKey&) const = default;
   };
   struct InFlight {
@@ -147,6 +149,9 @@ private:
   SheetPlace place() const;
   void createPipelines(FusedShape fused);
   void destroySheet();
+  /// Sizes the contact's buffers (a sheet made with contact off has a word in each) and the
+  /// scratch they share, once contact is turned on.
+  void sizeContact();
   void writeStaticUniforms();
   void recordTick(InFlight& flight, uint32_t index, const RecordKey& key);
   // PassSink: the passes of the per-colour path go to the tick being recorded (recording_)
@@ -195,6 +200,7 @@ private:
   VkFence normals_fence_ = VK_NULL_HANDLE;
   VkQueryPool normals_queries_ = VK_NULL_HANDLE;
   mutable bool normals_pending_ = false;
+  bool last_contact_ = false; ///< the last tick had contact on
   uint32_t query_capacity_ = 0;
   uint32_t dispatches_per_tick_ = 0;
   VkPipeline bound_ = VK_NULL_HANDLE; ///< pipeline bound while recording

@@ -3,6 +3,7 @@
 #include "gpu/sheet_buffers.h"
 
 #include <algorithm>
+#include <bit>
 #include <cstdlib>
 #include <cstring>
 
@@ -89,13 +90,44 @@ uint32_t scanSumsSize(uint32_t count) {
   return groups + (groups > 1 ? scanSumsSize(groups) : 0);
 }
 
-SheetLayout SheetLayout::of(const SheetTopology& topo, VkDeviceSize max_range) {
+std::vector<glm::uvec4> contactEdges(const SheetTopology& topo) {
+  std::vector<glm::uvec4> e;
+  e.reserve(3 * size_t(topo.triangleCount()));
+  for (const glm::uvec4& t : topo.triangles)
+    for (glm::uvec2 ab : {glm::uvec2(t.x, t.y), glm::uvec2(t.y, t.z), glm::uvec2(t.z, t.x)})
+      e.emplace_back(std::min(ab.x, ab.y), std::max(ab.x, ab.y), t.w, SIM_NONE);
+  std::sort(e.begin(), e.end(), [](glm::uvec4 a, glm::uvec4 b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  });
+  // An edge of two triangles: one entry, both ids
+  size_t w = 0;
+  for (size_t k = 0; k < e.size(); ++k)
+    if (w > 0 && e[w - 1].x == e[k].x && e[w - 1].y == e[k].y)
+      e[w - 1].w = e[k].z;
+    else
+      e[w++] = e[k];
+  e.resize(w);
+  return e;
+}
+
+SheetLayout SheetLayout::of(const SheetTopology& topo, VkDeviceSize max_range, bool contact) {
   SheetLayout l;
   l.tear_slots = topo.constraintCount() + topo.triangleCount() + 1;
   l.tear_sums = l.tear_slots;
   l.hash_sums = l.tear_sums + scanSumsSize(l.tear_slots);
   // Collision candidate lists, when the largest binding holds them
   l.candidates_fit = 4ull * SIM_CANDIDATE_STRIDE * topo.particleCount() <= max_range;
+  l.contact = contact;
+  if (contact) {
+    // Each edge once: V - E + F = 1 for a sheet in one piece with no hole, E = V + F - 1 at most
+    l.contact_edges = uint32_t(contactEdges(topo).size());
+    const uint32_t boxes = topo.triangleCount() + l.contact_edges;
+    l.contact_buckets = 2 * std::bit_ceil(std::max(boxes, 16u)); // two halves: triangles, edges
+    l.contact_counts = l.hash_sums + scanSumsSize(topo.hash_size);
+    l.contact_fill = l.contact_counts + l.contact_buckets + 1;
+    l.contact_sums = l.contact_fill + l.contact_buckets;
+    l.contact_words = SIM_CONTACT_HEADER + topo.triangleCount() + uint64_t(SIM_CONTACT_CELLS_PER_BOX) * boxes;
+  }
   return l;
 }
 
@@ -105,7 +137,9 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
   const uint32_t cells = topo.hash_size;
   // The fused tick's scans meet their per-invocation totals in the SIM_WG_FUSED slots after the
   // compaction slots (the per-colour passes' block sums, unused on that path).
-  const uint32_t scratch = std::max(layout.hash_sums + scanSumsSize(cells), layout.tear_slots + SIM_WG_FUSED);
+  const uint32_t scratch =
+      std::max({layout.hash_sums + scanSumsSize(cells), layout.tear_slots + SIM_WG_FUSED,
+                layout.contact ? layout.contact_sums + scanSumsSize(layout.contact_buckets + 1) : 0u});
   const VkDeviceSize list_bytes = layout.candidates_fit ? 4ull * SIM_CANDIDATE_STRIDE * n : 16,
                      list_base = layout.candidates_fit ? 16ull * n : 16;
 
@@ -116,6 +150,7 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
     d.normal.assign(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
     d.adj_mask = adjacencyMasks(topo);
   }
+  if (layout.contact) d.contact_edges = contactEdges(topo);
   d.last_start = n; // cell_start[T] = N, always
   d.colors.clear();
   for (const ColorRange& c : topo.colors) d.colors.emplace_back(c.first, c.count);
@@ -163,6 +198,11 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
       spec(SIM_BIND_HASH_ARGS, 16ull * 2 * SIM_HASH_DISPATCHES),
       // Interaction
       spec(SIM_BIND_PICK, sizeof(PickResult)),
+      // Contact (a word each while it is not sized): the edges, and what a reset clears
+      spec(SIM_BIND_CONTACT_EDGES, layout.contact ? bytesOf(d.contact_edges) : 16, d.contact_edges.data(),
+           bytesOf(d.contact_edges)),
+      spec(SIM_BIND_CONTACT, layout.contact ? sizeof(ContactParticle) * n : 16, nullptr, 0, kRestored),
+      spec(SIM_BIND_CONTACT_GRID, layout.contact ? 4ull * layout.contact_words : 16),
   };
 }
 

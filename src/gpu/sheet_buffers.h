@@ -19,8 +19,16 @@ struct SheetLayout {
   uint32_t tear_slots = 0;               ///< constraints + triangles + 1: the compaction's scan length
   uint32_t tear_sums = 0, hash_sums = 0; ///< scratch offsets of the per-block sums
   bool candidates_fit = false;           ///< the candidate-list buffer fits a binding of the device
-  /// The layout of a topology on a device that binds at most `max_range` bytes.
-  static SheetLayout of(const SheetTopology& topo, VkDeviceSize max_range);
+  /// Penetration-free contact: its buffers are sized (else one word each); the sheet's edges; the
+  /// contact grid's buckets (two halves of a power of two: the triangles', the edges'); the scratch offsets of the
+  /// buckets' counts (then starts, buckets + 1 of them), of their fills and of the counts' scan sums; the words of
+  /// SIM_BIND_CONTACT_GRID
+  bool contact = false;
+  uint32_t contact_edges = 0, contact_buckets = 0, contact_counts = 0, contact_fill = 0, contact_sums = 0;
+  uint64_t contact_words = 0;
+  /// The layout of a topology on a device that binds at most `max_range` bytes, with the contact's
+  /// buffers sized or not.
+  static SheetLayout of(const SheetTopology& topo, VkDeviceSize max_range, bool contact = false);
 };
 
 /// `v` rounded up to a multiple of `a`.
@@ -46,13 +54,14 @@ struct StartData {
   std::vector<glm::vec4> pos, normal;
   std::vector<uint32_t> adj_mask;
   std::vector<glm::uvec2> colors;
+  std::vector<glm::uvec4> contact_edges;
   uint32_t last_start = 0;
   shaderio::Counters counters{};
 };
 
 /// Bindings of a sheet's descriptor set: the uniforms (SIM_BIND_UNIFORMS, a dynamic uniform buffer)
-/// and every storage array, up to SIM_BIND_HINGES.
-constexpr uint32_t kSheetBindingCount = SIM_BIND_HINGES + 1;
+/// and every storage array, up to SIM_BIND_CONTACT_GRID.
+constexpr uint32_t kSheetBindingCount = SIM_BIND_CONTACT_GRID + 1;
 
 /// The layout of a sheet's descriptor set (kSheetBindingCount bindings).
 VkDescriptorSetLayout createSheetSetLayout(VkDevice dev);
@@ -63,6 +72,10 @@ VkDescriptorPool createSheetSetPool(VkDevice dev, uint32_t sets);
 /// Points `set`'s bindings at `where[binding]` (the uniforms take sizeof(SimUniforms)).
 void writeSheetSet(VkDevice dev, VkDescriptorSet set,
                    const std::array<VkDescriptorBufferInfo, kSheetBindingCount>& where);
+
+/// The sheet's edges, each once, sorted by their particles (SIM_BIND_CONTACT_EDGES): xy its
+/// particles a < b, zw the ids of the triangles that hold it (w SIM_NONE when only one does).
+std::vector<glm::uvec4> contactEdges(const SheetTopology& topo);
 
 /// Elements of the per-block sums of a scan of `count` elements (every level).
 uint32_t scanSumsSize(uint32_t count);

@@ -64,10 +64,15 @@ enum class Elements : uint8_t {
   HASH_ARGS,
   HASH_CELLS,
   TEAR_SLOTS,
-  INDIRECT
+  INDIRECT,
+  TRIANGLES,
+  CONTACT_SLOTS,
+  CONTACT_BOXES,
+  CONTACT_QUERIES,
+  CONTACT_CELLS
 };
 /// When a sheet records a dispatch (SIM_DISPATCHES' needs column).
-enum class Needs : uint8_t { ALWAYS, AIR, CREASE, CONSTRAINTS };
+enum class Needs : uint8_t { ALWAYS, AIR, CREASE, CONSTRAINTS, CONTACT };
 
 /// One row of SIM_DISPATCHES.
 struct Dispatch {
@@ -155,6 +160,28 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
   case Elements::INDIRECT:
     sink.pass(p, d.grid, 0, nullptr, 0, s, d.gate, 0);
     break;
+  case Elements::TRIANGLES:
+    record(sink, p, d.grid, topo.triangleCount(), SimPush{0, topo.triangleCount(), s, 0}, s, d.gate);
+    break;
+  case Elements::CONTACT_SLOTS: {
+    const uint32_t slots = std::max({n, sizes.contact_buckets + 1, topo.triangleCount(), sizes.contact_edges});
+    record(sink, p, d.grid, slots, SimPush{0, slots, s, 0}, s, d.gate);
+    break;
+  }
+  case Elements::CONTACT_BOXES: {
+    const uint32_t boxes = topo.triangleCount() + sizes.contact_edges;
+    record(sink, p, d.grid, boxes, SimPush{0, boxes, s, 0}, s, d.gate);
+    break;
+  }
+  case Elements::CONTACT_QUERIES: {
+    const uint32_t queries = n + sizes.contact_edges;
+    record(sink, p, d.grid, queries, SimPush{0, queries, s, 0}, s, d.gate);
+    break;
+  }
+  case Elements::CONTACT_CELLS:
+    recordScan(sink, pipes, SIM_SCAN_SCRATCH, sizes.contact_counts, sizes.contact_buckets + 1, sizes.contact_sums,
+               d.grid, s, d.gate);
+    return;
   }
   sink.barrier();
 }
@@ -180,7 +207,8 @@ bool recordSubstep(PassSink& sink, const SimPipelines& pipes, const SheetTopolog
         if (d.stage != stage) continue;
         const bool needed = d.needs == Needs::ALWAYS || (d.needs == Needs::AIR && plan.air) ||
                             (d.needs == Needs::CREASE && plan.crease && topo.hingeCount() > 0) ||
-                            (d.needs == Needs::CONSTRAINTS && has_constraints);
+                            (d.needs == Needs::CONSTRAINTS && has_constraints) ||
+                            (d.needs == Needs::CONTACT && plan.contact);
         if (needed) recordDispatch(sink, pipes, topo, sizes, d, s, k);
         if (k + 1 == passes && closesCategory(row)) sink.mark(d.category);
       }

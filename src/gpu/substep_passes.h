@@ -19,7 +19,18 @@ enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash };
 
 /// Timestamp categories of a tick, in Solver::passTimes() order (SIM_DISPATCHES' category column
 /// names the first six). kFused: the fused small-sheet tick, every pass in one dispatch.
-enum PassCategory : uint8_t { kIntegrate, kProject, kHash, kCollide, kFloor, kTear, kNormals, kFused, kCategoryCount };
+enum PassCategory : uint8_t {
+  kContact,
+  kIntegrate,
+  kProject,
+  kHash,
+  kCollide,
+  kFloor,
+  kTear,
+  kNormals,
+  kFused,
+  kCategoryCount
+};
 
 /// The full grid of `count` elements of `p`, with `sheets` workgroups in z: wider than
 /// SIM_MAX_GROUPS_X spills into y (the shaders linearise the group index).
@@ -87,6 +98,7 @@ struct SubstepPlan {
   bool air = false;
   uint32_t stop = SIM_NONE; ///< last pass to record (SIM_STAGES numbering; Solver::stopNextTickAfter)
   bool crease = false;      ///< the crease pass runs (creasing in xpbd.h)
+  bool contact = false;     ///< the contact passes run (SimUniforms::contact)
 };
 
 /// Timestamps a substep of the per-colour path records (one where each category ends).

@@ -58,7 +58,7 @@ if [ "$rc" -ne 0 ]; then
 fi
 if [ -f "$report" ]; then
   for check in environment devices gpu-tests render-tests diff-tender-hanging diff-tender-yank diff-crumple-hanging \
-    diff-crumple-yank bench fleet fleet-large; do
+    diff-crumple-yank diff-crumple-contact contact bench fleet fleet-large; do
     grep -q "^| $check | .* | pass | " "$report" || fail "report.md: check $check did not pass or is missing"
   done
   grep -q '^\*\*PASS\*\*' "$report" || fail "report.md does not say PASS"

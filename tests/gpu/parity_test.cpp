@@ -4,6 +4,7 @@
 #include <cstring>
 #include <set>
 
+#include "core/intersections.h"
 #include "core/stats.h"
 #include "cpu/cpu_solver.h"
 #include "gpu/gpu_solver.h"
@@ -198,6 +199,61 @@ TEST_F(Parity, TheHandCrumplesTheSameOnEveryPath) {
     EXPECT_TRUE(sameState(cpu, gpu)) << (fused ? "fused tick" : "per-colour passes");
     expectSameTopology(cpu, gpu);
   }
+}
+
+TEST_F(Parity, ContactIsTheSameOnTheGpu) {
+  // Penetration-free contact (the per-colour passes run it; the fused tick leaves it to them). The
+  // hanging sheet's bottom middle dragged up and back through the sheet with the particle repulsion
+  // alone, then contact turned on (the GPU sizes its buffers then) and the sheet let go: the
+  // particles of the crossing triangles go free, and the bounds, pushes and free particles hold the
+  // CPU's bits on the way out, as does the count of particles in contact.
+  const SimParams p = preset("crumple", {"cols=16", "rows=24"});
+  const uint32_t bottom = (p.rows - 1) * p.cols + p.cols / 2;
+  const float height = float(p.rows - 1) * p.spacing;
+  glm::vec3 b;
+  {
+    CpuSolver probe;
+    Simulation sim(p, probe);
+    b = glm::vec3(run(sim, 0).pos[bottom]);
+  }
+  std::string text = "0 grab particle " + std::to_string(bottom) + "\n";
+  char line[160];
+  auto path = [&](int t0, glm::vec3 from, glm::vec3 to, int ticks) {
+    for (int t = 1; t <= ticks; ++t) {
+      const glm::vec3 q = from + (to - from) * (float(t) / float(ticks));
+      std::snprintf(line, sizeof(line), "%d move %.6f %.6f %.6f\n", t0 + t, q.x, q.y, q.z);
+      text += line;
+    }
+  };
+  const glm::vec3 front = b + glm::vec3(0.0f, 0.05f * height, 0.8f), high = b + glm::vec3(0.0f, 0.7f * height, 0.8f);
+  path(0, b, front, 8);
+  path(8, front, high, 12);
+  path(20, high, high - glm::vec3(0.0f, 0.0f, 1.6f), 8);
+  text += "29 set contact_factor 0.5\n32 release\n";
+  gpu::GpuSolver gpu(ctx());
+  CpuSolver cpu(cpuOptionsLike(ctx()));
+  Simulation a(p, cpu), g(p, gpu);
+  a.setScript(script(text.c_str()));
+  g.setScript(script(text.c_str()));
+  const SimState forced = run(a, 29);
+  run(g, 29);
+  const uint32_t crossed = intersectingPairs(forced.pos, forced.triangles, forced.triangle_count).pairs;
+  const SimState cpu_end = run(a, 60), gpu_end = run(g, 60);
+  const uint32_t left = intersectingPairs(cpu_end.pos, cpu_end.triangles, cpu_end.triangle_count).pairs;
+  std::printf("contact: %u pairs crossing when it starts, %u a second later; %lld particles in contact\n", crossed,
+              left, static_cast<long long>(cpu.contacts()));
+  EXPECT_GT(crossed, 0u);
+  EXPECT_LT(left, crossed);
+  EXPECT_GT(cpu.contacts(), 0);
+  EXPECT_EQ(cpu.contacts(), gpu.contacts());
+  EXPECT_TRUE(sameState(cpu_end, gpu_end));
+
+  // A yank that tears the sheet with contact on from the start: torn triangles stop colliding at once
+  const SimParams yank = preset("tender", {"cols=12", "rows=16", "wind=off", "contact_factor=0.5"});
+  auto [torn_cpu, torn_gpu] = runBoth(ctx(), yank, "0 grab particle 191\n1 move 6 -4 5\n", 10);
+  EXPECT_GT(tornIds(torn_cpu).size(), 0u);
+  EXPECT_TRUE(sameState(torn_cpu, torn_gpu));
+  expectSameTopology(torn_cpu, torn_gpu);
 }
 
 TEST_F(Parity, ScriptedYankTearsTheSameConstraints) {

@@ -34,9 +34,11 @@ std::vector<Instruction> instructions(std::span<const uint32_t> code) {
   return out;
 }
 
-// GLSL.std.450 instructions that are exact on every device: abs, floor, min/max/clamp, bit scans,
-// sign, and Sqrt (only ever the approximation that exact_math.h corrects).
-const std::set<uint32_t> kExactExtInsts = {3 /*Trunc*/,
+// GLSL.std.450 instructions that are exact on every device: abs, floor, roundEven (the contact's
+// fixed point; not Round, whose halves the device chooses), min/max/clamp, bit scans, sign, and Sqrt
+// (only ever the approximation that exact_math.h corrects).
+const std::set<uint32_t> kExactExtInsts = {2 /*RoundEven*/,
+                                           3 /*Trunc*/,
                                            4 /*FAbs*/,
                                            5 /*SAbs*/,
                                            6 /*FSign*/,

@@ -78,16 +78,20 @@ SheetLayout layoutOf(const SheetTopology& topo) { return SheetLayout::of(topo, V
 
 TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   const SheetTopology topo = tenderSheet(8, 6);
-  const SheetLayout sizes = layoutOf(topo);
+  const SheetLayout sizes = SheetLayout::of(topo, VkDeviceSize(1) << 27, true);
   const SimPipelines pipes = fakePipelines();
   RecordingSink sink(pipes);
   uint32_t pass = 0;
-  const SubstepPlan plan{2, true, true, SIM_NONE, true};
+  const SubstepPlan plan{2, true, true, SIM_NONE, true, true};
   EXPECT_FALSE(recordSubstep(sink, pipes, topo, sizes, plan, 0, pass));
   EXPECT_EQ(pass, shaderio::passesPerSubstep(2, topo.colorCount(), true));
   EXPECT_EQ(sink.barriers_due, 0u); // every pass is followed by a barrier
 
-  std::vector<std::string> expected = {"air", "integrate"};
+  // The contact's grid (its buckets' scan one block here), then the integration
+  ASSERT_LE(sizes.contact_buckets + 1, SIM_SCAN_BLOCK);
+  std::vector<std::string> expected = {"contact_begin",   "contact_clear", "contact_count", "scan",
+                                       "contact_scatter", "contact_cross", "contact_free",  "contact_near",
+                                       "contact_bound",   "air",           "integrate"};
   std::vector<uint32_t> iterations;
   // Every colour with constraints in the first iteration; in the second, all but the hinges'
   uint32_t hinge_colors = 0;
@@ -111,7 +115,8 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
       EXPECT_EQ(sink.passes[k].gate, SIM_GATE_ITERATION);
       EXPECT_EQ(sink.passes[k].gate_arg, iterations[project++]);
     }
-  EXPECT_EQ(sink.marks, (std::vector<PassCategory>{kIntegrate, kProject, kProject, kHash, kCollide, kFloor, kTear}));
+  EXPECT_EQ(sink.marks,
+            (std::vector<PassCategory>{kContact, kIntegrate, kProject, kProject, kHash, kCollide, kFloor, kTear}));
   EXPECT_EQ(marksPerSubstep(), sink.marks.size());
 }
 

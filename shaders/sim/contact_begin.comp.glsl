@@ -1,0 +1,12 @@
+#version 460
+// Contact (contact.glsl): clears the grid's header for the substep (one invocation).
+// Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
+#define SIM_LOCAL_SIZE SIM_WG_PARTICLES
+#define SIM_PUSH_TYPE SimPush
+#include "contact.glsl"
+#include "sim_common.glsl"
+
+void main() {
+  if (threadIndex() != 0u) return;
+  for (uint w = 0u; w < SIM_CONTACT_HEADER; ++w) contact_grid[w] = 0u;
+}
