@@ -85,8 +85,8 @@
 //             copies) or Compaction (the tear compaction's arguments): gpu::Grid
 //   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)
 //   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases),
-//             CONSTRAINTS (the sheet has constraints) or CONTACT (contact is on: the sheet alone
-//             runs it so far, not a fleet nor the fused tick)
+//             CONSTRAINTS (the sheet has constraints) or CONTACT (contact is on: a sheet alone,
+//             or a fleet's sheet recorded on its own)
 //   category  its timestamp category (gpu::PassCategory k<category>)
 #define SIM_DISPATCHES(X)                                                                                              \
   X(integrate, contact_begin, ONE, Threads, TICK, CONTACT, Contact)                                                    \

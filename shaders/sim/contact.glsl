@@ -9,6 +9,10 @@
 #ifndef SIM_CONTACT_GLSL
 #define SIM_CONTACT_GLSL
 #include "sim_common.glsl"
+// The position of particle j: its buffer, or the fused tick's shared copy
+#ifndef SIM_POSITION
+#define SIM_POSITION(j) pos[j]
+#endif
 
 // Words of the grid's header (SIM_CONTACT_HEADER)
 #define CONTACT_LONGEST 0u
@@ -34,12 +38,12 @@ bool contactEdgeLive(uint e) {
 
 // The positions went wrong (an edge of no finite length): no pair is looked for and nothing moves,
 // as on the CPU
-bool contactGoneWrong() { return contact_grid[CONTACT_LONGEST] >= 0x7F800000u; }
+bool contactGoneWrong() { return contact_words[CONTACT_LONGEST] >= 0x7F800000u; }
 
 // Cells per unit of length: the cells are SIM_CONTACT_CELL_ROOM x the longest live edge or the
 // contact diameter, whichever is longer
 float contactInvCell() {
-  float longest = simSqrt(uintBitsToFloat(contact_grid[CONTACT_LONGEST]));
+  float longest = simSqrt(uintBitsToFloat(contact_words[CONTACT_LONGEST]));
   return simDiv(1.0f, SIM_CONTACT_CELL_ROOM * max(longest, 2.0f * u.contact.x));
 }
 
@@ -48,14 +52,14 @@ bool contactBox(uint k, out vec3 lo, out vec3 hi) {
   if (k < u.triangle_count) {
     if (k >= counters.triangle_count) return false;
     uvec4 t = triangles[k];
-    vec3 a = vec3(pos[t.x]), b = vec3(pos[t.y]), c = vec3(pos[t.z]);
+    vec3 a = vec3(SIM_POSITION(t.x)), b = vec3(SIM_POSITION(t.y)), c = vec3(SIM_POSITION(t.z));
     lo = min(a, min(b, c));
     hi = max(a, max(b, c));
     return true;
   }
   uint e = k - u.triangle_count;
   if (e >= contactEdgeCount() || !contactEdgeLive(e)) return false;
-  vec3 a = vec3(pos[contact_edges[e].x]), b = vec3(pos[contact_edges[e].y]);
+  vec3 a = vec3(SIM_POSITION(contact_edges[e].x)), b = vec3(SIM_POSITION(contact_edges[e].y));
   lo = min(a, b);
   hi = max(a, b);
   return true;
@@ -78,22 +82,24 @@ void contactInsert(uint k, bool scatter) {
   vec3 lo, hi;
   if (contactGoneWrong() || !contactBox(k, lo, hi)) return;
   float inv = contactInvCell();
-  ivec3 a = cellOf(lo, inv), b = min(cellOf(hi, inv), a + ivec3(1));
-  uint seen[SIM_CONTACT_CELLS_PER_BOX];
-  uint count = 0u;
-  for (int z = a.z; z <= b.z; ++z)
-    for (int y = a.y; y <= b.y; ++y)
-      for (int x = a.x; x <= b.x; ++x) {
-        uint h = contactBucket(ivec3(x, y, z), k >= u.triangle_count);
-        bool again = false;
-        for (uint j = 0u; j < count; ++j) again = again || seen[j] == h;
-        if (again) continue;
-        seen[count++] = h;
-        if (scatter)
-          contact_grid[contactEntries() + scratch[contactCounts() + h] + atomicAdd(scratch[contactFill() + h], 1u)] = k;
-        else
-          atomicAdd(scratch[contactCounts() + h], 1u);
-      }
+  ivec3 a = cellOf(lo, inv), span = min(cellOf(hi, inv), a + ivec3(1)) - a;
+  bool edge = k >= u.triangle_count;
+  // Cell c of the box (bits: x, y, z steps), unless an earlier cell has its bucket
+  for (uint c = 0u; c < 8u; ++c) {
+    ivec3 step = ivec3(int(c & 1u), int((c >> 1) & 1u), int(c >> 2));
+    if (any(greaterThan(step, span))) continue;
+    uint h = contactBucket(a + step, edge);
+    bool again = false;
+    for (uint e = 0u; e < c; ++e) {
+      ivec3 earlier = ivec3(int(e & 1u), int((e >> 1) & 1u), int(e >> 2));
+      again = again || (all(lessThanEqual(earlier, span)) && contactBucket(a + earlier, edge) == h);
+    }
+    if (again) continue;
+    if (scatter)
+      contact_words[contactEntries() + scratch[contactCounts() + h] + atomicAdd(scratch[contactFill() + h], 1u)] = k;
+    else
+      atomicAdd(scratch[contactCounts() + h], 1u);
+  }
 }
 
 // The particle's step bound and nearest distance (ContactParticle.state)
@@ -110,14 +116,15 @@ void contactPair(uvec4 q, ContactPair c) {
   lowerNearest(q.z, c.d2);
   lowerNearest(q.w, c.d2);
   if (!(c.d2 < thickness * thickness)) return;
-  vec4 x0 = pos[q.x], x1 = pos[q.y], x2 = pos[q.z], x3 = pos[q.w];
+  vec4 x0 = SIM_POSITION(q.x), x1 = SIM_POSITION(q.y), x2 = SIM_POSITION(q.z), x3 = SIM_POSITION(q.w);
   for (uint j = 0u; j < 4u; ++j) {
     uint i = j == 0u ? q.x : (j == 1u ? q.y : (j == 2u ? q.z : q.w));
     ivec3 f = contactFixed(contactPush(x0, x1, x2, x3, c, thickness, j), u.contact.w);
-    atomicAdd(contact_particles[i].sum.x, f.x);
-    atomicAdd(contact_particles[i].sum.y, f.y);
-    atomicAdd(contact_particles[i].sum.z, f.z);
-    atomicAdd(contact_particles[i].sum.w, 1);
+    // Two's complement: unsigned sums have the bits of the signed ones
+    atomicAdd(contact_particles[i].sum.x, uint(f.x));
+    atomicAdd(contact_particles[i].sum.y, uint(f.y));
+    atomicAdd(contact_particles[i].sum.z, uint(f.z));
+    atomicAdd(contact_particles[i].sum.w, 1u);
   }
 }
 
@@ -130,8 +137,8 @@ void contactPair(uvec4 q, ContactPair c) {
 void visitTriangle(uint i, uint t) {
   uvec4 tri = triangles[t];
   if (i == tri.x || i == tri.y || i == tri.z || contactFree(tri.x) || contactFree(tri.y) || contactFree(tri.z)) return;
-  contactPair(uvec4(i, tri.x, tri.y, tri.z),
-              pointTriangle(vec3(pos[i]), vec3(pos[tri.x]), vec3(pos[tri.y]), vec3(pos[tri.z])));
+  contactPair(uvec4(i, tri.x, tri.y, tri.z), pointTriangle(vec3(SIM_POSITION(i)), vec3(SIM_POSITION(tri.x)),
+                                                           vec3(SIM_POSITION(tri.y)), vec3(SIM_POSITION(tri.z))));
 }
 
 // Edge e against edge f > e that shares no particle with it
@@ -139,7 +146,8 @@ void visitEdge(uint e, uint f) {
   uvec2 a = contact_edges[e].xy, b = contact_edges[f].xy;
   if (f <= e || a.x == b.x || a.x == b.y || a.y == b.x || a.y == b.y) return;
   if (contactFree(a.x) || contactFree(a.y) || contactFree(b.x) || contactFree(b.y)) return;
-  contactPair(uvec4(a, b), segmentSegment(vec3(pos[a.x]), vec3(pos[a.y]), vec3(pos[b.x]), vec3(pos[b.y])));
+  contactPair(uvec4(a, b), segmentSegment(vec3(SIM_POSITION(a.x)), vec3(SIM_POSITION(a.y)), vec3(SIM_POSITION(b.x)),
+                                          vec3(SIM_POSITION(b.y))));
 }
 
 // Live triangle slot t against slot o: when they share no particle and cross, both are marked
@@ -148,11 +156,12 @@ void visitCrossing(uint t, uint o) {
   if (a.x == b.x || a.x == b.y || a.x == b.z || a.y == b.x || a.y == b.y || a.y == b.z || a.z == b.x || a.z == b.y ||
       a.z == b.z)
     return;
-  if (!trianglesCross(vec3(pos[a.x]), vec3(pos[a.y]), vec3(pos[a.z]), vec3(pos[b.x]), vec3(pos[b.y]), vec3(pos[b.z])))
+  if (!trianglesCross(vec3(SIM_POSITION(a.x)), vec3(SIM_POSITION(a.y)), vec3(SIM_POSITION(a.z)),
+                      vec3(SIM_POSITION(b.x)), vec3(SIM_POSITION(b.y)), vec3(SIM_POSITION(b.z))))
     return;
-  atomicOr(contact_grid[SIM_CONTACT_HEADER + t], 1u);
-  atomicOr(contact_grid[SIM_CONTACT_HEADER + o], 1u);
-  atomicOr(contact_grid[CONTACT_TANGLED], 1u);
+  atomicOr(contact_words[SIM_CONTACT_HEADER + t], 1u);
+  atomicOr(contact_words[SIM_CONTACT_HEADER + o], 1u);
+  atomicOr(contact_words[CONTACT_TANGLED], 1u);
 }
 
 // Every grid entry of the kind `visit` looks for whose box meets [lo, hi], once: in the cell of the
@@ -168,7 +177,7 @@ void contactVisit(uint visit, uint self, vec3 lo, vec3 hi) {
         uint h = contactBucket(cell, visit == CONTACT_VISIT_EDGES);
         uint end = scratch[contactCounts() + h + 1u];
         for (uint m = scratch[contactCounts() + h]; m < end; ++m) {
-          uint k = contact_grid[entries + m];
+          uint k = contact_words[entries + m];
           vec3 elo, ehi;
           contactBox(k, elo, ehi);
           if (!boxesMeet(lo, hi, elo, ehi) || cellOf(max(lo, elo), inv) != cell) continue;
@@ -180,6 +189,89 @@ void contactVisit(uint visit, uint self, vec3 lo, vec3 hi) {
             visitCrossing(self, k);
         }
       }
+}
+
+// The passes' bodies, one element each (the contact_* kernels, and the fused tick's loops)
+
+// contact_begin: the header cleared (one invocation)
+void contactBegin() {
+  for (uint w = 0u; w < SIM_CONTACT_HEADER; ++w) contact_words[w] = 0u;
+}
+
+// Elements contact_clear covers: the particles, the buckets and their end, the triangle slots, the edges
+uint contactSlots() {
+  return max(max(u.particle_count, 2u * (u.contact_grid.x + 1u) + 1u), max(u.triangle_count, contactEdgeCount()));
+}
+
+// contact_clear: particle k's start of the substep; bucket k and triangle slot k cleared; edge k's
+// squared length raises the longest
+void contactClear(uint k) {
+  if (k < u.particle_count) {
+    float r = u.contact.x;
+    contact_particles[k].start = SIM_POSITION(k);
+    // Free in the last substep: bit 1 (crossingChecked looks at its triangles again)
+    contact_particles[k].state = uvec4(floatBitsToUint(r * r), (contact_particles[k].state.y & 1u) << 1, 0u, 0u);
+    contact_particles[k].sum = uvec4(0u);
+  }
+  uint buckets = 2u * (u.contact_grid.x + 1u); // the triangles' and the edges'
+  if (k <= buckets) scratch[contactCounts() + k] = 0u;
+  if (k < buckets) scratch[contactFill() + k] = 0u;
+  if (k < u.triangle_count) contact_words[SIM_CONTACT_HEADER + k] = 0u;
+  if (k < contactEdgeCount() && contactEdgeLive(k)) {
+    vec3 d = vec3(SIM_POSITION(contact_edges[k].y)) - vec3(SIM_POSITION(contact_edges[k].x));
+    atomicMax(contact_words[CONTACT_LONGEST], floatBitsToUint(dot3(d, d)));
+  }
+}
+
+// contact_cross: live triangle slot t, when crossingChecked names it in substep s, against every
+// triangle whose box meets its box
+void contactCross(uint t, uint s) {
+  if (t >= counters.triangle_count || contactGoneWrong()) return;
+  uvec4 tri = triangles[t];
+  uint was = contact_particles[tri.x].state.y | contact_particles[tri.y].state.y | contact_particles[tri.z].state.y;
+  bool all = s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u;
+  if (!crossingChecked(all, tri.xyz, u.contact_check.y, u.contact_check.z, (was & 2u) != 0u)) return;
+  vec3 lo, hi;
+  contactBox(t, lo, hi);
+  contactVisit(CONTACT_VISIT_CROSSING, t, lo, hi);
+}
+
+// contact_free: the particles of live triangle slot t go free when it crosses another
+void contactFreeOf(uint t) {
+  if (t >= counters.triangle_count || contact_words[SIM_CONTACT_HEADER + t] == 0u) return;
+  uvec4 tri = triangles[t];
+  atomicOr(contact_particles[tri.x].state.y, 1u);
+  atomicOr(contact_particles[tri.y].state.y, 1u);
+  atomicOr(contact_particles[tri.z].state.y, 1u);
+}
+
+// contact_near: particle k against the triangles near it, or (k past the particles) edge
+// k - particles against the edges near it. The boxes are widened a little past the radius: which
+// pairs count is their distance's call.
+void contactNear(uint k) {
+  if (contactGoneWrong()) return;
+  float reach = 1.01f * u.contact.x;
+  if (k < u.particle_count) {
+    if (contactFree(k)) return;
+    vec3 x = vec3(SIM_POSITION(k));
+    contactVisit(CONTACT_VISIT_TRIANGLES, k, x - vec3(reach), x + vec3(reach));
+    return;
+  }
+  uint e = k - u.particle_count;
+  if (e >= contactEdgeCount() || !contactEdgeLive(e)) return;
+  vec3 a = vec3(SIM_POSITION(contact_edges[e].x)), b = vec3(SIM_POSITION(contact_edges[e].y));
+  contactVisit(CONTACT_VISIT_EDGES, e, min(a, b) - vec3(reach), max(a, b) + vec3(reach));
+}
+
+// contact_bound: particle i's step bound (stepBound; unbounded when free) and push
+// (contactAverage); the particles in contact counted
+void contactBound(uint i) {
+  float r = u.contact.x;
+  uint nearest = contactGoneWrong() ? 0u : contact_particles[i].state.x;
+  if (nearest < floatBitsToUint(r * r)) atomicAdd(contact_words[CONTACT_COUNT], 1u);
+  contact_particles[i].start.w =
+      contactFree(i) ? uintBitsToFloat(0x7F800000u) : stepBound(uintBitsToFloat(nearest), r, u.contact.y);
+  contact_particles[i].push = vec4(contactAverage(ivec4(contact_particles[i].sum), u.contact.w), 0.0f);
 }
 
 #endif

@@ -7,6 +7,5 @@
 #include "sim_common.glsl"
 
 void main() {
-  if (threadIndex() != 0u) return;
-  for (uint w = 0u; w < SIM_CONTACT_HEADER; ++w) contact_grid[w] = 0u;
+  if (threadIndex() == 0u) contactBegin();
 }

@@ -8,9 +8,5 @@
 
 void main() {
   uint t = threadIndex();
-  if (t >= p.count || t >= counters.triangle_count || contact_grid[SIM_CONTACT_HEADER + t] == 0u) return;
-  uvec4 tri = triangles[t];
-  atomicOr(contact_particles[tri.x].state.y, 1u);
-  atomicOr(contact_particles[tri.y].state.y, 1u);
-  atomicOr(contact_particles[tri.z].state.y, 1u);
+  if (t < p.count) contactFreeOf(t);
 }

@@ -9,17 +9,5 @@
 
 void main() {
   uint k = threadIndex();
-  if (k >= p.count || contactGoneWrong()) return;
-  // The boxes are widened a little past the radius: which pairs count is their distance's call
-  float reach = 1.01f * u.contact.x;
-  if (k < u.particle_count) {
-    if (contactFree(k)) return;
-    vec3 x = vec3(pos[k]);
-    contactVisit(CONTACT_VISIT_TRIANGLES, k, x - vec3(reach), x + vec3(reach));
-    return;
-  }
-  uint e = k - u.particle_count;
-  if (e >= contactEdgeCount() || !contactEdgeLive(e)) return;
-  vec3 a = vec3(pos[contact_edges[e].x]), b = vec3(pos[contact_edges[e].y]);
-  contactVisit(CONTACT_VISIT_EDGES, e, min(a, b) - vec3(reach), max(a, b) + vec3(reach));
+  if (k < p.count) contactNear(k);
 }

@@ -2,10 +2,10 @@
 // fleet per workgroup, SIM_BATCH). Small sheets: substeps p.first_substep .. + p.substeps of a tick (on a GPU the whole
 // tick, on a CPU device one substep) in one dispatch of one workgroup. Positions stay in shared memory from the first
 // substep to the last; a workgroup barrier replaces each dispatch and pipeline barrier of the per-colour passes. Every
-// substep runs the same per-particle and per-constraint maths, in the same order, as integrate, project, hash_*,
-// collide, floor and tear_*; the hash is built in the same buffers. Each invocation owns the particles lid, lid +
-// kInvocations, ... (integration, collision and floor of a particle run on one invocation, so the collision delta stays
-// in a register). Workgroup size: at most SIM_WG_FUSED, specialised per device (sim_common.glsl declares it)
+// substep runs the same per-particle and per-constraint maths, in the same order, as contact_*, integrate, project,
+// hash_*, collide, floor and tear_*; the hash is built in the same buffers. Each invocation owns the particles lid, lid
+// + kInvocations, ... (integration, collision and floor of a particle run on one invocation, so the collision delta
+// stays in a register). Workgroup size: at most SIM_WG_FUSED, specialised per device (sim_common.glsl declares it)
 #define SIM_LOCAL_SIZE SIM_WG_FUSED
 #define SIM_LOCAL_SIZE_SPECIALIZED
 // Invocations exchange data through buffers between barriers
@@ -15,7 +15,9 @@
 shared vec4 s_pos[SIM_FUSED_MAX_PARTICLES];
 #define SIM_POSITION(j) s_pos[j]
 #include "sim_elements.glsl"
-#ifndef SIM_BATCH
+#ifdef SIM_FUSED_CONTACT
+// tick_fused_contact.comp: with contact (after SIM_POSITION)
+#include "contact.glsl"
 #endif
 
 // Invocations of the workgroup (specialised)
@@ -38,14 +40,19 @@ void storePositions(uint n) {
 }
 
 // Exclusive scan by the whole workgroup of cell_count into cell_start (SIM_SCAN_HASH) or of
-// scratch[0, count) in place (SIM_SCAN_SCRATCH). Each invocation scans a contiguous chunk after
-// adding up the totals of the chunks before its own, which meet in scratch[sums + invocation].
-void scanWorkgroup(uint mode, uint count, uint sums) {
+// scratch[offset, offset + count) in place (SIM_SCAN_SCRATCH). Each invocation scans a contiguous
+// chunk after adding up the totals of the chunks before its own, which meet in scratch[sums +
+// invocation].
+void scanWorkgroup(uint mode, uint offset, uint count, uint sums) {
   uint lid = gl_LocalInvocationID.x;
   uint chunk = (count + kInvocations - 1u) / kInvocations;
   uint first = min(lid * chunk, count), last = min(first + chunk, count);
   uint total = 0u;
-  for (uint k = first; k < last; ++k) total += mode == SIM_SCAN_HASH ? cell_count[k] : scratch[k];
+  // (each array read only in its own mode: a fleet's arrays are not bounds-checked)
+  if (mode == SIM_SCAN_HASH)
+    for (uint k = first; k < last; ++k) total += cell_count[k];
+  else
+    for (uint k = first; k < last; ++k) total += scratch[offset + k];
   scratch[sums + lid] = total;
   sync();
   uint run = 0u;
@@ -55,13 +62,42 @@ void scanWorkgroup(uint mode, uint count, uint sums) {
       cell_start[k] = run;
       run += cell_count[k];
     } else {
-      uint v = scratch[k];
-      scratch[k] = run;
+      uint v = scratch[offset + k];
+      scratch[offset + k] = run;
       run += v;
     }
   }
   sync();
 }
+
+#ifdef SIM_FUSED_CONTACT
+// Contact (as the contact_* passes, contact.glsl): each particle's step bound and push for substep
+// s, from where it starts it.
+void contactSubstep(uint s, uint n) {
+  uint lid = gl_LocalInvocationID.x;
+  sync(); // the positions of other invocations' particles
+  if (lid == 0u) contactBegin();
+  sync();
+  uint slots = contactSlots(), boxes = u.triangle_count + contactEdgeCount();
+  for (uint k = lid; k < slots; k += kInvocations) contactClear(k);
+  sync();
+  for (uint k = lid; k < boxes; k += kInvocations) contactInsert(k, false);
+  sync();
+  scanWorkgroup(SIM_SCAN_SCRATCH, contactCounts(), 2u * (u.contact_grid.x + 1u) + 1u, compactSlots());
+  for (uint k = lid; k < boxes; k += kInvocations) contactInsert(k, true);
+  sync();
+  for (uint t = lid; t < u.triangle_count; t += kInvocations) contactCross(t, s);
+  sync();
+  for (uint t = lid; t < u.triangle_count; t += kInvocations) contactFreeOf(t);
+  sync();
+  uint queries = u.particle_count + contactEdgeCount();
+  for (uint k = lid; k < queries; k += kInvocations) contactNear(k);
+  sync();
+  for (uint i = lid; i < n; i += kInvocations) contactBound(i);
+  sync();
+}
+
+#endif
 
 #ifdef SIM_BATCH
 // One frame of the animated reset (as reset.comp), in the first dispatch of the sheet's tick.
@@ -101,7 +137,11 @@ void main() {
   uint tear_pass = stageFirstPass(SIM_STAGE_tear, u.iterations, u.color_count, collision);
   for (uint s = p.first_substep; s < end; ++s) {
     uint first_pass = s * per_substep;
-    // 1. The air (as air.comp), then Verlet integration (as integrate.comp)
+    // 1. Contact's bounds (with contact on), the air (as air.comp), then Verlet integration (as
+    // integrate.comp)
+#ifdef SIM_FUSED_CONTACT
+    if (u.contact.x > 0.0f) contactSubstep(s, n);
+#endif
     if ((u.flags & SIM_FLAG_AIR) != 0u) {
       sync(); // the air reads the positions of other invocations' particles (loaded or moved)
       for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(airOnParticle(i), 0.0f);
@@ -167,7 +207,7 @@ void main() {
       if (mode != SIM_COLLIDE_CANDIDATES) {
         for (uint i = lid; i < n; i += kInvocations) hashCount(i, vec3(s_pos[i]));
         sync();
-        scanWorkgroup(SIM_SCAN_HASH, u.hash_mask + 1u, compactSlots());
+        scanWorkgroup(SIM_SCAN_HASH, 0u, u.hash_mask + 1u, compactSlots());
         for (uint i = lid; i < n; i += kInvocations) hashScatter(i);
         sync();
         for (uint i = lid; i < n; i += kInvocations) hashSort(i, vec3(s_pos[i]));
@@ -193,6 +233,12 @@ void main() {
         continue;
       }
       VerletState st = floorParticle(q, prev[i], repel, u.flags, u.floor_y, u.restitution, u.friction);
+#ifdef SIM_FUSED_CONTACT
+      bool placed = u.grab_target[s].w > 0.5f && i == u.grab_index; // the grab is not bounded
+      if (u.contact.x > 0.0f && st.position.w > 0.0f && !placed)
+        st = contactStep(st, vec3(contact_particles[i].start), vec3(contact_particles[i].push),
+                         contact_particles[i].start.w);
+#endif
       s_pos[i] = st.position;
       prev[i] = st.previous;
     }
@@ -232,7 +278,7 @@ void main() {
       uint slots = compactSlots();
       for (uint k = lid; k < slots; k += kInvocations) tearFlags(k);
       sync();
-      scanWorkgroup(SIM_SCAN_SCRATCH, slots, slots);
+      scanWorkgroup(SIM_SCAN_SCRATCH, 0u, slots, slots);
       for (uint k = lid; k < slots; k += kInvocations) tearCompact(k);
       sync();
     }

@@ -10,7 +10,9 @@ shared uint partial[SIM_WG_SCAN];
 
 uint load(uint i) {
   if (i >= p.count) return 0u;
-  return p.mode == SIM_SCAN_HASH ? cell_count[i] : scratch[p.offset + i];
+  // Each array read only in its own mode (a fleet's arrays are not bounds-checked)
+  if (p.mode == SIM_SCAN_HASH) return cell_count[i];
+  return scratch[p.offset + i];
 }
 
 void store(uint i, uint v) {

@@ -145,7 +145,7 @@ void bindSheet(uint sheet) {
 #define hinges g_hinges.v
 #define contact_edges g_contact_edges.v
 #define contact_particles g_contact.v
-#define contact_grid g_contact_grid.v
+#define contact_words g_contact_grid.v
 #else
 layout(std140, set = 0, binding = SIM_BIND_UNIFORMS) uniform UniformsBlock { SimUniforms u; };
 layout(std430, set = 0, binding = SIM_BIND_POS) SIM_COHERENT buffer PosBuffer { vec4 pos[]; };
@@ -194,7 +194,9 @@ layout(std430, set = 0, binding = SIM_BIND_CONTACT_EDGES) readonly buffer Contac
 layout(std430, set = 0, binding = SIM_BIND_CONTACT) SIM_COHERENT buffer ContactBuffer {
   ContactParticle contact_particles[];
 };
-layout(std430, set = 0, binding = SIM_BIND_CONTACT_GRID) SIM_COHERENT buffer ContactGridBuffer { uint contact_grid[]; };
+layout(std430, set = 0, binding = SIM_BIND_CONTACT_GRID) SIM_COHERENT buffer ContactGridBuffer {
+  uint contact_words[];
+};
 
 #endif
 

@@ -175,6 +175,7 @@ SheetTopology buildSheet(const SimParams& p) {
   uint32_t hs = 2;
   while (hs < 2 * N) hs <<= 1;
   t.hash_size = hs;
+  t.contact = p.contact_factor > 0.0f;
   return t;
 }
 

@@ -29,6 +29,7 @@ struct SheetTopology {
   std::vector<glm::uvec4> triangles;                  ///< xyz vertices (counter-clockwise from +z), w = triangle id
   std::vector<glm::uvec2> tri_edges;                  ///< per triangle id: original ids of its two structural edges
   uint32_t hash_size = 0;                             ///< spatial hash buckets: power of two >= 2N
+  bool contact = false; ///< made with contact on: the GPU sizes its contact buffers from the start
 
   uint32_t particleCount() const { return uint32_t(rest_pos.size()); }
   uint32_t constraintCount() const { return uint32_t(constraints.size()); }

@@ -90,7 +90,9 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes) {
   fused_max_cell_spacings_ = shape.max_cell_spacings;
   sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
   per_sheet_ = passes == BatchPasses::PerSheet || (passes == BatchPasses::Auto && cpu_device);
-  if (per_sheet_) {
+  {
+    // The passes of one sheet at a time (per_sheet_, and sheets with contact, whose passes run
+    // sheet by sheet, so far)
     sheet_set_layout_ = createSheetSetLayout(dev);
     VkPushConstantRange sheet_range{VK_SHADER_STAGE_COMPUTE_BIT, 0, uint32_t(sizeof(SimPush))};
     pli.setLayoutCount = 1;
@@ -121,6 +123,18 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes) {
   }
 }
 
+void GpuBatch::releaseSlices() {
+  VkDevice dev = ctx_.device();
+  vkDeviceWaitIdle(dev);
+  for (Buffer& b : buf_) ctx_.destroyBuffer(b);
+  ctx_.destroyBuffer(table_);
+  ctx_.destroyBuffer(inputs_);
+  if (sheet_pool_) vkDestroyDescriptorPool(dev, sheet_pool_, nullptr);
+  sheet_pool_ = VK_NULL_HANDLE;
+  sheet_sets_.clear();
+  allocated_ = false;
+}
+
 GpuBatch::~GpuBatch() {
   VkDevice dev = ctx_.device();
   vkDeviceWaitIdle(dev);
@@ -139,7 +153,7 @@ GpuBatch::~GpuBatch() {
 void GpuBatch::allocate(const SheetTopology& topo) {
   topo_ = topo;
   spacing_ = structuralSpacing(topo);
-  sizes_ = SheetLayout::of(topo, ctx_.properties().limits.maxStorageBufferRange);
+  sizes_ = SheetLayout::of(topo, ctx_.properties().limits.maxStorageBufferRange, topo.contact);
   const uint32_t sheets = size();
   StartData start;
   const std::vector<BindingSpec> table = sheetBindings(topo_, sizes_, start, false);
@@ -176,7 +190,7 @@ void GpuBatch::allocate(const SheetTopology& topo) {
                              ctx_.info().name + " (try a smaller --batch)");
   }
   ctx_.submitOnce([&](VkCommandBuffer cmd) { vkCmdUpdateBuffer(cmd, table_.buffer, 0, sizeof(entries), &entries); });
-  if (per_sheet_) {
+  if (per_sheet_ || sizes_.contact) {
     // Each sheet's descriptor set over its slices
     VkDevice dev = ctx_.device();
     sheet_pool_ = createSheetSetPool(dev, sheets);
@@ -213,12 +227,21 @@ void GpuBatch::flush() {
     auto& q = queued_[i]->queued();
     if (!q) continue;
     SimUniforms u = *q;
-    requireNoContact(u);
     q.reset();
+    if (u.contact.x > 0.0f) {
+      // The fleet sized its contact buffers when a sheet was made with contact on
+      if (!sizes_.contact)
+        throw std::runtime_error("contact_factor was turned on in a fleet made without it: a fleet on the GPU "
+                                 "needs it set when its sheets are made");
+      u.contact_grid =
+          glm::uvec4(sizes_.contact_buckets / 2 - 1, sizes_.contact_counts, sizes_.contact_fill, sizes_.contact_edges);
+    }
+    ticked_ = true;
     if (keepsCandidateLists(sizes_, candidates_allowed_)) u.flags |= SIM_FLAG_CANDIDATES; // as the solver does
     std::memcpy(inputs + uniforms_at + stride_[SIM_BIND_UNIFORMS] * i, &u, sizeof(u));
     const uint32_t substeps = u.reset_active ? 0u : substepCount(u.substeps);
-    if (fits_fused && fusedTickTakes(u, spacing_, fused_max_cell_spacings_)) {
+    // A sheet with contact runs the per-colour passes (the fleet's fused tick has no contact yet)
+    if (fits_fused && u.contact.x <= 0.0f && fusedTickTakes(u, spacing_, fused_max_cell_spacings_)) {
       fused_substeps = std::max(fused_substeps, std::max(substeps, 1u));
       fused.push_back(i);
       continue;
@@ -232,6 +255,7 @@ void GpuBatch::flush() {
     plan.collision = plan.collision || (u.flags & SIM_FLAG_COLLISION) != 0u;
     plan.air = plan.air || (u.flags & SIM_FLAG_AIR) != 0u;
     plan.crease = plan.crease || creasing(u.hinge.y, u.crease.y);
+    plan.contact = plan.contact || u.contact.x > 0.0f;
   }
   if (fused.empty() && passes.empty()) return;
   last_dispatches_ = 0;
@@ -254,7 +278,10 @@ void GpuBatch::flush() {
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BIND_UNIFORMS].buffer, uint32_t(regions.size()), regions.data());
   VkBufferCopy queue_region{0, 0, 4ull * queue.size()};
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_QUEUE].buffer, 1, &queue_region);
-  if (!passes.empty() && per_sheet_) {
+  const bool sheet_by_sheet = per_sheet_ || plan.contact;
+  if (plan.contact)
+    addContactPipelines(ctx_, sheet_layout_, float_rules_, math_, std::nullopt, sheet_passes_, owned_pipelines_);
+  if (!passes.empty() && sheet_by_sheet) {
     // Each sheet's full hash-pass grids, which its candidates_decide copies to the live ones
     std::vector<VkBufferCopy> grid_regions;
     for (uint32_t i : passes)
@@ -294,7 +321,7 @@ void GpuBatch::flush() {
       }
     last_dispatches_ += dispatched;
   }
-  if (!passes.empty() && per_sheet_) {
+  if (!passes.empty() && sheet_by_sheet) {
     // Each sheet's per-colour passes, on its own descriptor set, as it records them alone
     const uint32_t n = topo_.particleCount();
     hash_grids_.clear();
@@ -311,7 +338,7 @@ void GpuBatch::flush() {
         continue;
       }
       const SubstepPlan sheet_plan{u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u, (u.flags & SIM_FLAG_AIR) != 0u,
-                                   SIM_NONE, creasing(u.hinge.y, u.crease.y)};
+                                   SIM_NONE,     creasing(u.hinge.y, u.crease.y),      u.contact.x > 0.0f};
       for (uint32_t s = 0; s < substepCount(u.substeps); ++s)
         recordSubstep(*this, sheet_passes_, topo_, sizes_, sheet_plan, s, count);
     }

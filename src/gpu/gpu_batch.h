@@ -110,6 +110,10 @@ private:
   SheetTopology topo_; ///< the topology every sheet shares
   SheetLayout sizes_;
   bool allocated_ = false;
+  bool ticked_ = false;        ///< a sheet has ticked
+  std::vector<bool> uploaded_; ///< the sheets uploaded
+  /// Frees every slice (allocate makes them again).
+  void releaseSlices();
   std::array<Buffer, SIM_BATCH_ENTRIES> buf_{};          ///< per binding: a slice per sheet; the queue
   std::array<VkDeviceSize, SIM_BATCH_ENTRIES> stride_{}; ///< bytes from one sheet's slice to the next
   Buffer table_;                                         ///< SIM_BATCH_ENTRIES uvec4 (device)

@@ -2,6 +2,7 @@
 // transfers GpuSolver uses too, sheet_transfers.cpp), and every sheet's positions in one read-back
 // (gpu_batch.h); gpu_batch.cpp creates the batch and runs its ticks.
 #include <cstring>
+#include <stdexcept>
 
 #include "core/host_queries.h"
 #include "gpu/barriers.h"
@@ -23,7 +24,25 @@ SheetPlace GpuBatch::place(uint32_t i) const {
 
 void GpuBatch::uploadSheet(uint32_t i, const SheetTopology& topo) {
   finish();
+  if (allocated_ && topo.contact && !sizes_.contact) {
+    // The first sheet made with contact on: the fleet sizes its contact buffers, which it can do
+    // while no sheet has ticked, and uploads the sheets made before again
+    if (ticked_)
+      throw std::runtime_error("contact_factor was turned on in a fleet made without it: a fleet on the GPU "
+                               "needs it set when its sheets are made");
+    SheetTopology with = topo_;
+    with.contact = true;
+    releaseSlices();
+    allocate(with);
+    for (uint32_t j = 0; j < uploaded_.size(); ++j)
+      if (uploaded_[j] && j != i) {
+        StartData start;
+        uploadStart(ctx_, place(j), sheetBindings(topo_, sizes_, start, true));
+      }
+  }
   if (!allocated_) allocate(topo);
+  if (uploaded_.size() < size()) uploaded_.resize(size(), false);
+  uploaded_[i] = true;
   // Every sheet shares the topology: the restored bindings of a reset come from topo_.
   if (topo.cols != topo_.cols || topo.rows != topo_.rows || topo.constraints.size() != topo_.constraints.size() ||
       topo.triangles.size() != topo_.triangles.size() || topo.colors.size() != topo_.colors.size() ||

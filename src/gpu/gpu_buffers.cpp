@@ -51,7 +51,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
   topo_ = topo;
   spacing_ = structuralSpacing(topo);
   const VkDeviceSize max_range = ctx_.properties().limits.maxStorageBufferRange;
-  layout_sizes_ = SheetLayout::of(topo, max_range);
+  layout_sizes_ = SheetLayout::of(topo, max_range, topo.contact);
   hash_grids_.clear();
   hash_grids_uploaded_.clear();
 

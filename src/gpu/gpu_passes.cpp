@@ -61,7 +61,8 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
     for (uint32_t s = 0; s < key.substeps; s += fused_substeps_) {
       if (s > 0) computeToCompute(cmd);
       const uint32_t count = std::min(fused_substeps_, key.substeps - s);
-      dispatch(cmd, pipes_.tick_fused, Grid::Workgroup, 1, FusedPush{n, s, count, key.stop});
+      dispatch(cmd, key.contact ? pipes_.tick_fused_contact : pipes_.tick_fused, Grid::Workgroup, 1,
+               FusedPush{n, s, count, key.stop});
       if (key.stop != SIM_NONE && key.stop < (s + count) * per) break;
     }
     timestamp(cmd, flight, kFused);

@@ -64,6 +64,7 @@ void GpuSolver::createPipelines(FusedShape fused) {
   // The fused tick keeps the positions in shared memory; its shape suits the device.
   const FusedShape shape = resolveFusedShape(ctx_, fused);
   const uint32_t fused_workgroup = shape.workgroup;
+  fused_workgroup_ = fused_workgroup;
   fused_substeps_ = shape.substeps_per_dispatch;
   fused_max_cell_spacings_ = shape.max_cell_spacings;
   if (fusedTickSupported(ctx_))
@@ -128,15 +129,15 @@ void GpuSolver::collectTimes(const InFlight& flight) const {
   last_ms_ = ms;
 }
 
-void requireNoContact(const SimUniforms& u) {
-  if (u.contact.x > 0.0f)
-    throw std::runtime_error("contact_factor needs a sheet alone on the GPU (or --backend cpu): a fleet has no "
-                             "penetration-free contact yet");
-}
-
 void GpuSolver::tick(const SimUniforms& u) {
   const bool contact = u.contact.x > 0.0f;
-  if (contact && !layout_sizes_.contact) sizeContact();
+  if (contact) {
+    // The contact's buffers and pipelines, the first time contact is on
+    if (!layout_sizes_.contact) sizeContact();
+    addContactPipelines(ctx_, layout_, float_rules_, math_,
+                        pipes_.tick_fused.pipeline ? std::optional<uint32_t>(fused_workgroup_) : std::nullopt, pipes_,
+                        owned_pipelines_);
+  }
   last_contact_ = contact;
   const uint32_t index = next_in_flight_;
   next_in_flight_ = (next_in_flight_ + 1) % kInFlight;
@@ -297,7 +298,6 @@ bool fusedTickFits(const SheetTopology& topo) {
 }
 
 bool fusedTickTakes(const SimUniforms& u, float spacing, float max_cell_spacings) {
-  if (u.contact.x > 0.0f) return false; // the contact passes run on the per-colour path
   if ((u.flags & SIM_FLAG_COLLISION) == 0u || max_cell_spacings < 0.0f) return true;
   return u.inv_cell * max_cell_spacings * spacing >= 1.0f;
 }

@@ -39,10 +39,6 @@ float structuralSpacing(const SheetTopology& topo);
 /// True when a sheet of this topology is small enough for the fused tick: at most
 /// SIM_FUSED_MAX_PARTICLES particles and SIM_FUSED_MAX_BUCKETS hash buckets.
 bool fusedTickFits(const SheetTopology& topo);
-/// Throws when `u` asks for the penetration-free contact (SimUniforms::contact), which only the
-/// CPU solver has so far.
-void requireNoContact(const shaderio::SimUniforms& u);
-
 /// True when a tick with these uniforms, of a sheet of grid spacing `spacing` that fits the fused
 /// tick, takes it on a device whose fused tick takes hash cells of at most `max_cell_spacings`
 /// spacings (< 0: any) when collision is on.
@@ -208,6 +204,7 @@ private:
   bool fused_allowed_ = true;
   FloatRules float_rules_;                      ///< what the shaders' SPIR-V asks of the device's float arithmetic
   MathSwitches math_;                           ///< the switches of exact_math.h (from the environment)
+  uint32_t fused_workgroup_ = 0;                ///< invocations of the fused tick's workgroup
   uint32_t fused_substeps_ = 1;                 ///< substeps per dispatch of the fused tick
   float fused_max_cell_spacings_ = -1.0f;       ///< largest hash cell of the fused tick (< 0: any)
   float spacing_ = 0.0f;                        ///< grid spacing: the shortest structural rest length

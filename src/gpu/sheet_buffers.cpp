@@ -123,7 +123,8 @@ SheetLayout SheetLayout::of(const SheetTopology& topo, VkDeviceSize max_range, b
     l.contact_edges = uint32_t(contactEdges(topo).size());
     const uint32_t boxes = topo.triangleCount() + l.contact_edges;
     l.contact_buckets = 2 * std::bit_ceil(std::max(boxes, 16u)); // two halves: triangles, edges
-    l.contact_counts = l.hash_sums + scanSumsSize(topo.hash_size);
+    // After the hash's sums and the fused tick's scan totals (which meet after the compaction slots)
+    l.contact_counts = std::max(l.hash_sums + scanSumsSize(topo.hash_size), l.tear_slots + SIM_WG_FUSED);
     l.contact_fill = l.contact_counts + l.contact_buckets + 1;
     l.contact_sums = l.contact_fill + l.contact_buckets;
     l.contact_words = SIM_CONTACT_HEADER + topo.triangleCount() + uint64_t(SIM_CONTACT_CELLS_PER_BOX) * boxes;

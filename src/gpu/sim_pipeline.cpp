@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <string_view>
 
 #include "gpu/barriers.h"
 #include "gpu/shaders.h"
@@ -109,33 +110,52 @@ ComputePipeline makeComputePipeline(VulkanContext& ctx, std::string_view key, Vk
   return p;
 }
 
+namespace {
+
+/// Every kernel of the registry (SIM_KERNELS, sim_passes.h): its shader, push constants, elements per
+/// invocation, and whether a fleet runs it batched.
+struct PipelineSpec {
+  ComputePipeline SimPipelines::*member;
+  const char* key;
+  uint32_t push_size, per_invocation;
+  bool batched;
+};
+constexpr uint32_t kSIM = sizeof(shaderio::SimPush), kSCAN = sizeof(shaderio::ScanPush), kNONE = 0;
+constexpr PipelineSpec kPasses[] = {
+#define SIM_KERNEL_SPEC(name, push, per_invocation, batched)                                                           \
+  {&SimPipelines::name, #name ".comp", k##push, per_invocation, batched != 0},
+    SIM_KERNELS(SIM_KERNEL_SPEC)
+#undef SIM_KERNEL_SPEC
+};
+
+bool isContactKernel(const PipelineSpec& spec) { return std::string_view(spec.key).starts_with("contact_"); }
+
+} // namespace
+
 SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
                                bool batched, PipelineSet& owned) {
   using namespace shaderio;
-  // Every kernel of the registry (SIM_KERNELS, sim_passes.h): its shader, push constants, elements per
-  // invocation, and whether a fleet runs it batched.
-  struct PipelineSpec {
-    ComputePipeline SimPipelines::*member;
-    const char* key;
-    uint32_t push_size, per_invocation;
-    bool batched;
-  };
-  constexpr uint32_t kSIM = sizeof(SimPush), kSCAN = sizeof(ScanPush), kNONE = 0;
-  static constexpr PipelineSpec kPasses[] = {
-#define SIM_KERNEL_SPEC(name, push, per_invocation, batched)                                                           \
-  {&SimPipelines::name, #name ".comp", k##push, per_invocation, batched != 0},
-      SIM_KERNELS(SIM_KERNEL_SPEC)
-#undef SIM_KERNEL_SPEC
-  };
   SimPipelines pipes;
   for (const PipelineSpec& spec : kPasses) {
-    if (batched && !spec.batched) continue;
+    if ((batched && !spec.batched) || isContactKernel(spec)) continue;
     const std::string key = batched ? std::string(spec.key) + ".batch" : std::string(spec.key);
     pipes.*spec.member =
         makeComputePipeline(ctx, key, layout, rules, math, batched ? uint32_t(sizeof(BatchPassPush)) : spec.push_size,
                             spec.per_invocation, std::nullopt, false, owned);
   }
   return pipes;
+}
+
+void addContactPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
+                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, PipelineSet& owned) {
+  using namespace shaderio;
+  for (const PipelineSpec& spec : kPasses)
+    if (isContactKernel(spec) && !(pipes.*spec.member).pipeline)
+      pipes.*spec.member = makeComputePipeline(ctx, spec.key, layout, rules, math, spec.push_size, spec.per_invocation,
+                                               std::nullopt, false, owned);
+  if (fused_workgroup && !pipes.tick_fused_contact.pipeline)
+    pipes.tick_fused_contact = makeComputePipeline(ctx, "tick_fused_contact.comp", layout, rules, math,
+                                                   sizeof(FusedPush), 1, *fused_workgroup, true, owned);
 }
 
 void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math, MathOp op) {

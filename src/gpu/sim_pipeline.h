@@ -48,7 +48,8 @@ struct SimPipelines {
 #define SIM_KERNEL_MEMBER(name, push, per_invocation, batched) ComputePipeline name;
   SIM_KERNELS(SIM_KERNEL_MEMBER)
 #undef SIM_KERNEL_MEMBER
-  ComputePipeline tick_fused; ///< null when the device has under 32 KiB of shared memory
+  ComputePipeline tick_fused;         ///< null when the device has under 32 KiB of shared memory
+  ComputePipeline tick_fused_contact; ///< the fused tick with contact (addContactPipelines)
   std::array<ComputePipeline, 3> pick;
 };
 
@@ -70,9 +71,16 @@ ComputePipeline makeComputePipeline(VulkanContext& ctx, std::string_view key, Vk
 
 /// The passes of the per-colour path (every SimPipelines member but tick_fused and pick) on
 /// `layout`: a sheet's own, or a fleet's (`batched`: the SIM_BATCH_PASS builds, "<key>.batch",
-/// whose push constants are BatchPassPush; no normals pass).
+/// whose push constants are BatchPassPush; no normals pass). The contact's kernels (contact_*)
+/// wait for addContactPipelines.
 SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
                                bool batched, PipelineSet& owned);
+
+/// Adds the contact's kernels (contact_*) to `pipes`, a sheet's own passes on `layout`, and, with
+/// `fused_workgroup` set, the fused tick with contact (tick_fused_contact): made when a sheet first
+/// has contact on, so that a solver without it does not compile them. Nothing when they are made.
+void addContactPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
+                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, PipelineSet& owned);
 
 /// One input of the device math check and its results (bits of floats).
 struct MathCase {

@@ -43,6 +43,24 @@ TEST_F(GpuBatchTest, OneDispatchRunsEveryQueuedSheetsTick) {
   EXPECT_EQ(batch.dispatchesPerFlush(), cpu_device ? (4 + group - 1) / group * 8 : 1u);
 }
 
+/// `sheets` with contact on in every other sheet from the second (the first has none, so the fleet
+/// sizes its contact buffers when the second is made).
+std::vector<FleetSheet> withContact(std::vector<FleetSheet> sheets) {
+  for (size_t i = 1; i < sheets.size(); i += 2) sheets[i].params.contact_factor = 0.5f;
+  return sheets;
+}
+
+TEST_F(GpuBatchTest, ContactSheetsMatchTheirRunsAloneAndTheCpu) {
+  // The fused tick's contact, each sheet as alone on the GPU solver and on the CPU reference
+  const std::vector<FleetSheet> sheets = withContact(mixedFleet(4));
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()));
+  gpu::GpuSolver alone(ctx());
+  expectFleetMatchesAlone(batch, alone, sheets, 20);
+  gpu::GpuBatch again(ctx(), uint32_t(sheets.size()));
+  CpuSolver cpu(cpuOptionsLike(ctx()));
+  expectFleetMatchesAlone(again, cpu, sheets, 20);
+}
+
 // The per-colour passes of sheets the fused tick does not take, both ways: batched (a GPU's
 // default) and sheet by sheet (a CPU device's)
 class GpuBatchPasses : public GpuTest, public testing::WithParamInterface<gpu::BatchPasses> {};
@@ -84,6 +102,14 @@ TEST_P(GpuBatchPasses, ThePerColourFleetMatchesTheCpuReference) {
   gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
   CpuSolver alone(cpuOptionsLike(ctx()));
   expectFleetMatchesAlone(batch, alone, sheets, 20);
+}
+
+TEST_P(GpuBatchPasses, LargeContactSheetsMatchTheirRunsAlone) {
+  // Sheet 1 has contact on: its passes run sheet by sheet, in either mode
+  const std::vector<FleetSheet> sheets = withContact(mixedFleet(2, 40, 52));
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
+  CpuSolver alone(cpuOptionsLike(ctx()));
+  expectFleetMatchesAlone(batch, alone, sheets, 8);
 }
 
 // Without the candidate lists (the switch the solver and the fleet both honour), every substep with
