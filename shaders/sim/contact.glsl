@@ -85,7 +85,7 @@ void contactInsert(uint k, bool scatter) {
   ivec3 a = cellOf(lo, inv), span = min(cellOf(hi, inv), a + ivec3(1)) - a;
   bool edge = k >= u.triangle_count;
   // Cell c of the box (bits: x, y, z steps), unless an earlier cell has its bucket
-  for (uint c = 0u; c < 8u; ++c) {
+  for (uint c = 0u; c < SIM_CONTACT_CELLS_PER_BOX; ++c) {
     ivec3 step = ivec3(int(c & 1u), int((c >> 1) & 1u), int(c >> 2));
     if (any(greaterThan(step, span))) continue;
     uint h = contactBucket(a + step, edge);

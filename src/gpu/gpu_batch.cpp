@@ -91,15 +91,17 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes) {
   sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
   per_sheet_ = passes == BatchPasses::PerSheet || (passes == BatchPasses::Auto && cpu_device);
   {
-    // The passes of one sheet at a time (per_sheet_, and sheets with contact, whose passes run
-    // sheet by sheet, so far)
+    // The layouts of one sheet's passes at a time (per_sheet_, and sheets with contact, whose
+    // passes run sheet by sheet so far); a batched fleet makes their pipelines when it first needs
+    // them
     sheet_set_layout_ = createSheetSetLayout(dev);
     VkPushConstantRange sheet_range{VK_SHADER_STAGE_COMPUTE_BIT, 0, uint32_t(sizeof(SimPush))};
     pli.setLayoutCount = 1;
     pli.pSetLayouts = &sheet_set_layout_;
     pli.pPushConstantRanges = &sheet_range;
     VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &sheet_layout_));
-    sheet_passes_ = makePassPipelines(ctx_, sheet_layout_, float_rules_, math_, false, owned_pipelines_);
+    if (per_sheet_)
+      sheet_passes_ = makePassPipelines(ctx_, sheet_layout_, float_rules_, math_, false, owned_pipelines_);
   }
   if (fusedTickSupported(ctx_))
     tick_batch_ = makeComputePipeline(ctx_, "tick_batch.comp", layout_, float_rules_, math_, sizeof(BatchPush), 1,
@@ -279,6 +281,8 @@ void GpuBatch::flush() {
   VkBufferCopy queue_region{0, 0, 4ull * queue.size()};
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_QUEUE].buffer, 1, &queue_region);
   const bool sheet_by_sheet = per_sheet_ || plan.contact;
+  if (plan.contact && !sheet_passes_.integrate.pipeline)
+    sheet_passes_ = makePassPipelines(ctx_, sheet_layout_, float_rules_, math_, false, owned_pipelines_);
   if (plan.contact)
     addContactPipelines(ctx_, sheet_layout_, float_rules_, math_, std::nullopt, sheet_passes_, owned_pipelines_);
   if (!passes.empty() && sheet_by_sheet) {
