@@ -33,8 +33,6 @@
   X(contact_bound, SIM, 1, 0)                                                                                          \
   X(air, SIM, 1, 1)                                                                                                    \
   X(integrate, SIM, 1, 1)                                                                                              \
-  X(project, SIM, 1, 1)                                                                                                \
-  X(crease, SIM, 1, 1)                                                                                                 \
   X(candidates_check, SIM, 1, 1)                                                                                       \
   X(candidates_decide, SIM, 1, 1)                                                                                      \
   X(hash_count, SIM, 1, 1)                                                                                             \
@@ -44,6 +42,9 @@
   X(hash_sort, SIM, 1, 1)                                                                                              \
   X(collide, SIM, 1, 1)                                                                                                \
   X(candidates_finish, SIM, 1, 1)                                                                                      \
+  X(repel, SIM, 1, 1)                                                                                                  \
+  X(project, SIM, 1, 1)                                                                                                \
+  X(crease, SIM, 1, 1)                                                                                                 \
   X(floor, SIM, 1, 1)                                                                                                  \
   X(tear_mark, SIM, 1, 1)                                                                                              \
   X(tear_unsupported, NONE, 1, 1)                                                                                      \
@@ -62,9 +63,9 @@
 //   condition  ALWAYS, or COLLISION: only while collision is on
 #define SIM_STAGES(X)                                                                                                  \
   X(integrate, 0u, ONCE, ALWAYS)                                                                                       \
-  X(project, 1u, COLOUR, ALWAYS)                                                                                       \
-  X(crease, 2u, ONCE, ALWAYS)                                                                                          \
-  X(collide, 3u, ONCE, COLLISION)                                                                                      \
+  X(collide, 1u, ONCE, COLLISION)                                                                                      \
+  X(project, 2u, COLOUR, ALWAYS)                                                                                       \
+  X(crease, 3u, ONCE, ALWAYS)                                                                                          \
   X(floor, 4u, ONCE, ALWAYS)                                                                                           \
   X(tear, 5u, ONCE, ALWAYS)
 #define SIM_STAGE_COUNT 6u
@@ -100,8 +101,6 @@
   X(integrate, contact_bound, PARTICLES, Threads, TICK, CONTACT, Contact)                                              \
   X(integrate, air, PARTICLES, Threads, AIR, AIR, Integrate)                                                           \
   X(integrate, integrate, PARTICLES, Threads, TICK, ALWAYS, Integrate)                                                 \
-  X(project, project, COLOUR, Threads, ITERATION, ALWAYS, Project)                                                     \
-  X(crease, crease, HINGES, Threads, CREASE, CREASE, Project)                                                          \
   X(collide, candidates_check, PARTICLES, Threads, COLLISION, ALWAYS, Hash)                                            \
   X(collide, candidates_decide, HASH_ARGS, Threads, COLLISION, ALWAYS, Hash)                                           \
   X(collide, hash_count, PARTICLES, Hash, HASH, ALWAYS, Hash)                                                          \
@@ -110,6 +109,9 @@
   X(collide, hash_sort, PARTICLES, Hash, HASH, ALWAYS, Hash)                                                           \
   X(collide, collide, PARTICLES, Threads, COLLISION, ALWAYS, Collide)                                                  \
   X(collide, candidates_finish, ONE, Threads, COLLISION, ALWAYS, Collide)                                              \
+  X(collide, repel, PARTICLES, Threads, COLLISION, ALWAYS, Collide)                                                    \
+  X(project, project, COLOUR, Threads, ITERATION, ALWAYS, Project)                                                     \
+  X(crease, crease, HINGES, Threads, CREASE, CREASE, Project)                                                          \
   X(floor, floor, PARTICLES, Threads, TICK, ALWAYS, Floor)                                                             \
   X(tear, tear_mark, CONSTRAINTS, Threads, TICK, CONSTRAINTS, Tear)                                                    \
   X(tear, tear_unsupported, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                       \

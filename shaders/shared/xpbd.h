@@ -145,12 +145,12 @@ SIM_INLINE VerletState floorContact(vec4 pos, vec4 prev, float floor_y, float re
   return s;
 }
 
-/// The floor pass of one particle: its collision delta (when collision is on and the particle is
-/// free), then the ground contact.
-SIM_INLINE VerletState floorParticle(vec4 pos, vec4 prev, vec3 collision_delta, uint flags, float floor_y,
-                                     float restitution, float friction) {
+/// A particle's position after its collision delta (the repel pass): moved when collision is on and
+/// the particle is free. The repulsion comes before the projection, so that the distance constraints
+/// have the last word on what it stretches.
+SIM_INLINE vec4 repelParticle(vec4 pos, vec3 collision_delta, uint flags) {
   if ((flags & SIM_FLAG_COLLISION) != 0u && pos.w > 0.0f) pos += vec4(collision_delta, 0.0f);
-  return floorContact(pos, prev, floor_y, restitution, friction);
+  return pos;
 }
 
 /// True when a constraint of this kind is stretched beyond tear_factor x rest.

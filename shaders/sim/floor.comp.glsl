@@ -1,6 +1,6 @@
 #version 460
-// Applies the collision deltas (when collision is on), then the ground contact; with contact on,
-// the contact push, and the step cut to the particle's bound (contactStep; contact.glsl).
+// The ground contact; with contact on, the contact push, and the step cut to the particle's bound
+// (contactStep; contact.glsl).
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
 #define SIM_PUSH_TYPE SimPush
@@ -10,7 +10,7 @@
 void main() {
   uint i = threadIndex();
   if (i >= p.count) return;
-  VerletState st = floorParticle(pos[i], prev[i], vec3(delta[i]), u.flags, u.floor_y, u.restitution, u.friction);
+  VerletState st = floorContact(pos[i], prev[i], u.floor_y, u.restitution, u.friction);
   // The grab puts its particle where the user says: not bounded
   bool placed = u.grab_target[p.substep].w > 0.5f && i == u.grab_index;
   if (u.contact.x > 0.0f && st.position.w > 0.0f && !placed)

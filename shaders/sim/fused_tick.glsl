@@ -162,30 +162,7 @@ void main() {
     // A new substep: no constraint torn in it yet (every invocation read the count of the last
     // substep before the barrier above).
     if (lid == 0u) counters.torn_new = 0u;
-    // 2. Gauss-Seidel over colours (as project.comp), a barrier after each colour that projects
-    // in this iteration (projectsInIteration: the same for every invocation)
-    for (uint it = 0u; it < u.iterations; ++it)
-      for (uint c = 0u; c < u.color_count; ++c) {
-        uvec2 range = color_range[c];
-        if (range.y > 0u && projectsInIteration(constraints[range.x].kind_id, it)) {
-          for (uint t = lid; t < range.y; t += kInvocations) projectConstraint(constraints[range.x + t], it);
-          sync();
-        }
-        if (stopsAfter(first_pass + project_pass + it * u.color_count + c)) {
-          storePositions(n);
-          return;
-        }
-      }
-    // 3. The creases (as crease.comp)
-    if (creasing(u.hinge.y, u.crease.y)) {
-      for (uint k = lid; k < u.hinge.y; k += kInvocations) creaseHinge(k);
-      sync();
-    }
-    if (stopsAfter(first_pass + crease_pass)) {
-      storePositions(n);
-      return;
-    }
-    // 4. Collision (as candidates_check, hash_*, collide and candidates_finish). From the candidate lists
+    // 2. Collision (as candidates_check, hash_*, collide and candidates_finish). From the candidate lists
     // while they hold every pair that can touch (no particle has travelled SIM_CANDIDATE_TRAVEL x skin
     // since they were built); otherwise from the spatial hash (count, scan, scatter, order within
     // bucket) and a search of the 27 cells around each particle, which rebuilds the lists as it
@@ -218,21 +195,50 @@ void main() {
         sync();
       }
     }
-    // 5. Each particle takes its repulsion (from the lists, or gathered here from the hash's
-    // bucket-ordered copy of the positions) and meets the floor (as floor.comp). A tick that
-    // stops after the collision keeps the repulsion in delta (as collide.comp) instead.
-    bool stop_collide = collision && stopsAfter(first_pass + collide_pass);
-    for (uint i = lid; i < n; i += kInvocations) {
-      vec4 q = s_pos[i];
-      vec3 repel = vec3(0.0f);
-      bool fits = true;
-      if (collision) repel = mode == SIM_COLLIDE_CANDIDATES ? vec3(delta[i]) : gatherParticle(i, vec3(q), mode, fits);
-      if (!fits) atomicOr(counters.candidate_flags.y, 1u);
-      if (stop_collide) {
+    // Each free particle takes its repulsion (from the lists, or gathered here from the hash's
+    // bucket-ordered copy of the positions; as collide.comp, then repel.comp), kept in delta too.
+    if (collision) {
+      for (uint i = lid; i < n; i += kInvocations) {
+        vec4 q = s_pos[i];
+        bool fits = true;
+        vec3 repel = mode == SIM_COLLIDE_CANDIDATES ? vec3(delta[i]) : gatherParticle(i, vec3(q), mode, fits);
+        if (!fits) atomicOr(counters.candidate_flags.y, 1u);
         delta[i] = vec4(repel, 0.0f);
-        continue;
+        s_pos[i] = repelParticle(q, repel, u.flags);
       }
-      VerletState st = floorParticle(q, prev[i], repel, u.flags, u.floor_y, u.restitution, u.friction);
+      sync();
+      if (lid == 0u) counters.candidate_state = candidatesNextStateOf(state, mode, counters.candidate_flags.y != 0u);
+      if (stopsAfter(first_pass + collide_pass)) {
+        storePositions(n);
+        return;
+      }
+    }
+    // 3. Gauss-Seidel over colours (as project.comp), a barrier after each colour that projects
+    // in this iteration (projectsInIteration: the same for every invocation)
+    for (uint it = 0u; it < u.iterations; ++it)
+      for (uint c = 0u; c < u.color_count; ++c) {
+        uvec2 range = color_range[c];
+        if (range.y > 0u && projectsInIteration(constraints[range.x].kind_id, it)) {
+          for (uint t = lid; t < range.y; t += kInvocations) projectConstraint(constraints[range.x + t], it);
+          sync();
+        }
+        if (stopsAfter(first_pass + project_pass + it * u.color_count + c)) {
+          storePositions(n);
+          return;
+        }
+      }
+    // 4. The creases (as crease.comp)
+    if (creasing(u.hinge.y, u.crease.y)) {
+      for (uint k = lid; k < u.hinge.y; k += kInvocations) creaseHinge(k);
+      sync();
+    }
+    if (stopsAfter(first_pass + crease_pass)) {
+      storePositions(n);
+      return;
+    }
+    // 5. The floor (as floor.comp)
+    for (uint i = lid; i < n; i += kInvocations) {
+      VerletState st = floorContact(s_pos[i], prev[i], u.floor_y, u.restitution, u.friction);
 #ifdef SIM_FUSED_CONTACT
       bool placed = u.grab_target[s].w > 0.5f && i == u.grab_index; // the grab is not bounded
       if (u.contact.x > 0.0f && st.position.w > 0.0f && !placed)
@@ -243,12 +249,10 @@ void main() {
       prev[i] = st.previous;
     }
     sync();
-    if (stop_collide || stopsAfter(first_pass + floor_pass)) {
+    if (stopsAfter(first_pass + floor_pass)) {
       storePositions(n);
       return;
     }
-    if (collision && lid == 0u)
-      counters.candidate_state = candidatesNextStateOf(state, mode, counters.candidate_flags.y != 0u);
     // 6. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
     // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
     // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the

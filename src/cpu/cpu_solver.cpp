@@ -170,16 +170,20 @@ void CpuSolver::creasePass(const SimUniforms& u) {
   });
 }
 
+void CpuSolver::repelPass(const SimUniforms& u) {
+  pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
+    for (uint32_t i = begin; i < end; ++i) pos_[i] = repelParticle(pos_[i], collision_.delta(i), u.flags);
+  });
+}
+
 void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
-  const bool collide = (u.flags & SIM_FLAG_COLLISION) != 0u;
   const bool contact = u.contact.x > 0.0f;
   const bool placed = u.grab_target[s].w > 0.5f; // the grabbed particle goes where the user puts it
   pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
     vec4* pos = pos_.data();
     vec4* prev = prev_.data();
     for (uint32_t i = begin; i < end; ++i) {
-      const vec3 d = collide ? collision_.delta(i) : vec3(0.0f);
-      VerletState st = floorParticle(pos[i], prev[i], d, u.flags, u.floor_y, u.restitution, u.friction);
+      VerletState st = floorContact(pos[i], prev[i], u.floor_y, u.restitution, u.friction);
       if (contact && st.position.w > 0.0f && !(placed && i == u.grab_index))
         st = contactStep(st, vec3(start_[i]), vec3(push_[i]), bound_[i]);
       pos[i] = st.position;
@@ -337,10 +341,11 @@ void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint3
     creasePass(u); // hinges bent past their yield move their rest angles
     break;
   case PassKind::collide:
-    collide(u); // repulsion of unconnected neighbours (Jacobi)
+    collide(u);   // repulsion of unconnected neighbours (Jacobi)
+    repelPass(u); // which the free particles take before the projection
     break;
   case PassKind::floor:
-    floorPass(u, s); // apply the repulsion, then the ground contact; bound the steps
+    floorPass(u, s); // the ground contact; bound the steps
     break;
   case PassKind::tear:
     // Tear, let go of what stood on the triangles lost, compact the colours and triangles

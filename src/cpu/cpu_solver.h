@@ -92,7 +92,9 @@ public:
   void creasePass(const shaderio::SimUniforms& u);
   /// The collision of one substep (CpuCollision::substep); returns the mode (SIM_CANDIDATE_*).
   uint32_t collide(const shaderio::SimUniforms& u) { return collision_.substep(u, pos_.data()); }
-  /// Applies the collision deltas, then the ground contact; with contact on (SimUniforms::contact),
+  /// Moves the free particles by the collision deltas (repelParticle), before the projection.
+  void repelPass(const shaderio::SimUniforms& u);
+  /// The ground contact; with contact on (SimUniforms::contact),
   /// no free particle ends farther from where it started the substep than its bound (contact.h).
   void floorPass(const shaderio::SimUniforms& u, uint32_t substep);
   /// Marks constraints beyond the tear threshold; returns how many tore.

@@ -22,16 +22,16 @@ TEST(Passes, OrderOfOneSubstep) {
   const shaderio::SimUniforms u = uniforms(3, 2, 5, true);
   ASSERT_EQ(passesPerTick(u), 3u * (1u + 10u + 1u + 1u + 1u + 1u));
   EXPECT_EQ(passAt(u, 0), (PassPoint{0, PassKind::integrate}));
-  EXPECT_EQ(passAt(u, 1), (PassPoint{0, PassKind::project, 0, 0}));
-  EXPECT_EQ(passAt(u, 7), (PassPoint{0, PassKind::project, 1, 1}));
-  EXPECT_EQ(passAt(u, 10), (PassPoint{0, PassKind::project, 1, 4}));
-  EXPECT_EQ(passAt(u, 11), (PassPoint{0, PassKind::crease}));
-  EXPECT_EQ(passAt(u, 12), (PassPoint{0, PassKind::collide}));
+  EXPECT_EQ(passAt(u, 1), (PassPoint{0, PassKind::collide}));
+  EXPECT_EQ(passAt(u, 2), (PassPoint{0, PassKind::project, 0, 0}));
+  EXPECT_EQ(passAt(u, 8), (PassPoint{0, PassKind::project, 1, 1}));
+  EXPECT_EQ(passAt(u, 11), (PassPoint{0, PassKind::project, 1, 4}));
+  EXPECT_EQ(passAt(u, 12), (PassPoint{0, PassKind::crease}));
   EXPECT_EQ(passAt(u, 13), (PassPoint{0, PassKind::floor}));
   EXPECT_EQ(passAt(u, 14), (PassPoint{0, PassKind::tear}));
   EXPECT_EQ(passAt(u, 15), (PassPoint{1, PassKind::integrate}));
-  EXPECT_EQ(describePass(passAt(u, 22)), "substep 1, project (iteration 1, colour 1)");
-  EXPECT_EQ(describePass(passAt(u, 26)), "substep 1, crease");
+  EXPECT_EQ(describePass(passAt(u, 23)), "substep 1, project (iteration 1, colour 1)");
+  EXPECT_EQ(describePass(passAt(u, 27)), "substep 1, crease");
 }
 
 TEST(Passes, IndexIsTheInverseOfPassAt) {
