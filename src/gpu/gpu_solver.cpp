@@ -67,6 +67,7 @@ void GpuSolver::createPipelines(FusedShape fused) {
   fused_workgroup_ = fused_workgroup;
   fused_substeps_ = shape.substeps_per_dispatch;
   fused_max_cell_spacings_ = shape.max_cell_spacings;
+  fused_contact_ = shape.contact > 0;
   if (fusedTickSupported(ctx_))
     pipes_.tick_fused = makeComputePipeline(ctx_, "tick_fused.comp", layout_, float_rules_, math_, sizeof(FusedPush), 1,
                                             fused_workgroup, true, owned_pipelines_);
@@ -135,7 +136,9 @@ void GpuSolver::tick(const SimUniforms& u) {
     // The contact's buffers and pipelines, the first time contact is on
     if (!layout_sizes_.contact) sizeContact();
     addContactPipelines(ctx_, layout_, float_rules_, math_,
-                        pipes_.tick_fused.pipeline ? std::optional<uint32_t>(fused_workgroup_) : std::nullopt, pipes_,
+                        pipes_.tick_fused.pipeline && fused_contact_ ? std::optional<uint32_t>(fused_workgroup_)
+                                                                     : std::nullopt,
+                        pipes_,
                         owned_pipelines_);
   }
   last_contact_ = contact;
@@ -279,6 +282,7 @@ FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested) {
   shape.max_cell_spacings = requested.max_cell_spacings != 0.0f ? requested.max_cell_spacings
                             : cpu_device                        ? SIM_FUSED_CPU_MAX_CELL_SPACINGS
                                                                 : -1.0f;
+  shape.contact = requested.contact ? requested.contact : cpu_device ? -1 : 1;
   return shape;
 }
 
@@ -305,7 +309,8 @@ bool fusedTickTakes(const SimUniforms& u, float spacing, float max_cell_spacings
 bool GpuSolver::usesFusedPath() const { return fused_allowed_ && pipes_.tick_fused.pipeline && fusedTickFits(topo_); }
 
 bool GpuSolver::usesFusedPath(const SimUniforms& u) const {
-  return usesFusedPath() && fusedTickTakes(u, spacing_, fused_max_cell_spacings_);
+  return usesFusedPath() && fusedTickTakes(u, spacing_, fused_max_cell_spacings_) &&
+         (fused_contact_ || !(u.contact.x > 0.0f));
 }
 
 } // namespace tender::gpu

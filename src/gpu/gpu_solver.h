@@ -25,6 +25,11 @@ struct FusedShape {
   uint32_t workgroup = 0;             ///< invocations of the workgroup, at most SIM_WG_FUSED
   uint32_t substeps_per_dispatch = 0; ///< substeps each dispatch runs
   float max_cell_spacings = 0.0f;     ///< largest hash cell (in grid spacings) with collision on; < 0: any
+  /// 1: the fused tick takes the ticks with contact on; -1: the per-colour passes do; 0: the
+  /// device's kind decides. A CPU device leaves them to the passes: one workgroup, which it runs on
+  /// one thread, builds and searches the contact grid of every substep slower than the passes on
+  /// all its threads (lavapipe, 2 threads, the crumple sheet at 32 x 48: 527 ms a tick against 279).
+  int contact = 0;
 };
 
 /// The fused tick's shape on this device: what `requested` sets, the device's kind's values for the rest.
@@ -108,8 +113,9 @@ public:
   void setCandidateLists(bool keep) { candidates_allowed_ = keep; }
   /// True when ticks keep collision candidate lists.
   bool usesCandidateLists() const { return keepsCandidateLists(layout_sizes_, candidates_allowed_); }
-  /// True when a tick with these uniforms runs the fused tick: the sheet is small enough and, with
-  /// collision on, the hash cell is within the shape's limit.
+  /// True when a tick with these uniforms runs the fused tick: the sheet is small enough, with
+  /// collision on the hash cell is within the shape's limit, and with contact on the shape takes
+  /// contact (FusedShape::contact).
   bool usesFusedPath(const shaderio::SimUniforms& u) const;
   /// Waits until every submitted tick has finished.
   void finish() override;
@@ -207,6 +213,7 @@ private:
   uint32_t fused_workgroup_ = 0;                ///< invocations of the fused tick's workgroup
   uint32_t fused_substeps_ = 1;                 ///< substeps per dispatch of the fused tick
   float fused_max_cell_spacings_ = -1.0f;       ///< largest hash cell of the fused tick (< 0: any)
+  bool fused_contact_ = true;                   ///< the fused tick takes ticks with contact on (FusedShape)
   float spacing_ = 0.0f;                        ///< grid spacing: the shortest structural rest length
   bool candidates_allowed_ = true;              ///< setCandidateLists
   HashGrids hash_grids_;                        ///< full grids of the hash passes, in recording order

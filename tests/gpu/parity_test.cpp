@@ -257,16 +257,23 @@ TEST_F(Parity, ContactIsTheSameOnTheGpu) {
   const SimParams yank = preset("tender", {"cols=12", "rows=16", "wind=off", "contact_factor=0.5"});
   for (bool fused : {true, false}) {
     const char* way = fused ? "fused tick" : "per-colour passes";
-    gpu::GpuSolver gpu(ctx());
+    gpu::GpuSolver gpu(ctx(), gpu::FusedShape{0, 0, 0.0f, 1}); // the fused tick takes contact on lavapipe too
     gpu.setFusedPath(fused);
     Simulation g(yank, gpu);
     g.tick();
     EXPECT_EQ(gpu.usesFusedPath(g.lastUniforms()), fused) << way;
-    auto [torn_cpu, torn_gpu] = runBoth(ctx(), yank, "0 grab particle 191\n1 move 6 -4 5\n", 10, fused);
+    auto [torn_cpu, torn_gpu] =
+        runBoth(ctx(), yank, "0 grab particle 191\n1 move 6 -4 5\n", 10, fused, gpu::FusedShape{0, 0, 0.0f, 1});
     EXPECT_GT(tornIds(torn_cpu).size(), 0u) << way;
     EXPECT_TRUE(sameState(torn_cpu, torn_gpu)) << way;
     expectSameTopology(torn_cpu, torn_gpu);
   }
+  // Unless told, a CPU device leaves the ticks with contact to the per-colour passes
+  gpu::GpuSolver plain(ctx());
+  Simulation g(yank, plain);
+  g.tick();
+  EXPECT_EQ(plain.usesFusedPath(g.lastUniforms()), ctx().properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU);
+  EXPECT_TRUE(plain.usesFusedPath());
 }
 
 TEST_F(Parity, ScriptedYankTearsTheSameConstraints) {
