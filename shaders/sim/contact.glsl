@@ -47,7 +47,14 @@ float contactInvCell() {
   return simDiv(1.0f, SIM_CONTACT_CELL_ROOM * max(longest, 2.0f * u.contact.x));
 }
 
-// The box of grid entry k (a live triangle slot or a live edge); false when k is neither
+// True when grid entry k is a live triangle slot or a live edge
+bool contactLive(uint k) {
+  if (k < u.triangle_count) return k < counters.triangle_count;
+  uint e = k - u.triangle_count;
+  return e < contactEdgeCount() && contactEdgeLive(e);
+}
+
+// The box of grid entry k (a live triangle slot or a live edge) from the positions; false when k is neither
 bool contactBox(uint k, out vec3 lo, out vec3 hi) {
   if (k < u.triangle_count) {
     if (k >= counters.triangle_count) return false;
@@ -65,6 +72,27 @@ bool contactBox(uint k, out vec3 lo, out vec3 hi) {
   return true;
 }
 
+// The boxes of the grid's live entries, as the count pass found them (six words each, after the
+// entries' SIM_CONTACT_CELLS_PER_BOX words per entry): a look-up reads two vectors instead of the
+// corners' positions
+uint contactBoxWord(uint k) {
+  return contactEntries() + SIM_CONTACT_CELLS_PER_BOX * (u.triangle_count + contactEdgeCount()) + 6u * k;
+}
+void storeBox(uint k, vec3 lo, vec3 hi) {
+  uint w = contactBoxWord(k);
+  contact_words[w] = floatBitsToUint(lo.x);
+  contact_words[w + 1u] = floatBitsToUint(lo.y);
+  contact_words[w + 2u] = floatBitsToUint(lo.z);
+  contact_words[w + 3u] = floatBitsToUint(hi.x);
+  contact_words[w + 4u] = floatBitsToUint(hi.y);
+  contact_words[w + 5u] = floatBitsToUint(hi.z);
+}
+void loadBox(uint k, out vec3 lo, out vec3 hi) {
+  uint w = contactBoxWord(k);
+  lo = uintBitsToFloat(uvec3(contact_words[w], contact_words[w + 1u], contact_words[w + 2u]));
+  hi = uintBitsToFloat(uvec3(contact_words[w + 3u], contact_words[w + 4u], contact_words[w + 5u]));
+}
+
 // True when the closed boxes [lo, hi] and [elo, ehi] meet
 bool boxesMeet(vec3 lo, vec3 hi, vec3 elo, vec3 ehi) {
   return lo.x <= ehi.x && elo.x <= hi.x && lo.y <= ehi.y && elo.y <= hi.y && lo.z <= ehi.z && elo.z <= hi.z;
@@ -77,10 +105,17 @@ uint contactBucket(ivec3 cell, bool edge) {
 }
 
 // The buckets of the cells a box of grid entry k spans, each once (two cells of a box may share a
-// bucket): counted (scatter false) or filled with k (scatter true)
+// bucket): counted (scatter false), which keeps the box, or filled with k (scatter true)
 void contactInsert(uint k, bool scatter) {
   vec3 lo, hi;
-  if (contactGoneWrong() || !contactBox(k, lo, hi)) return;
+  if (contactGoneWrong()) return;
+  if (scatter) {
+    if (!contactLive(k)) return;
+    loadBox(k, lo, hi);
+  } else {
+    if (!contactBox(k, lo, hi)) return;
+    storeBox(k, lo, hi);
+  }
   float inv = contactInvCell();
   ivec3 a = cellOf(lo, inv), span = min(cellOf(hi, inv), a + ivec3(1)) - a;
   bool edge = k >= u.triangle_count;
@@ -178,8 +213,9 @@ void contactVisit(uint visit, uint self, vec3 lo, vec3 hi) {
         uint end = scratch[contactCounts() + h + 1u];
         for (uint m = scratch[contactCounts() + h]; m < end; ++m) {
           uint k = contact_words[entries + m];
+          if (visit == CONTACT_VISIT_EDGES && k - edges_from <= self) continue; // each pair from its first edge
           vec3 elo, ehi;
-          contactBox(k, elo, ehi);
+          loadBox(k, elo, ehi);
           if (!boxesMeet(lo, hi, elo, ehi) || cellOf(max(lo, elo), inv) != cell) continue;
           if (visit == CONTACT_VISIT_TRIANGLES)
             visitTriangle(self, k);
@@ -232,7 +268,7 @@ void contactCross(uint t, uint s) {
   bool all = s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u;
   if (!crossingChecked(all, tri.xyz, u.contact_check.y, u.contact_check.z, (was & 2u) != 0u)) return;
   vec3 lo, hi;
-  contactBox(t, lo, hi);
+  loadBox(t, lo, hi);
   contactVisit(CONTACT_VISIT_CROSSING, t, lo, hi);
 }
 

@@ -138,8 +138,7 @@ void GpuSolver::tick(const SimUniforms& u) {
     addContactPipelines(ctx_, layout_, float_rules_, math_,
                         pipes_.tick_fused.pipeline && fused_contact_ ? std::optional<uint32_t>(fused_workgroup_)
                                                                      : std::nullopt,
-                        pipes_,
-                        owned_pipelines_);
+                        pipes_, owned_pipelines_);
   }
   last_contact_ = contact;
   const uint32_t index = next_in_flight_;

@@ -127,7 +127,8 @@ SheetLayout SheetLayout::of(const SheetTopology& topo, VkDeviceSize max_range, b
     l.contact_counts = std::max(l.hash_sums + scanSumsSize(topo.hash_size), l.tear_slots + SIM_WG_FUSED);
     l.contact_fill = l.contact_counts + l.contact_buckets + 1;
     l.contact_sums = l.contact_fill + l.contact_buckets;
-    l.contact_words = SIM_CONTACT_HEADER + topo.triangleCount() + uint64_t(SIM_CONTACT_CELLS_PER_BOX) * boxes;
+    // The header, a crossing flag per triangle slot, the entries and the boxes (contact.glsl)
+    l.contact_words = SIM_CONTACT_HEADER + topo.triangleCount() + uint64_t(SIM_CONTACT_CELLS_PER_BOX + 6) * boxes;
   }
   return l;
 }
