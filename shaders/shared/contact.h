@@ -16,8 +16,10 @@
 // a triangle or an edge passing an edge, so a sheet that starts a substep without crossing itself
 // ends it without. Pairs farther apart than r are not searched: they move at most 2 fraction r < r
 // towards each other. Particles held by a pin or the grab are moved by the user, not bounded.
-// Floats round: stepBound keeps pairs from closing in on each other below a margin well above the
-// rounding.
+// Floats round: stepBound takes a margin m well above the rounding off d, so pairs close in on m
+// and stop there. The push that parts pairs closer than the thickness moves a particle on top of
+// its bound, by at most SIM_CONTACT_PUSH_FRACTION x d(v) (contactPushWithin): with
+// fraction (d - m) + 0.1 d on either side, a pair d apart keeps d - 2 (0.5 d - 0.4 m) = 0.8 m.
 #ifndef SIM_CONTACT_H
 #define SIM_CONTACT_H
 #include "exact_math.h"
@@ -137,14 +139,19 @@ SIM_INLINE vec3 contactPush(vec4 x0, vec4 x1, vec4 x2, vec4 x3, ContactPair c, f
 }
 
 /// The step bound of a particle whose nearest primitive is d = sqrt(nearest2) away (at most the
-/// contact radius): `fraction` of d less the margin m = SIM_CONTACT_MARGIN x radius, and never
-/// below a quarter of d. Pairs close in on the margin without reaching it while they are farther
-/// than 4/3 m, where the bound is all it is (the rounding of the positions is far below m);
-/// nearer, a pair still moves (never held still, so a push can part it), and comes no closer
-/// than 0.8 times its distance in a substep.
+/// contact radius): `fraction` of d less the margin m = SIM_CONTACT_MARGIN x radius, zero within the
+/// margin. Two primitives moving so close in on the margin without reaching it; pressed together,
+/// they stop (the rounding of the positions is far below m), and only their push parts them.
 SIM_INLINE float stepBound(float nearest2, float radius, float fraction) {
-  float d = simSqrt(nearest2);
-  return fraction * max(d - SIM_CONTACT_MARGIN * radius, 0.25f * d);
+  return fraction * max(simSqrt(nearest2) - SIM_CONTACT_MARGIN * radius, 0.0f);
+}
+
+/// A particle's push (contactAverage) cut to SIM_CONTACT_PUSH_FRACTION of the distance to its
+/// nearest primitive, sqrt(nearest2): it moves the particle on top of its bound (contactStep), and
+/// with the bounds' fraction below 1/2 leaves every pair 0.8 x the margin apart at least.
+SIM_INLINE vec3 contactPushWithin(vec3 push, float nearest2) {
+  float most = SIM_CONTACT_PUSH_FRACTION * simSqrt(nearest2), l2 = dot3(push, push);
+  return l2 > most * most ? push * simDiv(most, simSqrt(l2)) : push;
 }
 
 /// Where a particle that moved from x0 to x this substep ends when its step may not exceed
@@ -157,11 +164,11 @@ SIM_INLINE vec3 boundedStep(vec3 x0, vec3 x, float bound) {
 }
 
 /// A free particle's substep with contact (st: where it ends after the floor and its previous
-/// position; x0: where it started; push: contactPush's average over its pairs): the push moves it
-/// without speeding it up, then the step is cut to `bound` (boundedStep). A step cut short keeps the
+/// position; x0: where it started; push: contactPushWithin): the step is cut to `bound`
+/// (boundedStep), then the push moves it without speeding it up. A step cut short keeps the
 /// particle's speed at most, along the step it made: the contact never adds energy.
 SIM_INLINE VerletState contactStep(VerletState st, vec3 x0, vec3 push, float bound) {
-  vec3 p = vec3(st.position) + push, q = vec3(st.previous) + push;
+  vec3 p = vec3(st.position), q = vec3(st.previous);
   vec3 x = boundedStep(x0, p, bound);
   if (x != p) {
     vec3 step = x - x0, v = p - q;
@@ -169,8 +176,8 @@ SIM_INLINE VerletState contactStep(VerletState st, vec3 x0, vec3 push, float bou
     q = s2 > v2 ? x - step * simDiv(simSqrt(v2), simSqrt(s2)) : x0;
   }
   VerletState r;
-  r.position = vec4(x, st.position.w);
-  r.previous = vec4(q, st.previous.w);
+  r.position = vec4(x + push, st.position.w);
+  r.previous = vec4(q + push, st.previous.w);
   return r;
 }
 

@@ -195,6 +195,9 @@
 // The least distance of two primitives, per unit of contact radius: far above the rounding of the
 // positions, so that the bound of a step (stepBound in contact.h) holds in floats
 #define SIM_CONTACT_MARGIN 1e-3f
+// The part of the distance to its nearest primitive the push may move a particle on top of its
+// bound (contactPushWithin): two sides moving 0.4 (d - m) + 0.1 d each keep 0.8 m between them
+#define SIM_CONTACT_PUSH_FRACTION 0.1f
 // The thickness of the contact, per unit of contact radius: closer pairs are pushed apart
 #define SIM_CONTACT_THICKNESS 0.5f
 // Fixed-point units of the contact pushes per unit of thickness (contactFixed), and the largest
