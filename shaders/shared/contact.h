@@ -16,8 +16,8 @@
 // a triangle or an edge passing an edge, so a sheet that starts a substep without crossing itself
 // ends it without. Pairs farther apart than r are not searched: they move at most 2 fraction r < r
 // towards each other. Particles held by a pin or the grab are moved by the user, not bounded.
-// Floats round: stepBound takes a margin m well above the rounding off d, so pairs close in on m
-// and stop there. The push that parts pairs closer than the thickness moves a particle on top of
+// Floats round: stepBound takes a margin m, far above the rounding, off d, so pairs close in on
+// m and stop there. The push that parts pairs closer than the thickness moves a particle on top of
 // its bound, by at most SIM_CONTACT_PUSH_FRACTION x d(v) (contactPushWithin): with
 // fraction (d - m) + 0.1 d on either side, a pair d apart keeps d - 2 (0.5 d - 0.4 m) = 0.8 m.
 #ifndef SIM_CONTACT_H
@@ -140,8 +140,9 @@ SIM_INLINE vec3 contactPush(vec4 x0, vec4 x1, vec4 x2, vec4 x3, ContactPair c, f
 
 /// The step bound of a particle whose nearest primitive is d = sqrt(nearest2) away (at most the
 /// contact radius): `fraction` of d less the margin m = SIM_CONTACT_MARGIN x radius, zero within the
-/// margin. Two primitives moving so close in on the margin without reaching it; pressed together,
-/// they stop (the rounding of the positions is far below m), and only their push parts them.
+/// margin. Two primitives so bounded close in on the margin without reaching it; pressed
+/// together, they stop there (the rounding of the positions is far below m), and only their push
+/// parts them.
 SIM_INLINE float stepBound(float nearest2, float radius, float fraction) {
   return fraction * max(simSqrt(nearest2) - SIM_CONTACT_MARGIN * radius, 0.0f);
 }

@@ -176,10 +176,10 @@ void visitTriangle(uint i, uint t) {
                                                            vec3(SIM_POSITION(tri.y)), vec3(SIM_POSITION(tri.z))));
 }
 
-// Edge e against edge f > e that shares no particle with it
+// Edge e against edge f > e (contactVisit passes no other) that shares no particle with it
 void visitEdge(uint e, uint f) {
   uvec2 a = contact_edges[e].xy, b = contact_edges[f].xy;
-  if (f <= e || a.x == b.x || a.x == b.y || a.y == b.x || a.y == b.y) return;
+  if (a.x == b.x || a.x == b.y || a.y == b.x || a.y == b.y) return;
   if (contactFree(a.x) || contactFree(a.y) || contactFree(b.x) || contactFree(b.y)) return;
   contactPair(uvec4(a, b), segmentSegment(vec3(SIM_POSITION(a.x)), vec3(SIM_POSITION(a.y)), vec3(SIM_POSITION(b.x)),
                                           vec3(SIM_POSITION(b.y))));
