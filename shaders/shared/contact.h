@@ -155,6 +155,14 @@ SIM_INLINE vec3 contactPushWithin(vec3 push, float nearest2) {
   return l2 > most * most ? push * simDiv(most, simSqrt(l2)) : push;
 }
 
+/// The reach of the pair lists of contact radius `radius`: they hold the pairs closer than this.
+SIM_INLINE float contactReach(float radius) { return radius * (1.0f + SIM_CONTACT_SKIN); }
+
+/// How far a particle may travel from where it was when the pair lists were built before they are
+/// built again: under half the skin, so that every pair closer than the radius is in the lists (two
+/// primitives close in by at most twice this, plus a rounding far below the rest of the skin).
+SIM_INLINE float contactTravel(float radius) { return SIM_CONTACT_TRAVEL * SIM_CONTACT_SKIN * radius; }
+
 /// Where a particle that moved from x0 to x this substep ends when its step may not exceed
 /// `bound`: x, or the point `bound` from x0 towards x.
 SIM_INLINE vec3 boundedStep(vec3 x0, vec3 x, float bound) {

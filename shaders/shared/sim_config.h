@@ -72,10 +72,13 @@
 #define SIM_BIND_HASH_ARGS 28
 // Per hinge (HingeState): its plastic rest angle, the yield its hardening added, its XPBD multiplier
 #define SIM_BIND_HINGES 29
-// Penetration-free contact (contact.h, the contact_* passes): the sheet's edges, each once (uvec4:
-// its particles a < b, then the ids of the one or two triangles that hold it, SIM_NONE for none),
-// sorted by (a, b)
-#define SIM_BIND_CONTACT_EDGES 30
+// Penetration-free contact (contact.h, the contact_* passes), in words: the sheet's edges, each once
+// (four words: its particles a < b, then the ids of the one or two triangles that hold it, SIM_NONE
+// for none), sorted by (a, b); then the pair lists (contact.glsl): SIM_CONTACT_LIST_HEADER words
+// (the triangle count they stand for, the radius, the builds), where each particle was when they
+// were built (four words each), and per query (particles, then edges) the count of its pairs and
+// SIM_CONTACT_LIST_CAPACITY slots for them
+#define SIM_BIND_CONTACT_LISTS 30
 // Per particle (ContactParticle): where it starts the substep, its bound and push, its nearest
 // distance and whether it is free, its pushes in fixed point
 #define SIM_BIND_CONTACT 31
@@ -208,8 +211,18 @@
 #define SIM_CONTACT_CHECK_ALL 1u
 // Ticks between two checks of every triangle for crossing the sheet (and the first tick with contact on)
 #define SIM_CONTACT_AUDIT_TICKS 60u
+// The pair lists' skin, per unit of contact radius: they hold every pair closer than the radius
+// and the skin, and stand until a particle has travelled SIM_CONTACT_TRAVEL skins from where it was
+// when they were built (a little under half: two particles closing in cannot lose a pair)
+#define SIM_CONTACT_SKIN 0.25f
+#define SIM_CONTACT_TRAVEL 0.45f
+// The GPU's pair lists: words of their header, and the pairs a query keeps (one with more searches
+// the grid every substep)
+#define SIM_CONTACT_LIST_HEADER 4u
+#define SIM_CONTACT_LIST_CAPACITY 16u
 // The GPU's contact grid: words of its header in SIM_BIND_CONTACT_GRID (x the bits of the longest
-// live edge's squared length, y 1 when a triangle crosses another, z the particles in contact), and
+// live edge's squared length, y 1 when a triangle crosses another, z the particles in contact, w 1
+// when the pair lists are built this substep), and
 // the cells a box spans at most (cells as wide as the longest edge and the contact diameter, with
 // room to spare for rounding: two a side)
 #define SIM_CONTACT_HEADER 4u

@@ -1,11 +1,15 @@
 // The GPU's penetration-free contact, the contact_* passes of the integrate stage (contact.h has
 // the maths and the proof). Every substep a hashed grid of the live triangles' and edges' boxes is
 // built (count -> scan -> scatter; cells as wide as the longest edge and the contact diameter, so a
-// box spans two cells a side at most), then each particle and each edge looks up the boxes near
-// it. A pair is visited once, in the cell of the low corner of the two boxes' overlap, and counts
-// when its primitives are closer than the contact radius, exactly as the CPU's lists count it
+// box spans two cells a side at most); the crossing check looks its triangles up in it. Each
+// particle and each edge (a query) keeps a list of the primitives within contactReach of it, as the
+// CPU's lists do: built from the grid when a particle has travelled contactTravel since the last
+// build (or the triangles, the radius or the audit say so), in the query's own slots, in the order
+// of the grid; a query with more than its slots (u.contact_check.w) looks the grid up every substep.
+// A pair counts when its primitives are closer than the contact radius, exactly as on the CPU
 // (CpuContact): the bounds are atomic minimums of float bits and the pushes integer sums
-// (contactFixed), so neither depends on the order of the pairs, and the bits are the CPU's.
+// (contactFixed), so neither depends on the order of the pairs or on when the lists were built,
+// and the bits are the CPU's.
 #ifndef SIM_CONTACT_GLSL
 #define SIM_CONTACT_GLSL
 #include "sim_common.glsl"
@@ -18,6 +22,12 @@
 #define CONTACT_LONGEST 0u
 #define CONTACT_TANGLED 1u
 #define CONTACT_COUNT 2u
+#define CONTACT_REBUILD 3u
+// Words of the lists' header (SIM_CONTACT_LIST_HEADER): the triangle count + 1 they were built for
+// (0: none stand), the bits of the radius, the builds so far
+#define LIST_KEY 0u
+#define LIST_RADIUS 1u
+#define LIST_BUILDS 2u
 
 // The entries of the grid, after the header and a crossing flag per triangle slot: an entry k is
 // live triangle slot k (k < u.triangle_count) or edge k - u.triangle_count
@@ -31,14 +41,34 @@ bool contactTriangleLive(uint id) {
   return id != SIM_NONE && torn[tri_edges[id].x] == 0u && torn[tri_edges[id].y] == 0u;
 }
 
-// True when edge e of SIM_BIND_CONTACT_EDGES belongs to a live triangle
+// Edge e of SIM_BIND_CONTACT_LISTS: its particles, the triangles that hold it
+uvec4 contactEdge(uint e) {
+  return uvec4(contact_lists[4u * e], contact_lists[4u * e + 1u], contact_lists[4u * e + 2u],
+               contact_lists[4u * e + 3u]);
+}
+
+// True when edge e belongs to a live triangle
 bool contactEdgeLive(uint e) {
-  return contactTriangleLive(contact_edges[e].z) || contactTriangleLive(contact_edges[e].w);
+  uvec4 edge = contactEdge(e);
+  return contactTriangleLive(edge.z) || contactTriangleLive(edge.w);
 }
 
 // The positions went wrong (an edge of no finite length): no pair is looked for and nothing moves,
 // as on the CPU
 bool contactGoneWrong() { return contact_words[CONTACT_LONGEST] >= 0x7F800000u; }
+
+// The lists' header, after the edges
+uint listHeader() { return 4u * contactEdgeCount(); }
+// Where particle i was when the lists were built
+uint listBaseWord(uint i) { return listHeader() + SIM_CONTACT_LIST_HEADER + 4u * i; }
+vec3 listBase(uint i) {
+  uint w = listBaseWord(i);
+  return uintBitsToFloat(uvec3(contact_lists[w], contact_lists[w + 1u], contact_lists[w + 2u]));
+}
+// The list of query k (particle k, or edge k - particles): its count, then its pairs
+uint listOf(uint k) { return listBaseWord(u.particle_count) + (1u + SIM_CONTACT_LIST_CAPACITY) * k; }
+// True when the lists are built in this substep
+bool listsRebuilt() { return contact_words[CONTACT_REBUILD] != 0u; }
 
 // Cells per unit of length: the cells are SIM_CONTACT_CELL_ROOM x the longest live edge or the
 // contact diameter, whichever is longer
@@ -66,7 +96,7 @@ bool contactBox(uint k, out vec3 lo, out vec3 hi) {
   }
   uint e = k - u.triangle_count;
   if (e >= contactEdgeCount() || !contactEdgeLive(e)) return false;
-  vec3 a = vec3(SIM_POSITION(contact_edges[e].x)), b = vec3(SIM_POSITION(contact_edges[e].y));
+  vec3 a = vec3(SIM_POSITION(contactEdge(e).x)), b = vec3(SIM_POSITION(contactEdge(e).y));
   lo = min(a, b);
   hi = max(a, b);
   return true;
@@ -168,21 +198,38 @@ void contactPair(uvec4 q, ContactPair c) {
 #define CONTACT_VISIT_EDGES 1u     // edge `self` against the edges after it
 #define CONTACT_VISIT_CROSSING 2u  // live triangle slot `self` against the triangles whose boxes meet its box
 
-// Particle i against live triangle slot t
-void visitTriangle(uint i, uint t) {
+// A pair of query `list` found by a build: kept when within contactReach (in the first
+// u.contact_check.w of its slots; the count goes on past them)
+void listPair(uint list, float d2, uint other) {
+  float reach = contactReach(u.contact.x);
+  if (!(d2 < reach * reach)) return;
+  uint c = contact_lists[list];
+  if (c < u.contact_check.w) contact_lists[list + 1u + c] = other;
+  contact_lists[list] = c + 1u;
+}
+
+// Particle i against live triangle slot t (list: its list when the lists are built, else SIM_NONE)
+void visitTriangle(uint i, uint t, uint list) {
   uvec4 tri = triangles[t];
-  if (i == tri.x || i == tri.y || i == tri.z || contactFree(tri.x) || contactFree(tri.y) || contactFree(tri.z)) return;
-  contactPair(uvec4(i, tri.x, tri.y, tri.z), pointTriangle(vec3(SIM_POSITION(i)), vec3(SIM_POSITION(tri.x)),
-                                                           vec3(SIM_POSITION(tri.y)), vec3(SIM_POSITION(tri.z))));
+  if (i == tri.x || i == tri.y || i == tri.z) return;
+  bool free = contactFree(i) || contactFree(tri.x) || contactFree(tri.y) || contactFree(tri.z);
+  if (free && list == SIM_NONE) return;
+  ContactPair c = pointTriangle(vec3(SIM_POSITION(i)), vec3(SIM_POSITION(tri.x)), vec3(SIM_POSITION(tri.y)),
+                                vec3(SIM_POSITION(tri.z)));
+  if (list != SIM_NONE) listPair(list, c.d2, t);
+  if (!free) contactPair(uvec4(i, tri.x, tri.y, tri.z), c);
 }
 
 // Edge e against edge f > e (contactVisit passes no other) that shares no particle with it
-void visitEdge(uint e, uint f) {
-  uvec2 a = contact_edges[e].xy, b = contact_edges[f].xy;
+void visitEdge(uint e, uint f, uint list) {
+  uvec2 a = contactEdge(e).xy, b = contactEdge(f).xy;
   if (a.x == b.x || a.x == b.y || a.y == b.x || a.y == b.y) return;
-  if (contactFree(a.x) || contactFree(a.y) || contactFree(b.x) || contactFree(b.y)) return;
-  contactPair(uvec4(a, b), segmentSegment(vec3(SIM_POSITION(a.x)), vec3(SIM_POSITION(a.y)), vec3(SIM_POSITION(b.x)),
-                                          vec3(SIM_POSITION(b.y))));
+  bool free = contactFree(a.x) || contactFree(a.y) || contactFree(b.x) || contactFree(b.y);
+  if (free && list == SIM_NONE) return;
+  ContactPair c = segmentSegment(vec3(SIM_POSITION(a.x)), vec3(SIM_POSITION(a.y)), vec3(SIM_POSITION(b.x)),
+                                 vec3(SIM_POSITION(b.y)));
+  if (list != SIM_NONE) listPair(list, c.d2, f);
+  if (!free) contactPair(uvec4(a, b), c);
 }
 
 // Live triangle slot t against slot o: when they share no particle and cross, both are marked
@@ -200,8 +247,9 @@ void visitCrossing(uint t, uint o) {
 }
 
 // Every grid entry of the kind `visit` looks for whose box meets [lo, hi], once: in the cell of the
-// low corner of the two boxes' overlap (both boxes span that cell)
-void contactVisit(uint visit, uint self, vec3 lo, vec3 hi) {
+// low corner of the two boxes' overlap (both boxes span that cell); `list`: the list a build fills
+// (SIM_NONE: none)
+void contactVisit(uint visit, uint self, vec3 lo, vec3 hi, uint list) {
   float inv = contactInvCell();
   ivec3 a = cellOf(lo, inv), b = min(cellOf(hi, inv), a + ivec3(4));
   uint entries = contactEntries(), edges_from = u.triangle_count;
@@ -218,9 +266,9 @@ void contactVisit(uint visit, uint self, vec3 lo, vec3 hi) {
           loadBox(k, elo, ehi);
           if (!boxesMeet(lo, hi, elo, ehi) || cellOf(max(lo, elo), inv) != cell) continue;
           if (visit == CONTACT_VISIT_TRIANGLES)
-            visitTriangle(self, k);
+            visitTriangle(self, k, list);
           else if (visit == CONTACT_VISIT_EDGES)
-            visitEdge(self, k - edges_from);
+            visitEdge(self, k - edges_from, list);
           else
             visitCrossing(self, k);
         }
@@ -229,9 +277,15 @@ void contactVisit(uint visit, uint self, vec3 lo, vec3 hi) {
 
 // The passes' bodies, one element each (the contact_* kernels, and the fused tick's loops)
 
-// contact_begin: the header cleared (one invocation)
-void contactBegin() {
+// contact_begin: the header cleared (one invocation); the lists are built again in substep s when
+// none stand, the triangles or the radius changed, or the audit checks every triangle (a
+// particle that travelled too far says so in contact_clear)
+void contactBegin(uint s) {
   for (uint w = 0u; w < SIM_CONTACT_HEADER; ++w) contact_words[w] = 0u;
+  bool stand = contact_lists[listHeader() + LIST_KEY] == counters.triangle_count + 1u &&
+               contact_lists[listHeader() + LIST_RADIUS] == floatBitsToUint(u.contact.x) &&
+               !(s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u);
+  if (!stand) contact_words[CONTACT_REBUILD] = 1u;
 }
 
 // Elements contact_clear covers: the particles, the buckets and their end, the triangle slots, the edges
@@ -248,13 +302,16 @@ void contactClear(uint k) {
     // Free in the last substep: bit 1 (crossingChecked looks at its triangles again)
     contact_particles[k].state = uvec4(floatBitsToUint(r * r), (contact_particles[k].state.y & 1u) << 1, 0u, 0u);
     contact_particles[k].sum = uvec4(0u);
+    vec3 d = vec3(SIM_POSITION(k)) - listBase(k);
+    float travel = contactTravel(r);
+    if (!(dot3(d, d) < travel * travel)) atomicOr(contact_words[CONTACT_REBUILD], 1u);
   }
   uint buckets = 2u * (u.contact_grid.x + 1u); // the triangles' and the edges'
   if (k <= buckets) scratch[contactCounts() + k] = 0u;
   if (k < buckets) scratch[contactFill() + k] = 0u;
   if (k < u.triangle_count) contact_words[SIM_CONTACT_HEADER + k] = 0u;
   if (k < contactEdgeCount() && contactEdgeLive(k)) {
-    vec3 d = vec3(SIM_POSITION(contact_edges[k].y)) - vec3(SIM_POSITION(contact_edges[k].x));
+    vec3 d = vec3(SIM_POSITION(contactEdge(k).y)) - vec3(SIM_POSITION(contactEdge(k).x));
     atomicMax(contact_words[CONTACT_LONGEST], floatBitsToUint(dot3(d, d)));
   }
 }
@@ -269,7 +326,7 @@ void contactCross(uint t, uint s) {
   if (!crossingChecked(all, tri.xyz, u.contact_check.y, u.contact_check.z, (was & 2u) != 0u)) return;
   vec3 lo, hi;
   loadBox(t, lo, hi);
-  contactVisit(CONTACT_VISIT_CROSSING, t, lo, hi);
+  contactVisit(CONTACT_VISIT_CROSSING, t, lo, hi, SIM_NONE);
 }
 
 // contact_free: the particles of live triangle slot t go free when it crosses another
@@ -282,27 +339,56 @@ void contactFreeOf(uint t) {
 }
 
 // contact_near: particle k against the triangles near it, or (k past the particles) edge
-// k - particles against the edges near it. The boxes are widened a little past the radius: which
-// pairs count is their distance's call.
+// k - particles against the edges near it: through its list, or when the lists are built (or its
+// list overflowed) through the grid, its box widened past the reach (or the radius): which pairs
+// are kept and which count is their distance's call.
 void contactNear(uint k) {
   if (contactGoneWrong()) return;
-  float reach = 1.01f * u.contact.x;
+  uint list = listOf(k);
+  bool build = listsRebuilt();
+  if (build) contact_lists[list] = 0u;
+  bool search = build || contact_lists[list] > u.contact_check.w;
+  float reach = (build ? 1.01f * contactReach(u.contact.x) : 1.01f * u.contact.x);
+  uint into = build ? list : SIM_NONE;
   if (k < u.particle_count) {
-    if (contactFree(k)) return;
     vec3 x = vec3(SIM_POSITION(k));
-    contactVisit(CONTACT_VISIT_TRIANGLES, k, x - vec3(reach), x + vec3(reach));
+    if (build) {
+      uint w = listBaseWord(k);
+      contact_lists[w] = floatBitsToUint(x.x);
+      contact_lists[w + 1u] = floatBitsToUint(x.y);
+      contact_lists[w + 2u] = floatBitsToUint(x.z);
+    } else if (contactFree(k)) {
+      return;
+    }
+    if (search) {
+      contactVisit(CONTACT_VISIT_TRIANGLES, k, x - vec3(reach), x + vec3(reach), into);
+      return;
+    }
+    uint count = contact_lists[list];
+    for (uint j = 0u; j < count; ++j) visitTriangle(k, contact_lists[list + 1u + j], SIM_NONE);
     return;
   }
   uint e = k - u.particle_count;
   if (e >= contactEdgeCount() || !contactEdgeLive(e)) return;
-  vec3 a = vec3(SIM_POSITION(contact_edges[e].x)), b = vec3(SIM_POSITION(contact_edges[e].y));
-  contactVisit(CONTACT_VISIT_EDGES, e, min(a, b) - vec3(reach), max(a, b) + vec3(reach));
+  if (search) {
+    vec3 a = vec3(SIM_POSITION(contactEdge(e).x)), b = vec3(SIM_POSITION(contactEdge(e).y));
+    contactVisit(CONTACT_VISIT_EDGES, e, min(a, b) - vec3(reach), max(a, b) + vec3(reach), into);
+    return;
+  }
+  uint count = contact_lists[list];
+  for (uint j = 0u; j < count; ++j) visitEdge(e, contact_lists[list + 1u + j], SIM_NONE);
 }
 
 // contact_bound: particle i's step bound (stepBound; unbounded when free) and push
 // (contactAverage); the particles in contact counted
 void contactBound(uint i) {
   float r = u.contact.x;
+  if (i == 0u && listsRebuilt()) {
+    // The lists stand for these triangles and this radius (none when the positions went wrong)
+    contact_lists[listHeader() + LIST_KEY] = contactGoneWrong() ? 0u : counters.triangle_count + 1u;
+    contact_lists[listHeader() + LIST_RADIUS] = floatBitsToUint(r);
+    contact_lists[listHeader() + LIST_BUILDS] += 1u;
+  }
   uint nearest = contactGoneWrong() ? 0u : contact_particles[i].state.x;
   if (nearest < floatBitsToUint(r * r)) atomicAdd(contact_words[CONTACT_COUNT], 1u);
   contact_particles[i].start.w =

@@ -1,5 +1,6 @@
 #version 460
-// Contact (contact.glsl): clears the grid's header for the substep (one invocation).
+// Contact (contact.glsl): clears the grid's header for the substep and says whether the pair lists are
+// built again (one invocation).
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
 #define SIM_PUSH_TYPE SimPush
@@ -7,5 +8,5 @@
 #include "sim_common.glsl"
 
 void main() {
-  if (threadIndex() == 0u) contactBegin();
+  if (threadIndex() == 0u) contactBegin(p.substep);
 }

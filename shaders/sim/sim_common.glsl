@@ -67,8 +67,8 @@ Vec4Ref g_hinges;
 UintRef g_adj_offsets, g_adj_list, g_adj_mask, g_cell_count, g_cell_start, g_cell_particles, g_particle_cell, g_torn,
     g_scratch, g_cell_scatter, g_candidates;
 Uvec4Ref g_triangles, g_compact_tmp, g_cell_pos;
-Uvec4Ref g_hash_args, g_contact_edges;
-UintRef g_contact_grid;
+Uvec4Ref g_hash_args;
+UintRef g_contact_grid, g_contact_lists;
 ContactRef g_contact;
 CountersRef g_counters;
 
@@ -111,9 +111,9 @@ void bindSheet(uint sheet) {
   g_hash_args = Uvec4Ref(batchSlice(SIM_BIND_HASH_ARGS, sheet));
   g_counters = CountersRef(batchSlice(SIM_BIND_COUNTERS, sheet));
   g_hinges = Vec4Ref(batchSlice(SIM_BIND_HINGES, sheet));
-  g_contact_edges = Uvec4Ref(batchSlice(SIM_BIND_CONTACT_EDGES, sheet));
   g_contact = ContactRef(batchSlice(SIM_BIND_CONTACT, sheet));
   g_contact_grid = UintRef(batchSlice(SIM_BIND_CONTACT_GRID, sheet));
+  g_contact_lists = UintRef(batchSlice(SIM_BIND_CONTACT_LISTS, sheet));
 }
 #define u g_u.v
 #define pos g_pos.v
@@ -143,9 +143,9 @@ void bindSheet(uint sheet) {
 #define hash_args g_hash_args.v
 #define counters g_counters.v
 #define hinges g_hinges.v
-#define contact_edges g_contact_edges.v
 #define contact_particles g_contact.v
 #define contact_words g_contact_grid.v
+#define contact_lists g_contact_lists.v
 #else
 layout(std140, set = 0, binding = SIM_BIND_UNIFORMS) uniform UniformsBlock { SimUniforms u; };
 layout(std430, set = 0, binding = SIM_BIND_POS) SIM_COHERENT buffer PosBuffer { vec4 pos[]; };
@@ -190,7 +190,9 @@ layout(std430, set = 0, binding = SIM_BIND_CANDIDATE_BASE) SIM_COHERENT buffer C
 layout(std430, set = 0, binding = SIM_BIND_HASH_ARGS) SIM_COHERENT buffer HashArgsBuffer { uvec4 hash_args[]; };
 layout(std430, set = 0, binding = SIM_BIND_HINGES) SIM_COHERENT buffer HingeBuffer { HingeState hinges[]; };
 // Penetration-free contact (contact.glsl)
-layout(std430, set = 0, binding = SIM_BIND_CONTACT_EDGES) readonly buffer ContactEdgeBuffer { uvec4 contact_edges[]; };
+layout(std430, set = 0, binding = SIM_BIND_CONTACT_LISTS) SIM_COHERENT buffer ContactListBuffer {
+  uint contact_lists[];
+};
 layout(std430, set = 0, binding = SIM_BIND_CONTACT) SIM_COHERENT buffer ContactBuffer {
   ContactParticle contact_particles[];
 };

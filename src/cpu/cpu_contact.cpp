@@ -100,11 +100,11 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
     edges_key_ = count;
     lists_ = false;
   }
-  const float r = radius, r2 = r * r, skin = kSkin * radius;
-  // The pair lists hold every pair that can be closer than r while no particle is skin / 2 or more
-  // from where it was when they were built (a little less, so that rounding cannot lose a pair)
+  const float r = radius, r2 = r * r;
+  // The pair lists hold every pair that can be closer than r while no particle has travelled
+  // contactTravel from where it was when they were built
   bool fresh = lists_ && list_radius_ == radius && base_.size() == n;
-  const float travel = 0.45f * skin;
+  const float travel = contactTravel(radius);
   for (uint32_t i = 0; fresh && i < n; ++i) {
     const vec3 d = vec3(pos[i]) - vec3(base_[i]);
     fresh = dot3(d, d) < travel * travel;
@@ -223,7 +223,7 @@ void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vec
 
 void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
                             float radius) {
-  const float reach = radius * (1.0f + kSkin);
+  const float reach = contactReach(radius);
   const uint32_t n = uint32_t(pos.size()), edge_count = uint32_t(edges_.size());
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
   vf_.clear();

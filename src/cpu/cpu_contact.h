@@ -48,15 +48,13 @@ private:
     void build(const std::vector<glm::vec3>& lo, const std::vector<glm::vec3>& hi, float inv_cell);
   };
 
-  /// The pair lists' skin, per unit of contact radius
-  static constexpr float kSkin = 0.25f;
   /// Box tests below which the crossing check tests its triangles against every triangle
   static constexpr uint64_t kBruteForceTests = 1u << 20;
   /// Sets free_ to the particles of the triangles that cross another, among the pairs with one of
   /// the triangles crossingChecked names (contact.h); the last call's free_ is was_free_.
   void findCrossings(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                      bool all, uint32_t grab_now, uint32_t grab_last);
-  /// Lists the particle-triangle and edge-edge pairs closer than radius + skin at `pos`.
+  /// Lists the particle-triangle and edge-edge pairs closer than contactReach at `pos`.
   void buildLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                   float radius);
 

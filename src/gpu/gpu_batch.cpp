@@ -237,6 +237,7 @@ void GpuBatch::flush() {
                                  "needs it set when its sheets are made");
       u.contact_grid =
           glm::uvec4(sizes_.contact_buckets / 2 - 1, sizes_.contact_counts, sizes_.contact_fill, sizes_.contact_edges);
+      u.contact_check.w = SIM_CONTACT_LIST_CAPACITY;
     }
     ticked_ = true;
     if (keepsCandidateLists(sizes_, candidates_allowed_)) u.flags |= SIM_FLAG_CANDIDATES; // as the solver does

@@ -106,7 +106,7 @@ void GpuSolver::sizeContact() {
   StartData start;
   std::vector<BindingSpec> table = sheetBindings(topo_, sizes, start, false);
   std::erase_if(table, [](const BindingSpec& b) {
-    return b.binding != SIM_BIND_SCRATCH && b.binding != SIM_BIND_CONTACT_EDGES && b.binding != SIM_BIND_CONTACT &&
+    return b.binding != SIM_BIND_SCRATCH && b.binding != SIM_BIND_CONTACT_LISTS && b.binding != SIM_BIND_CONTACT &&
            b.binding != SIM_BIND_CONTACT_GRID;
   });
   for (const BindingSpec& b : table)
@@ -148,6 +148,14 @@ int64_t GpuSolver::contacts() const {
   const_cast<GpuSolver*>(this)->finish();
   uint32_t header[SIM_CONTACT_HEADER];
   ctx_.download(buf_[SIM_BIND_CONTACT_GRID], header, sizeof(header));
+  return header[2];
+}
+
+uint32_t GpuSolver::contactListBuilds() {
+  if (!layout_sizes_.contact) return 0;
+  finish();
+  uint32_t header[SIM_CONTACT_LIST_HEADER];
+  ctx_.download(buf_[SIM_BIND_CONTACT_LISTS], header, sizeof(header), 16ull * layout_sizes_.contact_edges);
   return header[2];
 }
 

@@ -148,9 +148,11 @@ void GpuSolver::tick(const SimUniforms& u) {
   waitFor(flight);
   SimUniforms gpu_u = u;
   if (usesCandidateLists()) gpu_u.flags |= SIM_FLAG_CANDIDATES;
-  if (contact)
+  if (contact) {
     gpu_u.contact_grid = glm::uvec4(layout_sizes_.contact_buckets / 2 - 1, layout_sizes_.contact_counts,
                                     layout_sizes_.contact_fill, layout_sizes_.contact_edges);
+    gpu_u.contact_check.w = contact_list_capacity_;
+  }
   std::memcpy(static_cast<char*>(buf_[SIM_BIND_UNIFORMS].mapped) + index * uniform_stride_, &gpu_u, sizeof(gpu_u));
   if (u.reset_active) {
     ctx_.submit(flight.reset, flight.fence);

@@ -113,6 +113,11 @@ public:
   void setCandidateLists(bool keep) { candidates_allowed_ = keep; }
   /// True when ticks keep collision candidate lists.
   bool usesCandidateLists() const { return keepsCandidateLists(layout_sizes_, candidates_allowed_); }
+  /// The pairs each contact query keeps in its list (SIM_CONTACT_LIST_CAPACITY, or fewer: the tests
+  /// make queries overflow, which then search the grid every substep).
+  void setContactListCapacity(uint32_t pairs) { contact_list_capacity_ = std::min(pairs, SIM_CONTACT_LIST_CAPACITY); }
+  /// How many times the contact's pair lists have been built (0 before contact runs).
+  uint32_t contactListBuilds();
   /// True when a tick with these uniforms runs the fused tick: the sheet is small enough, with
   /// collision on the hash cell is within the shape's limit, and with contact on the shape takes
   /// contact (FusedShape::contact).
@@ -208,17 +213,18 @@ private:
   VkPipeline bound_ = VK_NULL_HANDLE; ///< pipeline bound while recording
   uint32_t recorded_dispatches_ = 0;
   bool fused_allowed_ = true;
-  FloatRules float_rules_;                      ///< what the shaders' SPIR-V asks of the device's float arithmetic
-  MathSwitches math_;                           ///< the switches of exact_math.h (from the environment)
-  uint32_t fused_workgroup_ = 0;                ///< invocations of the fused tick's workgroup
-  uint32_t fused_substeps_ = 1;                 ///< substeps per dispatch of the fused tick
-  float fused_max_cell_spacings_ = -1.0f;       ///< largest hash cell of the fused tick (< 0: any)
-  bool fused_contact_ = true;                   ///< the fused tick takes ticks with contact on (FusedShape)
-  float spacing_ = 0.0f;                        ///< grid spacing: the shortest structural rest length
-  bool candidates_allowed_ = true;              ///< setCandidateLists
-  HashGrids hash_grids_;                        ///< full grids of the hash passes, in recording order
-  std::vector<glm::uvec4> hash_grids_uploaded_; ///< what SIM_BIND_HASH_ARGS holds of them
-  uint32_t stop_after_ = SIM_NONE;              ///< stopNextTickAfter
+  FloatRules float_rules_;                ///< what the shaders' SPIR-V asks of the device's float arithmetic
+  MathSwitches math_;                     ///< the switches of exact_math.h (from the environment)
+  uint32_t fused_workgroup_ = 0;          ///< invocations of the fused tick's workgroup
+  uint32_t fused_substeps_ = 1;           ///< substeps per dispatch of the fused tick
+  float fused_max_cell_spacings_ = -1.0f; ///< largest hash cell of the fused tick (< 0: any)
+  bool fused_contact_ = true;             ///< the fused tick takes ticks with contact on (FusedShape)
+  float spacing_ = 0.0f;                  ///< grid spacing: the shortest structural rest length
+  bool candidates_allowed_ = true;        ///< setCandidateLists
+  uint32_t contact_list_capacity_ = SIM_CONTACT_LIST_CAPACITY; ///< setContactListCapacity
+  HashGrids hash_grids_;                                       ///< full grids of the hash passes, in recording order
+  std::vector<glm::uvec4> hash_grids_uploaded_;                ///< what SIM_BIND_HASH_ARGS holds of them
+  uint32_t stop_after_ = SIM_NONE;                             ///< stopNextTickAfter
   mutable std::array<double, kCategoryCount> last_ms_{};
 };
 

@@ -129,6 +129,9 @@ SheetLayout SheetLayout::of(const SheetTopology& topo, VkDeviceSize max_range, b
     l.contact_sums = l.contact_fill + l.contact_buckets;
     // The header, a crossing flag per triangle slot, the entries and the boxes (contact.glsl)
     l.contact_words = SIM_CONTACT_HEADER + topo.triangleCount() + uint64_t(SIM_CONTACT_CELLS_PER_BOX + 6) * boxes;
+    // The edges, then the lists' header, where each particle was, each query's count and pairs
+    l.contact_list_words = 4ull * l.contact_edges + SIM_CONTACT_LIST_HEADER + 4ull * topo.particleCount() +
+                           uint64_t(1 + SIM_CONTACT_LIST_CAPACITY) * (topo.particleCount() + l.contact_edges);
   }
   return l;
 }
@@ -201,7 +204,7 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
       // Interaction
       spec(SIM_BIND_PICK, sizeof(PickResult)),
       // Contact (a word each while it is not sized): the edges, and what a reset clears
-      spec(SIM_BIND_CONTACT_EDGES, layout.contact ? bytesOf(d.contact_edges) : 16, d.contact_edges.data(),
+      spec(SIM_BIND_CONTACT_LISTS, layout.contact ? 4ull * layout.contact_list_words : 16, d.contact_edges.data(),
            bytesOf(d.contact_edges)),
       spec(SIM_BIND_CONTACT, layout.contact ? sizeof(ContactParticle) * n : 16, nullptr, 0, kRestored),
       spec(SIM_BIND_CONTACT_GRID, layout.contact ? 4ull * layout.contact_words : 16),

@@ -22,10 +22,10 @@ struct SheetLayout {
   /// Penetration-free contact: its buffers are sized (else one word each); the sheet's edges; the
   /// contact grid's buckets (two halves of a power of two: the triangles', the edges'); the scratch offsets of the
   /// buckets' counts (then starts, buckets + 1 of them), of their fills and of the counts' scan sums; the words of
-  /// SIM_BIND_CONTACT_GRID
+  /// SIM_BIND_CONTACT_GRID, and of SIM_BIND_CONTACT_LISTS (the edges, then the lists)
   bool contact = false;
   uint32_t contact_edges = 0, contact_buckets = 0, contact_counts = 0, contact_fill = 0, contact_sums = 0;
-  uint64_t contact_words = 0;
+  uint64_t contact_words = 0, contact_list_words = 0;
   /// The layout of a topology on a device that binds at most `max_range` bytes, with the contact's
   /// buffers sized or not.
   static SheetLayout of(const SheetTopology& topo, VkDeviceSize max_range, bool contact = false);
@@ -73,7 +73,7 @@ VkDescriptorPool createSheetSetPool(VkDevice dev, uint32_t sets);
 void writeSheetSet(VkDevice dev, VkDescriptorSet set,
                    const std::array<VkDescriptorBufferInfo, kSheetBindingCount>& where);
 
-/// The sheet's edges, each once, sorted by their particles (SIM_BIND_CONTACT_EDGES): xy its
+/// The sheet's edges, each once, sorted by their particles (SIM_BIND_CONTACT_LISTS): xy its
 /// particles a < b, zw the ids of the triangles that hold it (w SIM_NONE when only one does).
 std::vector<glm::uvec4> contactEdges(const SheetTopology& topo);
 

@@ -242,16 +242,20 @@ TEST_F(Parity, ContactIsTheSameOnTheGpu) {
   EXPECT_GT(crossed, 0u);
   EXPECT_LT(left, crossed);
   EXPECT_GT(cpu.contacts(), 0);
-  {
-    // On the per-colour passes (the fused tick takes the yank below)
+  for (uint32_t capacity : {SIM_CONTACT_LIST_CAPACITY, 1u}) {
+    // On the per-colour passes (the fused tick takes the yank below); with lists of one pair, the
+    // queries with more search the grid every substep, with the same bits
     gpu::GpuSolver gpu(ctx());
     gpu.setFusedPath(false);
+    gpu.setContactListCapacity(capacity);
     Simulation g(p, gpu);
     g.setScript(script(text.c_str()));
     run(g, 29);
     const SimState gpu_end = run(g, 45);
-    EXPECT_EQ(cpu.contacts(), gpu.contacts());
-    EXPECT_TRUE(sameState(cpu_end, gpu_end));
+    EXPECT_EQ(cpu.contacts(), gpu.contacts()) << capacity << " pairs a list";
+    EXPECT_TRUE(sameState(cpu_end, gpu_end)) << capacity << " pairs a list";
+    std::printf("%u pairs a list: the lists were built %u times in %u substeps\n", capacity, gpu.contactListBuilds(),
+                45 * p.substeps);
   }
   // A yank that tears the sheet with contact on from the start: torn triangles stop colliding at once
   const SimParams yank = preset("tender", {"cols=12", "rows=16", "wind=off", "contact_factor=0.5"});
