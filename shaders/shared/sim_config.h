@@ -222,12 +222,15 @@
 #define SIM_CONTACT_LIST_CAPACITY 16u
 // The GPU's contact grid: words of its header in SIM_BIND_CONTACT_GRID (x the bits of the longest
 // live edge's squared length, y 1 when a triangle crosses another, z the particles in contact, w 1
-// when the pair lists are built this substep), and
+// when the pair lists are built this substep, then 1 when the grid is built this substep and 1 when a
+// list overflowed in this substep's build), and
 // the cells a box spans at most (cells as wide as the longest edge and the contact diameter, with
 // room to spare for rounding: two a side)
-#define SIM_CONTACT_HEADER 4u
+#define SIM_CONTACT_HEADER 8u
 #define SIM_CONTACT_CELLS_PER_BOX 8u
 #define SIM_CONTACT_CELL_ROOM 1.01f
+// Buckets one invocation of contact_grid_clear clears
+#define SIM_CONTACT_CLEAR_PER_THREAD 32u
 
 // Largest workgroup count in X of one dispatch; bigger grids spill into Y
 #define SIM_MAX_GROUPS_X 65535u

@@ -25,6 +25,7 @@
 #define SIM_KERNELS(X)                                                                                                 \
   X(contact_begin, SIM, 1, 0)                                                                                          \
   X(contact_clear, SIM, 1, 0)                                                                                          \
+  X(contact_grid_clear, SIM, SIM_CONTACT_CLEAR_PER_THREAD, 0)                                                          \
   X(contact_count, SIM, 1, 0)                                                                                          \
   X(contact_scatter, SIM, 1, 0)                                                                                        \
   X(contact_cross, SIM, 1, 0)                                                                                          \
@@ -80,6 +81,7 @@
 //             arguments), HASH_CELLS and TEAR_SLOTS (a scan of the hash's cells or of the
 //             compaction's slots), INDIRECT (the grid's arguments, no push constants); contact's:
 //             TRIANGLES (the triangle slots), CONTACT_SLOTS (whatever its clearing covers),
+//             CONTACT_BUCKETS (its grid's buckets and their end),
 //             CONTACT_BOXES (triangle slots, then edges), CONTACT_QUERIES (particles, then
 //             edges), CONTACT_CELLS (a scan of its grid's buckets)
 //   grid      Threads (from the elements), Hash (the live hash arguments candidates_decide
@@ -92,6 +94,7 @@
 #define SIM_DISPATCHES(X)                                                                                              \
   X(integrate, contact_begin, ONE, Threads, TICK, CONTACT, Contact)                                                    \
   X(integrate, contact_clear, CONTACT_SLOTS, Threads, TICK, CONTACT, Contact)                                          \
+  X(integrate, contact_grid_clear, CONTACT_BUCKETS, Threads, TICK, CONTACT, Contact)                                   \
   X(integrate, contact_count, CONTACT_BOXES, Threads, TICK, CONTACT, Contact)                                          \
   X(integrate, scan, CONTACT_CELLS, Threads, TICK, CONTACT, Contact)                                                   \
   X(integrate, contact_scatter, CONTACT_BOXES, Threads, TICK, CONTACT, Contact)                                        \

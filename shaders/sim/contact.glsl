@@ -23,11 +23,14 @@
 #define CONTACT_TANGLED 1u
 #define CONTACT_COUNT 2u
 #define CONTACT_REBUILD 3u
+#define CONTACT_GRID 4u
+#define CONTACT_OVERFLOW 5u
 // Words of the lists' header (SIM_CONTACT_LIST_HEADER): the triangle count + 1 they were built for
 // (0: none stand), the bits of the radius, the builds so far
 #define LIST_KEY 0u
 #define LIST_RADIUS 1u
 #define LIST_BUILDS 2u
+#define LIST_SEARCH 3u // 1: a query overflowed its slots at the last build (it searches the grid)
 
 // The entries of the grid, after the header and a crossing flag per triangle slot: an entry k is
 // live triangle slot k (k < u.triangle_count) or edge k - u.triangle_count
@@ -69,6 +72,9 @@ vec3 listBase(uint i) {
 uint listOf(uint k) { return listBaseWord(u.particle_count) + (1u + SIM_CONTACT_LIST_CAPACITY) * k; }
 // True when the lists are built in this substep
 bool listsRebuilt() { return contact_words[CONTACT_REBUILD] != 0u; }
+// True when the grid is built in this substep: the lists are, a query searches it, or the crossing
+// check looks at a triangle
+bool gridBuilt() { return contact_words[CONTACT_GRID] != 0u; }
 
 // Cells per unit of length: the cells are SIM_CONTACT_CELL_ROOM x the longest live edge or the
 // contact diameter, whichever is longer
@@ -138,7 +144,7 @@ uint contactBucket(ivec3 cell, bool edge) {
 // bucket): counted (scatter false), which keeps the box, or filled with k (scatter true)
 void contactInsert(uint k, bool scatter) {
   vec3 lo, hi;
-  if (contactGoneWrong()) return;
+  if (contactGoneWrong() || !gridBuilt()) return;
   if (scatter) {
     if (!contactLive(k)) return;
     loadBox(k, lo, hi);
@@ -204,7 +210,10 @@ void listPair(uint list, float d2, uint other) {
   float reach = contactReach(u.contact.x);
   if (!(d2 < reach * reach)) return;
   uint c = contact_lists[list];
-  if (c < u.contact_check.w) contact_lists[list + 1u + c] = other;
+  if (c < u.contact_check.w)
+    contact_lists[list + 1u + c] = other;
+  else if (c == u.contact_check.w)
+    contact_words[CONTACT_OVERFLOW] = 1u;
   contact_lists[list] = c + 1u;
 }
 
@@ -279,22 +288,28 @@ void contactVisit(uint visit, uint self, vec3 lo, vec3 hi, uint list) {
 
 // contact_begin: the header cleared (one invocation); the lists are built again in substep s when
 // none stand, the triangles or the radius changed, or the audit checks every triangle (a
-// particle that travelled too far says so in contact_clear)
+// particle that travelled too far says so in contact_clear), and the grid when they are, when a
+// list overflowed at the last build, or when crossingChecked may name a triangle: the audit, the
+// grab's (now or the last tick), or a particle free in the last substep (a triangle crossed)
 void contactBegin(uint s) {
+  bool crossed = contact_words[CONTACT_TANGLED] != 0u;
   for (uint w = 0u; w < SIM_CONTACT_HEADER; ++w) contact_words[w] = 0u;
+  bool audit = s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u;
   bool stand = contact_lists[listHeader() + LIST_KEY] == counters.triangle_count + 1u &&
-               contact_lists[listHeader() + LIST_RADIUS] == floatBitsToUint(u.contact.x) &&
-               !(s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u);
+               contact_lists[listHeader() + LIST_RADIUS] == floatBitsToUint(u.contact.x) && !audit;
+  bool check = audit || crossed || u.contact_check.y != SIM_NONE || u.contact_check.z != SIM_NONE;
   if (!stand) contact_words[CONTACT_REBUILD] = 1u;
+  if (!stand || check || contact_lists[listHeader() + LIST_SEARCH] != 0u) contact_words[CONTACT_GRID] = 1u;
 }
 
-// Elements contact_clear covers: the particles, the buckets and their end, the triangle slots, the edges
-uint contactSlots() {
-  return max(max(u.particle_count, 2u * (u.contact_grid.x + 1u) + 1u), max(u.triangle_count, contactEdgeCount()));
-}
+// Elements contact_clear covers: the particles, the triangle slots, the edges
+uint contactSlots() { return max(u.particle_count, max(u.triangle_count, contactEdgeCount())); }
+// Elements contact_grid_clear covers: the buckets and their end
+uint contactBucketSlots() { return 2u * (u.contact_grid.x + 1u) + 1u; }
 
-// contact_clear: particle k's start of the substep; bucket k and triangle slot k cleared; edge k's
-// squared length raises the longest
+// contact_clear: particle k's start of the substep (one that travelled too far since the lists were
+// built has them built again, and the grid); triangle slot k cleared; edge k's squared length
+// raises the longest
 void contactClear(uint k) {
   if (k < u.particle_count) {
     float r = u.contact.x;
@@ -304,11 +319,11 @@ void contactClear(uint k) {
     contact_particles[k].sum = uvec4(0u);
     vec3 d = vec3(SIM_POSITION(k)) - listBase(k);
     float travel = contactTravel(r);
-    if (!(dot3(d, d) < travel * travel)) atomicOr(contact_words[CONTACT_REBUILD], 1u);
+    if (!(dot3(d, d) < travel * travel)) {
+      atomicOr(contact_words[CONTACT_REBUILD], 1u);
+      atomicOr(contact_words[CONTACT_GRID], 1u);
+    }
   }
-  uint buckets = 2u * (u.contact_grid.x + 1u); // the triangles' and the edges'
-  if (k <= buckets) scratch[contactCounts() + k] = 0u;
-  if (k < buckets) scratch[contactFill() + k] = 0u;
   if (k < u.triangle_count) contact_words[SIM_CONTACT_HEADER + k] = 0u;
   if (k < contactEdgeCount() && contactEdgeLive(k)) {
     vec3 d = vec3(SIM_POSITION(contactEdge(k).y)) - vec3(SIM_POSITION(contactEdge(k).x));
@@ -316,10 +331,18 @@ void contactClear(uint k) {
   }
 }
 
+// contact_grid_clear: bucket k cleared when the grid is built
+void contactGridClear(uint k) {
+  if (!gridBuilt()) return;
+  uint buckets = 2u * (u.contact_grid.x + 1u); // the triangles' and the edges'
+  if (k <= buckets) scratch[contactCounts() + k] = 0u;
+  if (k < buckets) scratch[contactFill() + k] = 0u;
+}
+
 // contact_cross: live triangle slot t, when crossingChecked names it in substep s, against every
 // triangle whose box meets its box
 void contactCross(uint t, uint s) {
-  if (t >= counters.triangle_count || contactGoneWrong()) return;
+  if (t >= counters.triangle_count || contactGoneWrong() || !gridBuilt()) return;
   uvec4 tri = triangles[t];
   uint was = contact_particles[tri.x].state.y | contact_particles[tri.y].state.y | contact_particles[tri.z].state.y;
   bool all = s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u;
@@ -346,8 +369,22 @@ void contactNear(uint k) {
   if (contactGoneWrong()) return;
   uint list = listOf(k);
   bool build = listsRebuilt();
+  if (!build) {
+    // Through its list (which holds only live primitives: a tear builds the lists again)
+    uint count = contact_lists[list];
+    if (count == 0u) return;
+    if (count <= u.contact_check.w) {
+      if (k < u.particle_count) {
+        if (contactFree(k)) return;
+        for (uint j = 0u; j < count; ++j) visitTriangle(k, contact_lists[list + 1u + j], SIM_NONE);
+      } else {
+        for (uint j = 0u; j < count; ++j) visitEdge(k - u.particle_count, contact_lists[list + 1u + j], SIM_NONE);
+      }
+      return;
+    }
+  }
+  // Through the grid: the lists are built, or its list overflowed
   if (build) contact_lists[list] = 0u;
-  bool search = build || contact_lists[list] > u.contact_check.w;
   float reach = (build ? 1.01f * contactReach(u.contact.x) : 1.01f * u.contact.x);
   uint into = build ? list : SIM_NONE;
   if (k < u.particle_count) {
@@ -360,23 +397,13 @@ void contactNear(uint k) {
     } else if (contactFree(k)) {
       return;
     }
-    if (search) {
-      contactVisit(CONTACT_VISIT_TRIANGLES, k, x - vec3(reach), x + vec3(reach), into);
-      return;
-    }
-    uint count = contact_lists[list];
-    for (uint j = 0u; j < count; ++j) visitTriangle(k, contact_lists[list + 1u + j], SIM_NONE);
+    contactVisit(CONTACT_VISIT_TRIANGLES, k, x - vec3(reach), x + vec3(reach), into);
     return;
   }
   uint e = k - u.particle_count;
   if (e >= contactEdgeCount() || !contactEdgeLive(e)) return;
-  if (search) {
-    vec3 a = vec3(SIM_POSITION(contactEdge(e).x)), b = vec3(SIM_POSITION(contactEdge(e).y));
-    contactVisit(CONTACT_VISIT_EDGES, e, min(a, b) - vec3(reach), max(a, b) + vec3(reach), into);
-    return;
-  }
-  uint count = contact_lists[list];
-  for (uint j = 0u; j < count; ++j) visitEdge(e, contact_lists[list + 1u + j], SIM_NONE);
+  vec3 a = vec3(SIM_POSITION(contactEdge(e).x)), b = vec3(SIM_POSITION(contactEdge(e).y));
+  contactVisit(CONTACT_VISIT_EDGES, e, min(a, b) - vec3(reach), max(a, b) + vec3(reach), into);
 }
 
 // contact_bound: particle i's step bound (stepBound; unbounded when free) and push
@@ -388,6 +415,7 @@ void contactBound(uint i) {
     contact_lists[listHeader() + LIST_KEY] = contactGoneWrong() ? 0u : counters.triangle_count + 1u;
     contact_lists[listHeader() + LIST_RADIUS] = floatBitsToUint(r);
     contact_lists[listHeader() + LIST_BUILDS] += 1u;
+    contact_lists[listHeader() + LIST_SEARCH] = contact_words[CONTACT_OVERFLOW];
   }
   uint nearest = contactGoneWrong() ? 0u : contact_particles[i].state.x;
   if (nearest < floatBitsToUint(r * r)) atomicAdd(contact_words[CONTACT_COUNT], 1u);

@@ -81,6 +81,8 @@ void contactSubstep(uint s, uint n) {
   uint slots = contactSlots(), boxes = u.triangle_count + contactEdgeCount();
   for (uint k = lid; k < slots; k += kInvocations) contactClear(k);
   sync();
+  for (uint k = lid; k < contactBucketSlots(); k += kInvocations) contactGridClear(k);
+  sync();
   for (uint k = lid; k < boxes; k += kInvocations) contactInsert(k, false);
   sync();
   scanWorkgroup(SIM_SCAN_SCRATCH, contactCounts(), 2u * (u.contact_grid.x + 1u) + 1u, compactSlots());

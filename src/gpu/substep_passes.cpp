@@ -67,6 +67,7 @@ enum class Elements : uint8_t {
   INDIRECT,
   TRIANGLES,
   CONTACT_SLOTS,
+  CONTACT_BUCKETS,
   CONTACT_BOXES,
   CONTACT_QUERIES,
   CONTACT_CELLS
@@ -164,10 +165,13 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
     record(sink, p, d.grid, topo.triangleCount(), SimPush{0, topo.triangleCount(), s, 0}, s, d.gate);
     break;
   case Elements::CONTACT_SLOTS: {
-    const uint32_t slots = std::max({n, sizes.contact_buckets + 1, topo.triangleCount(), sizes.contact_edges});
+    const uint32_t slots = std::max({n, topo.triangleCount(), sizes.contact_edges});
     record(sink, p, d.grid, slots, SimPush{0, slots, s, 0}, s, d.gate);
     break;
   }
+  case Elements::CONTACT_BUCKETS:
+    record(sink, p, d.grid, sizes.contact_buckets + 1, SimPush{0, sizes.contact_buckets + 1, s, 0}, s, d.gate);
+    break;
   case Elements::CONTACT_BOXES: {
     const uint32_t boxes = topo.triangleCount() + sizes.contact_edges;
     record(sink, p, d.grid, boxes, SimPush{0, boxes, s, 0}, s, d.gate);

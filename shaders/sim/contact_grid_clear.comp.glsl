@@ -1,0 +1,12 @@
+#version 460
+// Contact (contact.glsl): clears the grid's buckets when the grid is built this substep,
+// SIM_CONTACT_CLEAR_PER_THREAD an invocation, a dispatch's invocations apart.
+// Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
+#define SIM_LOCAL_SIZE SIM_WG_PARTICLES
+#define SIM_PUSH_TYPE SimPush
+#include "contact.glsl"
+#include "sim_common.glsl"
+
+void main() {
+  for (uint k = threadIndex(); k < p.count; k += threadCount()) contactGridClear(k);
+}
