@@ -229,8 +229,6 @@
 #define SIM_CONTACT_HEADER 8u
 #define SIM_CONTACT_CELLS_PER_BOX 8u
 #define SIM_CONTACT_CELL_ROOM 1.01f
-// Buckets one invocation of contact_grid_clear clears
-#define SIM_CONTACT_CLEAR_PER_THREAD 32u
 
 // Largest workgroup count in X of one dispatch; bigger grids spill into Y
 #define SIM_MAX_GROUPS_X 65535u

@@ -25,7 +25,7 @@
 #define SIM_KERNELS(X)                                                                                                 \
   X(contact_begin, SIM, 1, 0)                                                                                          \
   X(contact_clear, SIM, 1, 0)                                                                                          \
-  X(contact_grid_clear, SIM, SIM_CONTACT_CLEAR_PER_THREAD, 0)                                                          \
+  X(contact_grid_clear, SIM, 1, 0)                                                                                     \
   X(contact_count, SIM, 1, 0)                                                                                          \
   X(contact_scatter, SIM, 1, 0)                                                                                        \
   X(contact_cross, SIM, 1, 0)                                                                                          \

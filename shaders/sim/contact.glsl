@@ -102,7 +102,8 @@ bool contactBox(uint k, out vec3 lo, out vec3 hi) {
   }
   uint e = k - u.triangle_count;
   if (e >= contactEdgeCount() || !contactEdgeLive(e)) return false;
-  vec3 a = vec3(SIM_POSITION(contactEdge(e).x)), b = vec3(SIM_POSITION(contactEdge(e).y));
+  uvec2 edge = contactEdge(e).xy;
+  vec3 a = vec3(SIM_POSITION(edge.x)), b = vec3(SIM_POSITION(edge.y));
   lo = min(a, b);
   hi = max(a, b);
   return true;
@@ -326,7 +327,8 @@ void contactClear(uint k) {
   }
   if (k < u.triangle_count) contact_words[SIM_CONTACT_HEADER + k] = 0u;
   if (k < contactEdgeCount() && contactEdgeLive(k)) {
-    vec3 d = vec3(SIM_POSITION(contactEdge(k).y)) - vec3(SIM_POSITION(contactEdge(k).x));
+    uvec2 edge = contactEdge(k).xy;
+    vec3 d = vec3(SIM_POSITION(edge.y)) - vec3(SIM_POSITION(edge.x));
     atomicMax(contact_words[CONTACT_LONGEST], floatBitsToUint(dot3(d, d)));
   }
 }
@@ -402,7 +404,8 @@ void contactNear(uint k) {
   }
   uint e = k - u.particle_count;
   if (e >= contactEdgeCount() || !contactEdgeLive(e)) return;
-  vec3 a = vec3(SIM_POSITION(contactEdge(e).x)), b = vec3(SIM_POSITION(contactEdge(e).y));
+  uvec2 edge = contactEdge(e).xy;
+  vec3 a = vec3(SIM_POSITION(edge.x)), b = vec3(SIM_POSITION(edge.y));
   contactVisit(CONTACT_VISIT_EDGES, e, min(a, b) - vec3(reach), max(a, b) + vec3(reach), into);
 }
 

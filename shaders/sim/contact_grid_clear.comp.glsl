@@ -1,6 +1,5 @@
 #version 460
-// Contact (contact.glsl): clears the grid's buckets when the grid is built this substep,
-// SIM_CONTACT_CLEAR_PER_THREAD an invocation, a dispatch's invocations apart.
+// Contact (contact.glsl): clears the grid's buckets when the grid is built this substep.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
 #define SIM_PUSH_TYPE SimPush
@@ -8,5 +7,6 @@
 #include "sim_common.glsl"
 
 void main() {
-  for (uint k = threadIndex(); k < p.count; k += threadCount()) contactGridClear(k);
+  uint k = threadIndex();
+  if (k < p.count) contactGridClear(k);
 }

@@ -207,10 +207,6 @@ uint threadIndex() {
   return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
 }
 
-// Invocations of this dispatch (workgroups in X and Y): the stride of a loop that gives each
-// invocation several elements (contact_grid_clear).
-uint threadCount() { return gl_NumWorkGroups.x * gl_NumWorkGroups.y * gl_WorkGroupSize.x; }
-
 // Linear index of this workgroup.
 uint groupIndex() { return gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x; }
 
