@@ -11,8 +11,10 @@ for tool in Xvfb xdotool xwd convert xdpyinfo; do
 done
 export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
 tmp=$(mktemp -d)
-display=":$((90 + RANDOM % 400))"
-Xvfb "$display" -screen 0 1024x768x24 -nolisten tcp >"$tmp/xvfb.log" 2>&1 &
+# Xvfb picks a free display itself (-displayfd writes its number). -noreset: by default Xvfb resets
+# when its last client leaves, and a demo that connects during the reset (the next start_demo after
+# a stop_demo) finds no display.
+Xvfb -displayfd 3 -screen 0 1024x768x24 -nolisten tcp -noreset 3>"$tmp/display" >"$tmp/xvfb.log" 2>&1 &
 xvfb=$!
 demo=
 cleanup() {
@@ -22,14 +24,23 @@ cleanup() {
   rm -rf "$tmp"
 }
 trap cleanup EXIT
+for _ in $(seq 100); do [ -s "$tmp/display" ] && break; sleep 0.1; done
+display=":$(head -1 "$tmp/display")"
 export DISPLAY=$display
-for _ in $(seq 100); do xdpyinfo >/dev/null 2>&1 && break; sleep 0.1; done
+# Waits until the display answers (10 s at most); fails when Xvfb has gone.
+display_up() {
+  local _
+  for _ in $(seq 100); do xdpyinfo >/dev/null 2>&1 && return 0; sleep 0.1; done
+  kill -0 "$xvfb" 2>/dev/null || fail "Xvfb on $display has exited"
+  fail "Xvfb on $display does not answer"
+}
 
 fail() { echo "FAIL: $*"; echo "--- demo output"; cat "$tmp/demo.log" 2>/dev/null; echo "--- Xvfb"; cat "$tmp/xvfb.log"; exit 1; }
 alive() { kill -0 "$demo" 2>/dev/null || fail "tender-demo exited during: $1"; }
 shot() { xwd -root -silent | convert xwd:- "$tmp/$1.png"; }
 
 start_demo() {
+  display_up
   "$DEMO" "$@" >"$tmp/demo.log" 2>&1 &
   demo=$!
   wid=
