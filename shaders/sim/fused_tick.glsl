@@ -142,7 +142,7 @@ void main() {
     // 1. Contact's bounds (with contact on), the air (as air.comp), then Verlet integration (as
     // integrate.comp)
 #ifdef SIM_FUSED_CONTACT
-    if (u.contact.x > 0.0f) contactSubstep(s, n);
+    if (u.contact.x > 0.0f && (u.flags & SIM_FLAG_CONTACT_PASSES) == 0u) contactSubstep(s, n);
 #endif
     if ((u.flags & SIM_FLAG_AIR) != 0u) {
       sync(); // the air reads the positions of other invocations' particles (loaded or moved)

@@ -56,16 +56,26 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
   anyToCompute(cmd); // earlier submissions (previous tick, copies, the renderer) are done
   bindSet(cmd, index);
   if (key.fused) {
-    // Small sheet: every pass of fused_substeps_ substeps (on a GPU: all) in one workgroup
+    // Small sheet: every pass of fused_substeps_ substeps (on a GPU: all) in one workgroup; on a
+    // CPU device with contact on, the contact passes on all its threads before each substep
+    // (SIM_FLAG_CONTACT_PASSES), the rest of the substep in the workgroup
     const uint32_t per = passesPerSubstep(key.iterations, topo_.colorCount(), key.collision);
-    for (uint32_t s = 0; s < key.substeps; s += fused_substeps_) {
+    const bool contact_passes = key.contact && !fused_contact_;
+    const uint32_t step = contact_passes ? 1 : fused_substeps_;
+    for (uint32_t s = 0; s < key.substeps; s += step) {
       if (s > 0) computeToCompute(cmd);
-      const uint32_t count = std::min(fused_substeps_, key.substeps - s);
+      if (contact_passes) {
+        recording_ = &flight;
+        recordContactPasses(*this, pipes_, topo_, layout_sizes_, s);
+        recording_ = nullptr;
+        timestamp(cmd, flight, kContact);
+      }
+      const uint32_t count = std::min(step, key.substeps - s);
       dispatch(cmd, key.contact ? pipes_.tick_fused_contact : pipes_.tick_fused, Grid::Workgroup, 1,
                FusedPush{n, s, count, key.stop});
+      timestamp(cmd, flight, kFused);
       if (key.stop != SIM_NONE && key.stop < (s + count) * per) break;
     }
-    timestamp(cmd, flight, kFused);
   } else {
     uint32_t pass = 0;
     const SubstepPlan plan{key.iterations, key.collision, key.air, key.stop, key.crease, key.contact};

@@ -136,9 +136,8 @@ void GpuSolver::tick(const SimUniforms& u) {
     // The contact's buffers and pipelines, the first time contact is on
     if (!layout_sizes_.contact) sizeContact();
     addContactPipelines(ctx_, layout_, float_rules_, math_,
-                        pipes_.tick_fused.pipeline && fused_contact_ ? std::optional<uint32_t>(fused_workgroup_)
-                                                                     : std::nullopt,
-                        pipes_, owned_pipelines_);
+                        pipes_.tick_fused.pipeline ? std::optional<uint32_t>(fused_workgroup_) : std::nullopt, pipes_,
+                        owned_pipelines_);
   }
   last_contact_ = contact;
   const uint32_t index = next_in_flight_;
@@ -148,6 +147,7 @@ void GpuSolver::tick(const SimUniforms& u) {
   waitFor(flight);
   SimUniforms gpu_u = u;
   if (usesCandidateLists()) gpu_u.flags |= SIM_FLAG_CANDIDATES;
+  if (contact && !fused_contact_ && usesFusedPath(u)) gpu_u.flags |= SIM_FLAG_CONTACT_PASSES;
   if (contact) {
     gpu_u.contact_grid = glm::uvec4(layout_sizes_.contact_buckets / 2 - 1, layout_sizes_.contact_counts,
                                     layout_sizes_.contact_fill, layout_sizes_.contact_edges);
@@ -310,8 +310,7 @@ bool fusedTickTakes(const SimUniforms& u, float spacing, float max_cell_spacings
 bool GpuSolver::usesFusedPath() const { return fused_allowed_ && pipes_.tick_fused.pipeline && fusedTickFits(topo_); }
 
 bool GpuSolver::usesFusedPath(const SimUniforms& u) const {
-  return usesFusedPath() && fusedTickTakes(u, spacing_, fused_max_cell_spacings_) &&
-         (fused_contact_ || !(u.contact.x > 0.0f));
+  return usesFusedPath() && fusedTickTakes(u, spacing_, fused_max_cell_spacings_);
 }
 
 } // namespace tender::gpu

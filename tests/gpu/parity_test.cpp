@@ -257,27 +257,41 @@ TEST_F(Parity, ContactIsTheSameOnTheGpu) {
     std::printf("%u pairs a list: the lists were built %u times in %u substeps\n", capacity, gpu.contactListBuilds(),
                 45 * p.substeps);
   }
-  // A yank that tears the sheet with contact on from the start: torn triangles stop colliding at once
+  // A yank that tears the sheet with contact on from the start: torn triangles stop colliding at
+  // once. Three ways: the fused tick with contact's bodies in its workgroup (a GPU's), the fused
+  // tick after the contact passes each substep (a CPU device's), the per-colour passes.
   const SimParams yank = preset("tender", {"cols=12", "rows=16", "wind=off", "contact_factor=0.5"});
-  for (bool fused : {true, false}) {
-    const char* way = fused ? "fused tick" : "per-colour passes";
-    gpu::GpuSolver gpu(ctx(), gpu::FusedShape{0, 0, 0.0f, 1}); // the fused tick takes contact on lavapipe too
-    gpu.setFusedPath(fused);
+  struct Way {
+    const char* name;
+    bool fused;
+    int contact; // FusedShape::contact
+  };
+  for (const Way way : {Way{"fused tick", true, 1}, Way{"contact passes, then the fused tick", true, -1},
+                        Way{"per-colour passes", false, 1}}) {
+    const gpu::FusedShape shape{0, 0, 0.0f, way.contact};
+    gpu::GpuSolver gpu(ctx(), shape);
+    gpu.setFusedPath(way.fused);
     Simulation g(yank, gpu);
     g.tick();
-    EXPECT_EQ(gpu.usesFusedPath(g.lastUniforms()), fused) << way;
-    auto [torn_cpu, torn_gpu] =
-        runBoth(ctx(), yank, "0 grab particle 191\n1 move 6 -4 5\n", 10, fused, gpu::FusedShape{0, 0, 0.0f, 1});
-    EXPECT_GT(tornIds(torn_cpu).size(), 0u) << way;
-    EXPECT_TRUE(sameState(torn_cpu, torn_gpu)) << way;
+    EXPECT_EQ(gpu.usesFusedPath(g.lastUniforms()), way.fused) << way.name;
+    // The fused tick's one dispatch a tick (a CPU device's: one a substep), and with the contact
+    // passes, theirs before each substep
+    if (way.fused && way.contact > 0) {
+      EXPECT_LE(gpu.dispatchesPerTick(), yank.substeps) << way.name;
+    } else if (way.fused) {
+      EXPECT_GT(gpu.dispatchesPerTick(), 8u * yank.substeps) << way.name;
+    }
+    auto [torn_cpu, torn_gpu] = runBoth(ctx(), yank, "0 grab particle 191\n1 move 6 -4 5\n", 10, way.fused, shape);
+    EXPECT_GT(tornIds(torn_cpu).size(), 0u) << way.name;
+    EXPECT_TRUE(sameState(torn_cpu, torn_gpu)) << way.name;
     expectSameTopology(torn_cpu, torn_gpu);
   }
-  // Unless told, a CPU device leaves the ticks with contact to the per-colour passes
+  // Unless told, a CPU device runs the contact passes before each substep of the fused tick
   gpu::GpuSolver plain(ctx());
   Simulation g(yank, plain);
   g.tick();
-  EXPECT_EQ(plain.usesFusedPath(g.lastUniforms()), ctx().properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU);
-  EXPECT_TRUE(plain.usesFusedPath());
+  EXPECT_TRUE(plain.usesFusedPath(g.lastUniforms()));
+  EXPECT_EQ(plain.dispatchesPerTick() > yank.substeps, ctx().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
 }
 
 TEST_F(Parity, ScriptedYankTearsTheSameConstraints) {
