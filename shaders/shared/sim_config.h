@@ -82,8 +82,8 @@
 // Per particle (ContactParticle): where it starts the substep, its bound and push, its nearest
 // distance and whether it is free, its pushes in fixed point
 #define SIM_BIND_CONTACT 31
-// The contact grid's words: SIM_CONTACT_HEADER words (ContactHeader), then a crossing flag per
-// triangle slot, then the grid's entries (SIM_CONTACT_CELLS_PER_BOX per triangle and edge at most)
+// The contact grid's words: SIM_CONTACT_HEADER words (ContactHeader), then the grid's entries
+// (SIM_CONTACT_CELLS_PER_BOX per triangle and edge at most) and the boxes
 #define SIM_BIND_CONTACT_GRID 32
 // A fleet's shaders (tick_batch.comp, and the per-colour passes built with SIM_BATCH_PASS) reach
 // each binding's buffer through its device address instead: the fleet's table (BatchArgs.table)

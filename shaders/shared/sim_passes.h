@@ -29,7 +29,6 @@
   X(contact_count, SIM, 1, 0)                                                                                          \
   X(contact_scatter, SIM, 1, 0)                                                                                        \
   X(contact_cross, SIM, 1, 0)                                                                                          \
-  X(contact_free, SIM, 1, 0)                                                                                           \
   X(contact_near, SIM, 1, 0)                                                                                           \
   X(contact_bound, SIM, 1, 0)                                                                                          \
   X(air, SIM, 1, 1)                                                                                                    \
@@ -99,7 +98,6 @@
   X(integrate, scan, CONTACT_CELLS, Threads, TICK, CONTACT, Contact)                                                   \
   X(integrate, contact_scatter, CONTACT_BOXES, Threads, TICK, CONTACT, Contact)                                        \
   X(integrate, contact_cross, TRIANGLES, Threads, TICK, CONTACT, Contact)                                              \
-  X(integrate, contact_free, TRIANGLES, Threads, TICK, CONTACT, Contact)                                               \
   X(integrate, contact_near, CONTACT_QUERIES, Threads, TICK, CONTACT, Contact)                                         \
   X(integrate, contact_bound, PARTICLES, Threads, TICK, CONTACT, Contact)                                              \
   X(integrate, air, PARTICLES, Threads, AIR, AIR, Integrate)                                                           \

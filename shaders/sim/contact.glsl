@@ -32,9 +32,9 @@
 #define LIST_BUILDS 2u
 #define LIST_SEARCH 3u // 1: a query overflowed its slots at the last build (it searches the grid)
 
-// The entries of the grid, after the header and a crossing flag per triangle slot: an entry k is
-// live triangle slot k (k < u.triangle_count) or edge k - u.triangle_count
-uint contactEntries() { return SIM_CONTACT_HEADER + u.triangle_count; }
+// The entries of the grid, after the header: an entry k is live triangle slot k
+// (k < u.triangle_count) or edge k - u.triangle_count
+uint contactEntries() { return SIM_CONTACT_HEADER; }
 uint contactCounts() { return u.contact_grid.y; }
 uint contactFill() { return u.contact_grid.z; }
 uint contactEdgeCount() { return u.contact_grid.w; }
@@ -200,11 +200,6 @@ void contactPair(uvec4 q, ContactPair c) {
   }
 }
 
-// What a look-up of the grid does with the entries it finds (contactVisit)
-#define CONTACT_VISIT_TRIANGLES 0u // particle `self` against the triangles near it
-#define CONTACT_VISIT_EDGES 1u     // edge `self` against the edges after it
-#define CONTACT_VISIT_CROSSING 2u  // live triangle slot `self` against the triangles whose boxes meet its box
-
 // A pair of query `list` found by a build: kept when within contactReach (in the first
 // u.contact_check.w of its slots; the count goes on past them)
 void listPair(uint list, float d2, uint other) {
@@ -218,31 +213,8 @@ void listPair(uint list, float d2, uint other) {
   contact_lists[list] = c + 1u;
 }
 
-// Particle i against live triangle slot t (list: its list when the lists are built, else SIM_NONE)
-void visitTriangle(uint i, uint t, uint list) {
-  uvec4 tri = triangles[t];
-  if (i == tri.x || i == tri.y || i == tri.z) return;
-  bool free = contactFree(i) || contactFree(tri.x) || contactFree(tri.y) || contactFree(tri.z);
-  if (free && list == SIM_NONE) return;
-  ContactPair c = pointTriangle(vec3(SIM_POSITION(i)), vec3(SIM_POSITION(tri.x)), vec3(SIM_POSITION(tri.y)),
-                                vec3(SIM_POSITION(tri.z)));
-  if (list != SIM_NONE) listPair(list, c.d2, t);
-  if (!free) contactPair(uvec4(i, tri.x, tri.y, tri.z), c);
-}
-
-// Edge e against edge f > e (contactVisit passes no other) that shares no particle with it
-void visitEdge(uint e, uint f, uint list) {
-  uvec2 a = contactEdge(e).xy, b = contactEdge(f).xy;
-  if (a.x == b.x || a.x == b.y || a.y == b.x || a.y == b.y) return;
-  bool free = contactFree(a.x) || contactFree(a.y) || contactFree(b.x) || contactFree(b.y);
-  if (free && list == SIM_NONE) return;
-  ContactPair c = segmentSegment(vec3(SIM_POSITION(a.x)), vec3(SIM_POSITION(a.y)), vec3(SIM_POSITION(b.x)),
-                                 vec3(SIM_POSITION(b.y)));
-  if (list != SIM_NONE) listPair(list, c.d2, f);
-  if (!free) contactPair(uvec4(a, b), c);
-}
-
-// Live triangle slot t against slot o: when they share no particle and cross, both are marked
+// Live triangle slot t against slot o: when they share no particle and cross, both triangles'
+// particles go free this substep
 void visitCrossing(uint t, uint o) {
   uvec4 a = triangles[t], b = triangles[o];
   if (a.x == b.x || a.x == b.y || a.x == b.z || a.y == b.x || a.y == b.y || a.y == b.z || a.z == b.x || a.z == b.y ||
@@ -251,38 +223,26 @@ void visitCrossing(uint t, uint o) {
   if (!trianglesCross(vec3(SIM_POSITION(a.x)), vec3(SIM_POSITION(a.y)), vec3(SIM_POSITION(a.z)),
                       vec3(SIM_POSITION(b.x)), vec3(SIM_POSITION(b.y)), vec3(SIM_POSITION(b.z))))
     return;
-  atomicOr(contact_words[SIM_CONTACT_HEADER + t], 1u);
-  atomicOr(contact_words[SIM_CONTACT_HEADER + o], 1u);
+  for (uint j = 0u; j < 3u; ++j) {
+    atomicOr(contact_particles[a[j]].state.y, 1u);
+    atomicOr(contact_particles[b[j]].state.y, 1u);
+  }
   atomicOr(contact_words[CONTACT_TANGLED], 1u);
 }
 
-// Every grid entry of the kind `visit` looks for whose box meets [lo, hi], once: in the cell of the
-// low corner of the two boxes' overlap (both boxes span that cell); `list`: the list a build fills
-// (SIM_NONE: none)
-void contactVisit(uint visit, uint self, vec3 lo, vec3 hi, uint list) {
-  float inv = contactInvCell();
-  ivec3 a = cellOf(lo, inv), b = min(cellOf(hi, inv), a + ivec3(4));
-  uint entries = contactEntries(), edges_from = u.triangle_count;
-  for (int z = a.z; z <= b.z; ++z)
-    for (int y = a.y; y <= b.y; ++y)
-      for (int x = a.x; x <= b.x; ++x) {
-        ivec3 cell = ivec3(x, y, z);
-        uint h = contactBucket(cell, visit == CONTACT_VISIT_EDGES);
-        uint end = scratch[contactCounts() + h + 1u];
-        for (uint m = scratch[contactCounts() + h]; m < end; ++m) {
-          uint k = contact_words[entries + m];
-          if (visit == CONTACT_VISIT_EDGES && k - edges_from <= self) continue; // each pair from its first edge
-          vec3 elo, ehi;
-          loadBox(k, elo, ehi);
-          if (!boxesMeet(lo, hi, elo, ehi) || cellOf(max(lo, elo), inv) != cell) continue;
-          if (visit == CONTACT_VISIT_TRIANGLES)
-            visitTriangle(self, k, list);
-          else if (visit == CONTACT_VISIT_EDGES)
-            visitEdge(self, k - edges_from, list);
-          else
-            visitCrossing(self, k);
-        }
-      }
+// The cells [a, b] of a box, x fastest, then y, then z: the next after `cell`; false past the last
+bool nextCell(ivec3 a, ivec3 b, inout ivec3 cell) {
+  if (++cell.x <= b.x) return true;
+  cell.x = a.x;
+  if (++cell.y <= b.y) return true;
+  cell.y = a.y;
+  return ++cell.z <= b.z;
+}
+
+// Where the entries of `cell`'s bucket of triangles (or of edges) start and end in the grid
+uvec2 bucketRange(ivec3 cell, bool edge) {
+  uint h = contactBucket(cell, edge);
+  return uvec2(scratch[contactCounts() + h], scratch[contactCounts() + h + 1u]);
 }
 
 // The passes' bodies, one element each (the contact_* kernels, and the fused tick's loops)
@@ -303,14 +263,13 @@ void contactBegin(uint s) {
   if (!stand || check || contact_lists[listHeader() + LIST_SEARCH] != 0u) contact_words[CONTACT_GRID] = 1u;
 }
 
-// Elements contact_clear covers: the particles, the triangle slots, the edges
-uint contactSlots() { return max(u.particle_count, max(u.triangle_count, contactEdgeCount())); }
+// Elements contact_clear covers: the particles, the edges
+uint contactSlots() { return max(u.particle_count, contactEdgeCount()); }
 // Elements contact_grid_clear covers: the buckets and their end
 uint contactBucketSlots() { return 2u * (u.contact_grid.x + 1u) + 1u; }
 
 // contact_clear: particle k's start of the substep (one that travelled too far since the lists were
-// built has them built again, and the grid); triangle slot k cleared; edge k's squared length
-// raises the longest
+// built has them built again, and the grid); edge k's squared length raises the longest
 void contactClear(uint k) {
   if (k < u.particle_count) {
     float r = u.contact.x;
@@ -325,7 +284,6 @@ void contactClear(uint k) {
       atomicOr(contact_words[CONTACT_GRID], 1u);
     }
   }
-  if (k < u.triangle_count) contact_words[SIM_CONTACT_HEADER + k] = 0u;
   if (k < contactEdgeCount() && contactEdgeLive(k)) {
     uvec2 edge = contactEdge(k).xy;
     vec3 d = vec3(SIM_POSITION(edge.y)) - vec3(SIM_POSITION(edge.x));
@@ -342,7 +300,8 @@ void contactGridClear(uint k) {
 }
 
 // contact_cross: live triangle slot t, when crossingChecked names it in substep s, against every
-// triangle whose box meets its box
+// triangle whose box meets its box (once: in the cell of the low corner of the boxes' overlap, which
+// both boxes span); the particles of the two go free when they cross
 void contactCross(uint t, uint s) {
   if (t >= counters.triangle_count || contactGoneWrong() || !gridBuilt()) return;
   uvec4 tri = triangles[t];
@@ -351,62 +310,106 @@ void contactCross(uint t, uint s) {
   if (!crossingChecked(all, tri.xyz, u.contact_check.y, u.contact_check.z, (was & 2u) != 0u)) return;
   vec3 lo, hi;
   loadBox(t, lo, hi);
-  contactVisit(CONTACT_VISIT_CROSSING, t, lo, hi, SIM_NONE);
+  float inv = contactInvCell();
+  ivec3 a = cellOf(lo, inv), b = min(cellOf(hi, inv), a + ivec3(4)), cell = a;
+  if (any(lessThan(b, a))) return;
+  do {
+    uvec2 range = bucketRange(cell, false);
+    for (uint m = range.x; m < range.y; ++m) {
+      uint o = contact_words[contactEntries() + m];
+      vec3 elo, ehi;
+      loadBox(o, elo, ehi);
+      if (boxesMeet(lo, hi, elo, ehi) && cellOf(max(lo, elo), inv) == cell) visitCrossing(t, o);
+    }
+  } while (nextCell(a, b, cell));
 }
 
-// contact_free: the particles of live triangle slot t go free when it crosses another
-void contactFreeOf(uint t) {
-  if (t >= counters.triangle_count || contact_words[SIM_CONTACT_HEADER + t] == 0u) return;
-  uvec4 tri = triangles[t];
-  atomicOr(contact_particles[tri.x].state.y, 1u);
-  atomicOr(contact_particles[tri.y].state.y, 1u);
-  atomicOr(contact_particles[tri.z].state.y, 1u);
-}
-
-// contact_near: particle k against the triangles near it, or (k past the particles) edge
-// k - particles against the edges near it: through its list, or when the lists are built (or its
-// list overflowed) through the grid, its box widened past the reach (or the radius): which pairs
-// are kept and which count is their distance's call.
+// contact_near: query k, particle k (against the triangles near it) or, past the particles, edge
+// e = k - particles (against the edges after it near it): through its list, or when the lists are
+// built (or its list overflowed) through the grid, its box widened past the reach (or the radius):
+// which pairs are kept and which count is their distance's call. One loop walks the candidates,
+// the list's slots or the entries of the grid in the box's cells (a pair once: in the cell of the
+// low corner of the two boxes' overlap), and one place weighs a pair: a CPU device runs every
+// instruction of a kernel for each group of invocations, whatever the branches, so the kernel is
+// kept short.
 void contactNear(uint k) {
   if (contactGoneWrong()) return;
+  bool particle = k < u.particle_count;
+  uint self = particle ? k : k - u.particle_count;
   uint list = listOf(k);
   bool build = listsRebuilt();
-  if (!build) {
-    // Through its list (which holds only live primitives: a tear builds the lists again)
-    uint count = contact_lists[list];
-    if (count == 0u) return;
-    if (count <= u.contact_check.w) {
-      if (k < u.particle_count) {
-        if (contactFree(k)) return;
-        for (uint j = 0u; j < count; ++j) visitTriangle(k, contact_lists[list + 1u + j], SIM_NONE);
-      } else {
-        for (uint j = 0u; j < count; ++j) visitEdge(k - u.particle_count, contact_lists[list + 1u + j], SIM_NONE);
-      }
-      return;
-    }
+  uint count = build ? 0u : contact_lists[list];
+  // Through its list (which holds only live primitives: a tear builds the lists again)
+  bool walk = !build && count <= u.contact_check.w;
+  if (walk && count == 0u) return;
+  if (particle && !build && contactFree(k)) return;
+  uvec2 edge = uvec2(0u);
+  vec3 lo, hi;
+  if (particle) {
+    lo = vec3(SIM_POSITION(k));
+    hi = lo;
+  } else {
+    if (self >= contactEdgeCount() || !contactEdgeLive(self)) return;
+    edge = contactEdge(self).xy;
+    vec3 ea = vec3(SIM_POSITION(edge.x)), eb = vec3(SIM_POSITION(edge.y));
+    lo = min(ea, eb);
+    hi = max(ea, eb);
   }
-  // Through the grid: the lists are built, or its list overflowed
-  if (build) contact_lists[list] = 0u;
-  float reach = (build ? 1.01f * contactReach(u.contact.x) : 1.01f * u.contact.x);
-  uint into = build ? list : SIM_NONE;
-  if (k < u.particle_count) {
-    vec3 x = vec3(SIM_POSITION(k));
-    if (build) {
+  uint into = SIM_NONE;
+  if (build) {
+    into = list;
+    contact_lists[list] = 0u;
+    if (particle) {
       uint w = listBaseWord(k);
-      contact_lists[w] = floatBitsToUint(x.x);
-      contact_lists[w + 1u] = floatBitsToUint(x.y);
-      contact_lists[w + 2u] = floatBitsToUint(x.z);
-    } else if (contactFree(k)) {
-      return;
+      contact_lists[w] = floatBitsToUint(lo.x);
+      contact_lists[w + 1u] = floatBitsToUint(lo.y);
+      contact_lists[w + 2u] = floatBitsToUint(lo.z);
     }
-    contactVisit(CONTACT_VISIT_TRIANGLES, k, x - vec3(reach), x + vec3(reach), into);
-    return;
   }
-  uint e = k - u.particle_count;
-  if (e >= contactEdgeCount() || !contactEdgeLive(e)) return;
-  uvec2 edge = contactEdge(e).xy;
-  vec3 a = vec3(SIM_POSITION(edge.x)), b = vec3(SIM_POSITION(edge.y));
-  contactVisit(CONTACT_VISIT_EDGES, e, min(a, b) - vec3(reach), max(a, b) + vec3(reach), into);
+  float reach = build ? 1.01f * contactReach(u.contact.x) : 1.01f * u.contact.x;
+  lo -= vec3(reach);
+  hi += vec3(reach);
+  float inv = contactInvCell();
+  ivec3 a = cellOf(lo, inv), b = min(cellOf(hi, inv), a + ivec3(4)), cell = a;
+  if (!walk && any(lessThan(b, a))) return;
+  uvec2 range = walk ? uvec2(0u, count) : bucketRange(cell, !particle);
+  uint entries = contactEntries(), edges_from = u.triangle_count;
+  for (;;) {
+    if (range.x >= range.y) {
+      if (walk || !nextCell(a, b, cell)) break;
+      range = bucketRange(cell, !particle);
+      continue;
+    }
+    uint m = range.x++, other;
+    if (walk) {
+      other = contact_lists[list + 1u + m];
+    } else {
+      uint e = contact_words[entries + m];
+      if (!particle && e - edges_from <= self) continue; // each pair from its first edge
+      vec3 elo, ehi;
+      loadBox(e, elo, ehi);
+      if (!boxesMeet(lo, hi, elo, ehi) || cellOf(max(lo, elo), inv) != cell) continue;
+      other = particle ? e : e - edges_from;
+    }
+    // The pair's four particles: the particle and the triangle's three, or the two edges' two
+    uvec4 q;
+    if (particle) {
+      uvec4 tri = triangles[other];
+      if (k == tri.x || k == tri.y || k == tri.z) continue;
+      q = uvec4(k, tri.xyz);
+    } else {
+      uvec2 f = contactEdge(other).xy;
+      if (edge.x == f.x || edge.x == f.y || edge.y == f.x || edge.y == f.y) continue;
+      q = uvec4(edge, f);
+    }
+    bool free = contactFree(q.x) || contactFree(q.y) || contactFree(q.z) || contactFree(q.w);
+    if (free && into == SIM_NONE) continue;
+    vec3 x0 = vec3(SIM_POSITION(q.x)), x1 = vec3(SIM_POSITION(q.y)), x2 = vec3(SIM_POSITION(q.z)),
+         x3 = vec3(SIM_POSITION(q.w));
+    ContactPair c = particle ? pointTriangle(x0, x1, x2, x3) : segmentSegment(x0, x1, x2, x3);
+    if (into != SIM_NONE) listPair(into, c.d2, other);
+    if (!free) contactPair(q, c);
+  }
 }
 
 // contact_bound: particle i's step bound (stepBound; unbounded when free) and push

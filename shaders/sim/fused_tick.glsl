@@ -90,8 +90,6 @@ void contactSubstep(uint s, uint n) {
   sync();
   for (uint t = lid; t < u.triangle_count; t += kInvocations) contactCross(t, s);
   sync();
-  for (uint t = lid; t < u.triangle_count; t += kInvocations) contactFreeOf(t);
-  sync();
   uint queries = u.particle_count + contactEdgeCount();
   for (uint k = lid; k < queries; k += kInvocations) contactNear(k);
   sync();

@@ -127,8 +127,8 @@ SheetLayout SheetLayout::of(const SheetTopology& topo, VkDeviceSize max_range, b
     l.contact_counts = std::max(l.hash_sums + scanSumsSize(topo.hash_size), l.tear_slots + SIM_WG_FUSED);
     l.contact_fill = l.contact_counts + l.contact_buckets + 1;
     l.contact_sums = l.contact_fill + l.contact_buckets;
-    // The header, a crossing flag per triangle slot, the entries and the boxes (contact.glsl)
-    l.contact_words = SIM_CONTACT_HEADER + topo.triangleCount() + uint64_t(SIM_CONTACT_CELLS_PER_BOX + 6) * boxes;
+    // The header, the entries and the boxes (contact.glsl)
+    l.contact_words = SIM_CONTACT_HEADER + uint64_t(SIM_CONTACT_CELLS_PER_BOX + 6) * boxes;
     // The edges, then the lists' header, where each particle was, each query's count and pairs
     l.contact_list_words = 4ull * l.contact_edges + SIM_CONTACT_LIST_HEADER + 4ull * topo.particleCount() +
                            uint64_t(1 + SIM_CONTACT_LIST_CAPACITY) * (topo.particleCount() + l.contact_edges);

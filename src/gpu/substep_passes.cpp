@@ -165,7 +165,7 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
     record(sink, p, d.grid, topo.triangleCount(), SimPush{0, topo.triangleCount(), s, 0}, s, d.gate);
     break;
   case Elements::CONTACT_SLOTS: {
-    const uint32_t slots = std::max({n, topo.triangleCount(), sizes.contact_edges});
+    const uint32_t slots = std::max(n, sizes.contact_edges);
     record(sink, p, d.grid, slots, SimPush{0, slots, s, 0}, s, d.gate);
     break;
   }
