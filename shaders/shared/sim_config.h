@@ -191,6 +191,11 @@
 // arguments, then as many with every pass's full grid): candidates_decide zeroes the live ones in a
 // substep that sums from the lists
 #define SIM_HASH_DISPATCHES 16u
+// Indirect dispatches of contact's grid passes (Grid::Contact): SIM_BIND_HASH_ARGS holds, after
+// the hash passes' arguments, this many live ones from SIM_CONTACT_GRID_ARGS, then as many with
+// every pass's full grid; contact_arm zeroes the live ones in a substep that does not build the grid
+#define SIM_CONTACT_GRID_DISPATCHES 16u
+#define SIM_CONTACT_GRID_ARGS (2u * SIM_HASH_DISPATCHES)
 
 // Penetration-free contact (contact.h): the part of the distance to its nearest primitive a particle
 // may move in a substep; below 1/2, with room for rounding

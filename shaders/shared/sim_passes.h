@@ -25,6 +25,7 @@
 #define SIM_KERNELS(X)                                                                                                 \
   X(contact_begin, SIM, 1, 0)                                                                                          \
   X(contact_clear, SIM, 1, 0)                                                                                          \
+  X(contact_arm, SIM, 1, 0)                                                                                            \
   X(contact_grid_clear, SIM, 1, 0)                                                                                     \
   X(contact_count, SIM, 1, 0)                                                                                          \
   X(contact_scatter, SIM, 1, 0)                                                                                        \
@@ -84,7 +85,9 @@
 //             CONTACT_BOXES (triangle slots, then edges), CONTACT_QUERIES (particles, then
 //             edges), CONTACT_CELLS (a scan of its grid's buckets)
 //   grid      Threads (from the elements), Hash (the live hash arguments candidates_decide
-//             copies) or Compaction (the tear compaction's arguments): gpu::Grid
+//             copies), Contact (the live arguments of contact's grid passes contact_arm copies:
+//             none in a substep that does not build the grid) or Compaction (the tear
+//             compaction's arguments): gpu::Grid
 //   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)
 //   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases),
 //             CONSTRAINTS (the sheet has constraints) or CONTACT (contact is on: a sheet alone,
@@ -93,11 +96,12 @@
 #define SIM_DISPATCHES(X)                                                                                              \
   X(integrate, contact_begin, ONE, Threads, TICK, CONTACT, Contact)                                                    \
   X(integrate, contact_clear, CONTACT_SLOTS, Threads, TICK, CONTACT, Contact)                                          \
-  X(integrate, contact_grid_clear, CONTACT_BUCKETS, Threads, TICK, CONTACT, Contact)                                   \
-  X(integrate, contact_count, CONTACT_BOXES, Threads, TICK, CONTACT, Contact)                                          \
-  X(integrate, scan, CONTACT_CELLS, Threads, TICK, CONTACT, Contact)                                                   \
-  X(integrate, contact_scatter, CONTACT_BOXES, Threads, TICK, CONTACT, Contact)                                        \
-  X(integrate, contact_cross, TRIANGLES, Threads, TICK, CONTACT, Contact)                                              \
+  X(integrate, contact_arm, ONE, Threads, TICK, CONTACT, Contact)                                                      \
+  X(integrate, contact_grid_clear, CONTACT_BUCKETS, Contact, TICK, CONTACT, Contact)                                   \
+  X(integrate, contact_count, CONTACT_BOXES, Contact, TICK, CONTACT, Contact)                                          \
+  X(integrate, scan, CONTACT_CELLS, Contact, TICK, CONTACT, Contact)                                                   \
+  X(integrate, contact_scatter, CONTACT_BOXES, Contact, TICK, CONTACT, Contact)                                        \
+  X(integrate, contact_cross, TRIANGLES, Contact, TICK, CONTACT, Contact)                                              \
   X(integrate, contact_near, CONTACT_QUERIES, Threads, TICK, CONTACT, Contact)                                         \
   X(integrate, contact_bound, PARTICLES, Threads, TICK, CONTACT, Contact)                                              \
   X(integrate, air, PARTICLES, Threads, AIR, AIR, Integrate)                                                           \

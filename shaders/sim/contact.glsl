@@ -291,6 +291,17 @@ void contactClear(uint k) {
   }
 }
 
+// contact_arm: the live indirect arguments of the grid's passes (Grid::Contact), their full grids
+// when the grid is built in this substep, else no workgroups: a substep that does not build it
+// dispatches none of them (a CPU device runs every instruction of a kernel for each group of
+// invocations, even those that return at once)
+void contactArm() {
+  bool built = gridBuilt();
+  for (uint k = 0u; k < SIM_CONTACT_GRID_DISPATCHES; ++k)
+    hash_args[SIM_CONTACT_GRID_ARGS + k] =
+        built ? hash_args[SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES + k] : uvec4(0u, 1u, 1u, 0u);
+}
+
 // contact_grid_clear: bucket k cleared when the grid is built
 void contactGridClear(uint k) {
   if (!gridBuilt()) return;

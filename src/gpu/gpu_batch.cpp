@@ -287,11 +287,17 @@ void GpuBatch::flush() {
   if (plan.contact)
     addContactPipelines(ctx_, sheet_layout_, float_rules_, math_, std::nullopt, sheet_passes_, owned_pipelines_);
   if (!passes.empty() && sheet_by_sheet) {
-    // Each sheet's full hash-pass grids, which its candidates_decide copies to the live ones
+    // Each sheet's full grids of the hash passes and of contact's grid passes, which its
+    // candidates_decide and contact_arm copy to the live ones
     std::vector<VkBufferCopy> grid_regions;
-    for (uint32_t i : passes)
+    for (uint32_t i : passes) {
       grid_regions.push_back(
           {args_at, sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * SIM_HASH_DISPATCHES, 16ull * SIM_HASH_DISPATCHES});
+      grid_regions.push_back(
+          {args_at + 16ull * SIM_HASH_DISPATCHES,
+           sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * (SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES),
+           16ull * SIM_CONTACT_GRID_DISPATCHES});
+    }
     vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BIND_HASH_ARGS].buffer, uint32_t(grid_regions.size()),
                     grid_regions.data());
   } else if (!passes.empty()) {
@@ -348,8 +354,9 @@ void GpuBatch::flush() {
         recordSubstep(*this, sheet_passes_, topo_, sizes_, sheet_plan, s, count);
     }
     pass_sheet_ = -1;
-    glm::uvec4 grids[SIM_HASH_DISPATCHES] = {};
+    glm::uvec4 grids[SIM_HASH_DISPATCHES + SIM_CONTACT_GRID_DISPATCHES] = {};
     std::copy(hash_grids_.grids().begin(), hash_grids_.grids().end(), grids);
+    std::copy(hash_grids_.contactGrids().begin(), hash_grids_.contactGrids().end(), grids + SIM_HASH_DISPATCHES);
     std::memcpy(inputs + args_at, grids, sizeof(grids));
   } else if (!passes.empty()) {
     // The per-colour passes of the most substeps and iterations, each for every sheet; a sheet
@@ -425,6 +432,9 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
   case Grid::Compaction:
     vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer, 16ull * (SIM_BATCH_ARGS_LIVE_COMPACT + substep));
     break;
+  case Grid::Contact:
+    // A sheet with contact runs its passes on its own (passOfSheet)
+    vkCheckFailed(VK_ERROR_UNKNOWN, "contact in a batched pass", __FILE__, __LINE__);
   }
   ++last_dispatches_;
 }

@@ -54,6 +54,7 @@ void GpuSolver::upload(const SheetTopology& topo) {
   layout_sizes_ = SheetLayout::of(topo, max_range, topo.contact);
   hash_grids_.clear();
   hash_grids_uploaded_.clear();
+  contact_grids_uploaded_.clear();
 
   // The uniforms (host-visible, a copy per tick in flight and one static), then the table.
   const VkDeviceSize align = ctx_.properties().limits.minUniformBufferOffsetAlignment;

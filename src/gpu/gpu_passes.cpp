@@ -87,13 +87,21 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
   computeToAll(cmd); // the renderer and copies see this tick
   VK_CHECK(vkEndCommandBuffer(cmd));
   flight.recorded = key;
-  // The full grids of the hash passes, which candidates_decide copies to the live arguments
-  if (hash_grids_.grids() != hash_grids_uploaded_) {
+  // The full grids of the hash passes and of contact's grid passes, which candidates_decide and
+  // contact_arm copy to the live arguments
+  if (hash_grids_.grids() != hash_grids_uploaded_ || hash_grids_.contactGrids() != contact_grids_uploaded_) {
     ctx_.submitOnce([&](VkCommandBuffer up) {
-      vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * SIM_HASH_DISPATCHES,
-                        16 * hash_grids_.grids().size(), hash_grids_.grids().data());
+      const std::vector<glm::uvec4>&hash = hash_grids_.grids(), &contact = hash_grids_.contactGrids();
+      if (!hash.empty())
+        vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * SIM_HASH_DISPATCHES, 16 * hash.size(),
+                          hash.data());
+      if (!contact.empty())
+        vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer,
+                          VkDeviceSize(16) * (SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES), 16 * contact.size(),
+                          contact.data());
     });
     hash_grids_uploaded_ = hash_grids_.grids();
+    contact_grids_uploaded_ = hash_grids_.contactGrids();
   }
   flight.dispatches = recorded_dispatches_;
 }

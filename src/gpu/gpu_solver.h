@@ -226,6 +226,7 @@ private:
   uint32_t contact_list_capacity_ = SIM_CONTACT_LIST_CAPACITY; ///< setContactListCapacity
   HashGrids hash_grids_;                                       ///< full grids of the hash passes, in recording order
   std::vector<glm::uvec4> hash_grids_uploaded_;                ///< what SIM_BIND_HASH_ARGS holds of them
+  std::vector<glm::uvec4> contact_grids_uploaded_;             ///< ... and of contact's grid passes
   uint32_t stop_after_ = SIM_NONE;                             ///< stopNextTickAfter
   mutable std::array<double, kCategoryCount> last_ms_{};
 };

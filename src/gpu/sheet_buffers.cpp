@@ -200,7 +200,7 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
       spec(SIM_BIND_CELL_POS, 16ull * n),
       spec(SIM_BIND_CANDIDATES, list_bytes),
       spec(SIM_BIND_CANDIDATE_BASE, list_base),
-      spec(SIM_BIND_HASH_ARGS, 16ull * 2 * SIM_HASH_DISPATCHES),
+      spec(SIM_BIND_HASH_ARGS, 16ull * (SIM_CONTACT_GRID_ARGS + 2 * SIM_CONTACT_GRID_DISPATCHES)),
       // Interaction
       spec(SIM_BIND_PICK, sizeof(PickResult)),
       // Contact (a word each while it is not sized): the edges, and what a reset clears

@@ -12,21 +12,24 @@ glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets) {
 }
 
 uint32_t HashGrids::record(Grid grid, glm::uvec4 full) {
-  if (grid != Grid::Hash) {
-    next_ = 0;
+  if (grid != Grid::Hash && grid != Grid::Contact) {
+    next_ = next_contact_ = 0;
     return 0;
   }
-  const uint32_t k = next_++;
-  if (k >= SIM_HASH_DISPATCHES) vkCheckFailed(VK_ERROR_UNKNOWN, "hash dispatches", __FILE__, __LINE__);
-  if (k == grids_.size()) grids_.push_back(full);
-  if (grids_[k] != full) vkCheckFailed(VK_ERROR_UNKNOWN, "hash grid", __FILE__, __LINE__);
-  return k;
+  const bool contact = grid == Grid::Contact;
+  std::vector<glm::uvec4>& grids = contact ? contact_grids_ : grids_;
+  const uint32_t k = contact ? next_contact_++ : next_++;
+  if (k >= (contact ? SIM_CONTACT_GRID_DISPATCHES : SIM_HASH_DISPATCHES))
+    vkCheckFailed(VK_ERROR_UNKNOWN, "indirect dispatches", __FILE__, __LINE__);
+  if (k == grids.size()) grids.push_back(full);
+  if (grids[k] != full) vkCheckFailed(VK_ERROR_UNKNOWN, "indirect grid", __FILE__, __LINE__);
+  return contact ? SIM_CONTACT_GRID_ARGS + k : k;
 }
 
 bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& hash_grids, const ComputePipeline& p,
                      Grid grid, uint32_t count, const void* push, uint32_t push_size) {
   if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
-  if (grid == Grid::Threads && count == 0) return false;
+  if ((grid == Grid::Threads || grid == Grid::Contact) && count == 0) return false;
   const glm::uvec4 full = fullGrid(p, count);
   const uint32_t hash_dispatch = hash_grids.record(grid, full);
   if (bound != p.pipeline) {
@@ -45,7 +48,8 @@ bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& has
     vkCmdDispatchIndirect(t.cmd, t.counters, t.counters_offset + offsetof(Counters, compact_dispatch));
     break;
   case Grid::Hash:
-    // The live arguments candidates_decide copied from the full grids (or zero workgroups)
+  case Grid::Contact:
+    // The live arguments candidates_decide (contact_arm) copied from the full grids, or zero workgroups
     vkCmdDispatchIndirect(t.cmd, t.hash_args, t.hash_offset + 16ull * hash_dispatch);
     break;
   }

@@ -13,9 +13,10 @@
 namespace tender::gpu {
 
 /// How a dispatch gets its grid: from the element count, one workgroup, the tear compaction's
-/// arguments (zero workgroups unless something tore), or the next live hash-pass argument (zero
-/// workgroups when the candidate lists stand in for the hash).
-enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash };
+/// arguments (zero workgroups unless something tore), the next live hash-pass argument (zero
+/// workgroups when the candidate lists stand in for the hash), or the next live argument of
+/// contact's grid passes (zero workgroups in a substep that does not build the grid).
+enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash, Contact };
 
 /// Timestamp categories of a tick, in Solver::passTimes() order (SIM_DISPATCHES' category column
 /// names the first six). kFused: the fused small-sheet tick, every pass in one dispatch.
@@ -36,24 +37,29 @@ enum PassCategory : uint8_t {
 /// SIM_MAX_GROUPS_X spills into y (the shaders linearise the group index).
 glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets = 1);
 
-/// The full grids of the hash passes, in recording order: every substep records the same hash
-/// passes as the same hash dispatches (at most SIM_HASH_DISPATCHES), whose live arguments the passes
-/// dispatch from.
+/// The full grids of the indirect passes, in recording order: every substep records the same hash
+/// passes as the same hash dispatches (at most SIM_HASH_DISPATCHES), and the same grid passes of
+/// contact (at most SIM_CONTACT_GRID_DISPATCHES), whose live arguments the passes dispatch from.
 class HashGrids {
 public:
-  /// A pass of grid `grid` is recorded. A hash pass of full grid `full` is the next hash dispatch and
-  /// returns it (its grid checked against earlier substeps'); any other pass makes the next hash
-  /// pass the first.
+  /// A pass of grid `grid` is recorded. A hash (or contact grid) pass of full grid `full` is the
+  /// next dispatch of its kind and returns the slot of its live argument in SIM_BIND_HASH_ARGS
+  /// (its grid checked against earlier substeps'); any other pass makes the next of each kind the
+  /// first.
   uint32_t record(Grid grid, glm::uvec4 full);
+  /// The hash passes' full grids (from slot SIM_HASH_DISPATCHES)
   const std::vector<glm::uvec4>& grids() const { return grids_; }
+  /// Contact's grid passes' full grids (from slot SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES)
+  const std::vector<glm::uvec4>& contactGrids() const { return contact_grids_; }
   void clear() {
     grids_.clear();
-    next_ = 0;
+    contact_grids_.clear();
+    next_ = next_contact_ = 0;
   }
 
 private:
-  std::vector<glm::uvec4> grids_;
-  uint32_t next_ = 0;
+  std::vector<glm::uvec4> grids_, contact_grids_;
+  uint32_t next_ = 0, next_contact_ = 0;
 };
 
 /// Where one sheet's arrays and indirect arguments are bound for its passes.
