@@ -194,8 +194,13 @@
 // Indirect dispatches of contact's grid passes (Grid::Contact): SIM_BIND_HASH_ARGS holds, after
 // the hash passes' arguments, this many live ones from SIM_CONTACT_GRID_ARGS, then as many with
 // every pass's full grid; contact_arm zeroes the live ones in a substep that does not build the grid
-#define SIM_CONTACT_GRID_DISPATCHES 16u
+#define SIM_CONTACT_GRID_DISPATCHES 24u
 #define SIM_CONTACT_GRID_ARGS (2u * SIM_HASH_DISPATCHES)
+// ... then contact_walk's live arguments (w: the queries it walks), then those contact_emit wrote at
+// the last build of the lists
+#define SIM_CONTACT_WALK_ARGS (SIM_CONTACT_GRID_ARGS + 2u * SIM_CONTACT_GRID_DISPATCHES)
+// The uvec4 of SIM_BIND_HASH_ARGS
+#define SIM_SHEET_ARGS (SIM_CONTACT_WALK_ARGS + 2u)
 
 // Penetration-free contact (contact.h): the part of the distance to its nearest primitive a particle
 // may move in a substep; below 1/2, with room for rounding

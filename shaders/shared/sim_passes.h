@@ -31,6 +31,9 @@
   X(contact_scatter, SIM, 1, 0)                                                                                        \
   X(contact_cross, SIM, 1, 0)                                                                                          \
   X(contact_near, SIM, 1, 0)                                                                                           \
+  X(contact_active, SIM, 1, 0)                                                                                         \
+  X(contact_emit, SIM, 1, 0)                                                                                           \
+  X(contact_walk, SIM, 1, 0)                                                                                           \
   X(contact_bound, SIM, 1, 0)                                                                                          \
   X(air, SIM, 1, 1)                                                                                                    \
   X(integrate, SIM, 1, 1)                                                                                              \
@@ -83,11 +86,14 @@
 //             TRIANGLES (the triangle slots), CONTACT_SLOTS (whatever its clearing covers),
 //             CONTACT_BUCKETS (its grid's buckets and their end),
 //             CONTACT_BOXES (triangle slots, then edges), CONTACT_QUERIES (particles, then
-//             edges), CONTACT_CELLS (a scan of its grid's buckets)
+//             edges), CONTACT_CELLS (a scan of its grid's buckets), CONTACT_ACTIVE (the queries
+//             and their end, from the scratch offset of their flags) and CONTACT_ACTIVE_CELLS (a
+//             scan of those flags)
 //   grid      Threads (from the elements), Hash (the live hash arguments candidates_decide
 //             copies), Contact (the live arguments of contact's grid passes contact_arm copies:
-//             none in a substep that does not build the grid) or Compaction (the tear
-//             compaction's arguments): gpu::Grid
+//             none in a substep that does not build the grid), Walk (contact_walk's, over the
+//             queries with pairs in their lists: none in a substep that builds them) or
+//             Compaction (the tear compaction's arguments): gpu::Grid
 //   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)
 //   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases),
 //             CONSTRAINTS (the sheet has constraints) or CONTACT (contact is on: a sheet alone,
@@ -102,7 +108,11 @@
   X(integrate, scan, CONTACT_CELLS, Contact, TICK, CONTACT, Contact)                                                   \
   X(integrate, contact_scatter, CONTACT_BOXES, Contact, TICK, CONTACT, Contact)                                        \
   X(integrate, contact_cross, TRIANGLES, Contact, TICK, CONTACT, Contact)                                              \
-  X(integrate, contact_near, CONTACT_QUERIES, Threads, TICK, CONTACT, Contact)                                         \
+  X(integrate, contact_near, CONTACT_QUERIES, Contact, TICK, CONTACT, Contact)                                         \
+  X(integrate, contact_active, CONTACT_ACTIVE, Contact, TICK, CONTACT, Contact)                                        \
+  X(integrate, scan, CONTACT_ACTIVE_CELLS, Contact, TICK, CONTACT, Contact)                                            \
+  X(integrate, contact_emit, CONTACT_ACTIVE, Contact, TICK, CONTACT, Contact)                                          \
+  X(integrate, contact_walk, CONTACT_QUERIES, Walk, TICK, CONTACT, Contact)                                            \
   X(integrate, contact_bound, PARTICLES, Threads, TICK, CONTACT, Contact)                                              \
   X(integrate, air, PARTICLES, Threads, AIR, AIR, Integrate)                                                           \
   X(integrate, integrate, PARTICLES, Threads, TICK, ALWAYS, Integrate)                                                 \

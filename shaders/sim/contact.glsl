@@ -300,6 +300,8 @@ void contactArm() {
   for (uint k = 0u; k < SIM_CONTACT_GRID_DISPATCHES; ++k)
     hash_args[SIM_CONTACT_GRID_ARGS + k] =
         built ? hash_args[SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES + k] : uvec4(0u, 1u, 1u, 0u);
+  // contact_walk: the queries with pairs at the last build, unless the lists are built now
+  hash_args[SIM_CONTACT_WALK_ARGS] = listsRebuilt() ? uvec4(0u, 1u, 1u, 0u) : hash_args[SIM_CONTACT_WALK_ARGS + 1u];
 }
 
 // contact_grid_clear: bucket k cleared when the grid is built
@@ -335,6 +337,13 @@ void contactCross(uint t, uint s) {
   } while (nextCell(a, b, cell));
 }
 
+// Which queries contactNear takes: all (the fused tick), those that search the grid (contact_near:
+// the lists are built, or theirs overflowed) or those that walk their lists (contact_walk, over the
+// queries contactActive names)
+#define NEAR_ALL 0u
+#define NEAR_SEARCH 1u
+#define NEAR_WALK 2u
+
 // contact_near: query k, particle k (against the triangles near it) or, past the particles, edge
 // e = k - particles (against the edges after it near it): through its list, or when the lists are
 // built (or its list overflowed) through the grid, its box widened past the reach (or the radius):
@@ -343,16 +352,17 @@ void contactCross(uint t, uint s) {
 // low corner of the two boxes' overlap), and one place weighs a pair: a CPU device runs every
 // instruction of a kernel for each group of invocations, whatever the branches, so the kernel is
 // kept short.
-void contactNear(uint k) {
+void contactNear(uint k, uint only) {
   if (contactGoneWrong()) return;
   bool particle = k < u.particle_count;
   uint self = particle ? k : k - u.particle_count;
   uint list = listOf(k);
-  bool build = listsRebuilt();
+  bool build = only != NEAR_WALK && listsRebuilt();
   uint count = build ? 0u : contact_lists[list];
   // Through its list (which holds only live primitives: a tear builds the lists again)
-  bool walk = !build && count <= u.contact_check.w;
+  bool walk = only == NEAR_WALK || (!build && count <= u.contact_check.w);
   if (walk && count == 0u) return;
+  if (only == NEAR_SEARCH && walk) return;
   if (particle && !build && contactFree(k)) return;
   uvec2 edge = uvec2(0u);
   vec3 lo, hi;
@@ -421,6 +431,38 @@ void contactNear(uint k) {
     if (into != SIM_NONE) listPair(into, c.d2, other);
     if (!free) contactPair(q, c);
   }
+}
+
+// Where the queries that walk their lists are named, after the boxes (contact_emit)
+uint activeWord() { return contactBoxWord(u.triangle_count + contactEdgeCount()); }
+// True when query k has pairs in its list, all in its slots (contact_walk walks it until the next build)
+bool contactActive(uint k) {
+  uint count = contact_lists[listOf(k)];
+  return count > 0u && count <= u.contact_check.w;
+}
+
+// contact_active: query k's flag, 1 when it walks its list (the end, k = queries: 0), at scratch
+// offset `flags` (scanned in place next)
+void contactActiveFlag(uint k, uint flags) {
+  scratch[flags + k] = k < u.particle_count + contactEdgeCount() && !contactGoneWrong() && contactActive(k) ? 1u : 0u;
+}
+
+// contact_emit: active query k named at its place (the flags' scan); the end (k = queries) says how
+// many there are, in contact_walk's arguments for the substeps until the next build
+void contactEmit(uint k, uint flags) {
+  uint queries = u.particle_count + contactEdgeCount();
+  if (k == queries) {
+    uint walkers = scratch[flags + queries];
+    hash_args[SIM_CONTACT_WALK_ARGS + 1u] =
+        uvec4(groupGrid((walkers + SIM_WG_PARTICLES - 1u) / SIM_WG_PARTICLES), 1u, walkers);
+  } else if (k < queries && !contactGoneWrong() && contactActive(k)) {
+    contact_words[activeWord() + scratch[flags + k]] = k;
+  }
+}
+
+// contact_walk: the j-th query that walks its list
+void contactWalk(uint j) {
+  if (j < hash_args[SIM_CONTACT_WALK_ARGS].w) contactNear(contact_words[activeWord() + j], NEAR_WALK);
 }
 
 // contact_bound: particle i's step bound (stepBound; unbounded when free) and push

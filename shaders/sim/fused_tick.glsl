@@ -91,7 +91,7 @@ void contactSubstep(uint s, uint n) {
   for (uint t = lid; t < u.triangle_count; t += kInvocations) contactCross(t, s);
   sync();
   uint queries = u.particle_count + contactEdgeCount();
-  for (uint k = lid; k < queries; k += kInvocations) contactNear(k);
+  for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_ALL);
   sync();
   for (uint i = lid; i < n; i += kInvocations) contactBound(i);
   sync();

@@ -433,6 +433,7 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
     vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer, 16ull * (SIM_BATCH_ARGS_LIVE_COMPACT + substep));
     break;
   case Grid::Contact:
+  case Grid::Walk:
     // A sheet with contact runs its passes on its own (passOfSheet)
     vkCheckFailed(VK_ERROR_UNKNOWN, "contact in a batched pass", __FILE__, __LINE__);
   }

@@ -127,8 +127,11 @@ SheetLayout SheetLayout::of(const SheetTopology& topo, VkDeviceSize max_range, b
     l.contact_counts = std::max(l.hash_sums + scanSumsSize(topo.hash_size), l.tear_slots + SIM_WG_FUSED);
     l.contact_fill = l.contact_counts + l.contact_buckets + 1;
     l.contact_sums = l.contact_fill + l.contact_buckets;
-    // The header, the entries and the boxes (contact.glsl)
-    l.contact_words = SIM_CONTACT_HEADER + uint64_t(SIM_CONTACT_CELLS_PER_BOX + 6) * boxes;
+    const uint32_t queries = topo.particleCount() + l.contact_edges;
+    l.contact_active = l.contact_sums + scanSumsSize(l.contact_buckets + 1);
+    l.contact_active_sums = l.contact_active + queries + 1;
+    // The header, the entries, the boxes and the active queries (contact.glsl)
+    l.contact_words = SIM_CONTACT_HEADER + uint64_t(SIM_CONTACT_CELLS_PER_BOX + 6) * boxes + queries;
     // The edges, then the lists' header, where each particle was, each query's count and pairs
     l.contact_list_words = 4ull * l.contact_edges + SIM_CONTACT_LIST_HEADER + 4ull * topo.particleCount() +
                            uint64_t(1 + SIM_CONTACT_LIST_CAPACITY) * (topo.particleCount() + l.contact_edges);
@@ -142,9 +145,10 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
   const uint32_t cells = topo.hash_size;
   // The fused tick's scans meet their per-invocation totals in the SIM_WG_FUSED slots after the
   // compaction slots (the per-colour passes' block sums, unused on that path).
-  const uint32_t scratch =
-      std::max({layout.hash_sums + scanSumsSize(cells), layout.tear_slots + SIM_WG_FUSED,
-                layout.contact ? layout.contact_sums + scanSumsSize(layout.contact_buckets + 1) : 0u});
+  const uint32_t scratch = std::max(
+      {layout.hash_sums + scanSumsSize(cells), layout.tear_slots + SIM_WG_FUSED,
+       layout.contact ? layout.contact_active_sums + scanSumsSize(layout.contact_active_sums - layout.contact_active)
+                      : 0u});
   const VkDeviceSize list_bytes = layout.candidates_fit ? 4ull * SIM_CANDIDATE_STRIDE * n : 16,
                      list_base = layout.candidates_fit ? 16ull * n : 16;
 
@@ -200,7 +204,7 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
       spec(SIM_BIND_CELL_POS, 16ull * n),
       spec(SIM_BIND_CANDIDATES, list_bytes),
       spec(SIM_BIND_CANDIDATE_BASE, list_base),
-      spec(SIM_BIND_HASH_ARGS, 16ull * (SIM_CONTACT_GRID_ARGS + 2 * SIM_CONTACT_GRID_DISPATCHES)),
+      spec(SIM_BIND_HASH_ARGS, 16ull * SIM_SHEET_ARGS),
       // Interaction
       spec(SIM_BIND_PICK, sizeof(PickResult)),
       // Contact (a word each while it is not sized): the edges, and what a reset clears

@@ -21,10 +21,12 @@ struct SheetLayout {
   bool candidates_fit = false;           ///< the candidate-list buffer fits a binding of the device
   /// Penetration-free contact: its buffers are sized (else one word each); the sheet's edges; the
   /// contact grid's buckets (two halves of a power of two: the triangles', the edges'); the scratch offsets of the
-  /// buckets' counts (then starts, buckets + 1 of them), of their fills and of the counts' scan sums; the words of
+  /// buckets' counts (then starts, buckets + 1 of them), of their fills and of the counts' scan sums, of the
+  /// queries' flags (then where each active one goes, queries + 1 of them) and their scan sums; the words of
   /// SIM_BIND_CONTACT_GRID, and of SIM_BIND_CONTACT_LISTS (the edges, then the lists)
   bool contact = false;
   uint32_t contact_edges = 0, contact_buckets = 0, contact_counts = 0, contact_fill = 0, contact_sums = 0;
+  uint32_t contact_active = 0, contact_active_sums = 0;
   uint64_t contact_words = 0, contact_list_words = 0;
   /// The layout of a topology on a device that binds at most `max_range` bytes, with the contact's
   /// buffers sized or not.

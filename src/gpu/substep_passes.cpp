@@ -29,7 +29,7 @@ uint32_t HashGrids::record(Grid grid, glm::uvec4 full) {
 bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& hash_grids, const ComputePipeline& p,
                      Grid grid, uint32_t count, const void* push, uint32_t push_size) {
   if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
-  if ((grid == Grid::Threads || grid == Grid::Contact) && count == 0) return false;
+  if ((grid == Grid::Threads || grid == Grid::Contact || grid == Grid::Walk) && count == 0) return false;
   const glm::uvec4 full = fullGrid(p, count);
   const uint32_t hash_dispatch = hash_grids.record(grid, full);
   if (bound != p.pipeline) {
@@ -51,6 +51,10 @@ bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& has
   case Grid::Contact:
     // The live arguments candidates_decide (contact_arm) copied from the full grids, or zero workgroups
     vkCmdDispatchIndirect(t.cmd, t.hash_args, t.hash_offset + 16ull * hash_dispatch);
+    break;
+  case Grid::Walk:
+    // The queries with pairs in their lists at the last build, or none when they are built now
+    vkCmdDispatchIndirect(t.cmd, t.hash_args, t.hash_offset + 16ull * SIM_CONTACT_WALK_ARGS);
     break;
   }
   return true;
@@ -74,6 +78,8 @@ enum class Elements : uint8_t {
   CONTACT_BUCKETS,
   CONTACT_BOXES,
   CONTACT_QUERIES,
+  CONTACT_ACTIVE,
+  CONTACT_ACTIVE_CELLS,
   CONTACT_CELLS
 };
 /// When a sheet records a dispatch (SIM_DISPATCHES' needs column).
@@ -189,6 +195,15 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
   case Elements::CONTACT_CELLS:
     recordScan(sink, pipes, SIM_SCAN_SCRATCH, sizes.contact_counts, sizes.contact_buckets + 1, sizes.contact_sums,
                d.grid, s, d.gate);
+    return;
+  case Elements::CONTACT_ACTIVE: {
+    const uint32_t flags = n + sizes.contact_edges + 1;
+    record(sink, p, d.grid, flags, SimPush{sizes.contact_active, flags, s, 0}, s, d.gate);
+    break;
+  }
+  case Elements::CONTACT_ACTIVE_CELLS:
+    recordScan(sink, pipes, SIM_SCAN_SCRATCH, sizes.contact_active, n + sizes.contact_edges + 1,
+               sizes.contact_active_sums, d.grid, s, d.gate);
     return;
   }
   sink.barrier();

@@ -91,7 +91,8 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   ASSERT_LE(sizes.contact_buckets + 1, SIM_SCAN_BLOCK);
   std::vector<std::string> expected = {
       "contact_begin",   "contact_clear", "contact_arm",  "contact_grid_clear", "contact_count", "scan",
-      "contact_scatter", "contact_cross", "contact_near", "contact_bound",      "air",           "integrate"};
+      "contact_scatter", "contact_cross", "contact_near", "contact_active",     "scan",          "contact_emit",
+      "contact_walk",    "contact_bound", "air",          "integrate"};
   // The repulsion, which the particles take before the projection
   for (const char* k : {"candidates_check", "candidates_decide", "hash_count", "scan", "hash_scatter", "hash_sort",
                         "collide", "candidates_finish", "repel"})
