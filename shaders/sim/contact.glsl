@@ -1,15 +1,17 @@
 // The GPU's penetration-free contact, the contact_* passes of the integrate stage (contact.h has
-// the maths and the proof). Every substep a hashed grid of the live triangles' and edges' boxes is
-// built (count -> scan -> scatter; cells as wide as the longest edge and the contact diameter, so a
-// box spans two cells a side at most); the crossing check looks its triangles up in it. Each
-// particle and each edge (a query) keeps a list of the primitives within contactReach of it, as the
-// CPU's lists do: built from the grid when a particle has travelled contactTravel since the last
-// build (or the triangles, the radius or the audit say so), in the query's own slots, in the order
-// of the grid; a query with more than its slots (u.contact_check.w) looks the grid up every substep.
-// A pair counts when its primitives are closer than the contact radius, exactly as on the CPU
-// (CpuContact): the bounds are atomic minimums of float bits and the pushes integer sums
-// (contactFixed), so neither depends on the order of the pairs or on when the lists were built,
-// and the bits are the CPU's.
+// the maths and the proof). A hashed grid of the live triangles' and edges' boxes (count -> scan ->
+// scatter; cells as wide as the longest edge and the contact diameter, so a box spans two cells a
+// side at most) is built in a substep that needs it; the crossing check looks its triangles up in
+// it. Each particle and each edge (a query) keeps a list of the primitives within contactReach of
+// it, as the CPU's lists do: built from the grid when a particle has travelled contactTravel since
+// the last build (or the triangles, the radius or the audit say so), in the query's own slots, in
+// the order of the grid; a query with more than its slots (u.contact_check.w) looks the grid up
+// every substep. The grid's passes dispatch indirectly (contact_arm: no workgroups in a substep
+// that does not build it), and between builds contact_walk runs over the queries with pairs alone
+// (named in order at each build). A pair counts when its primitives are closer than the contact
+// radius, exactly as on the CPU (CpuContact): the bounds are atomic minimums of float bits and the
+// pushes integer sums (contactFixed), so neither depends on the order of the pairs or on when the
+// lists were built, and the bits are the CPU's.
 #ifndef SIM_CONTACT_GLSL
 #define SIM_CONTACT_GLSL
 #include "sim_common.glsl"
@@ -304,7 +306,7 @@ void contactArm() {
   hash_args[SIM_CONTACT_WALK_ARGS] = listsRebuilt() ? uvec4(0u, 1u, 1u, 0u) : hash_args[SIM_CONTACT_WALK_ARGS + 1u];
 }
 
-// contact_grid_clear: bucket k cleared when the grid is built
+// contact_grid_clear: bucket k cleared when the grid is built (dispatched only then: contact_arm)
 void contactGridClear(uint k) {
   if (!gridBuilt()) return;
   uint buckets = 2u * (u.contact_grid.x + 1u); // the triangles' and the edges'
