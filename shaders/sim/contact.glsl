@@ -345,8 +345,10 @@ void contactCross(uint t, uint s) {
 #define NEAR_ALL 0u
 #define NEAR_SEARCH 1u
 #define NEAR_WALK 2u
+// Candidates contactNearOf gathers before it weighs them
+#define CONTACT_BATCH 16u
 
-// contact_near: query k, particle k (against the triangles near it) or, past the particles, edge
+// contact_near: query k (`particle`: k < particles), particle k (against the triangles near it) or edge
 // e = k - particles (against the edges after it near it): through its list, or when the lists are
 // built (or its list overflowed) through the grid, its box widened past the reach (or the radius):
 // which pairs are kept and which count is their distance's call. One loop walks the candidates,
@@ -354,9 +356,8 @@ void contactCross(uint t, uint s) {
 // low corner of the two boxes' overlap), and one place weighs a pair: a CPU device runs every
 // instruction of a kernel for each group of invocations, whatever the branches, so the kernel is
 // kept short.
-void contactNear(uint k, uint only) {
+void contactNearOf(uint k, uint only, bool particle) {
   if (contactGoneWrong()) return;
-  bool particle = k < u.particle_count;
   uint self = particle ? k : k - u.particle_count;
   uint list = listOf(k);
   bool build = only != NEAR_WALK && listsRebuilt();
@@ -397,42 +398,64 @@ void contactNear(uint k, uint only) {
   if (!walk && any(lessThan(b, a))) return;
   uvec2 range = walk ? uvec2(0u, count) : bucketRange(cell, !particle);
   uint entries = contactEntries(), edges_from = u.triangle_count;
-  for (;;) {
-    if (range.x >= range.y) {
-      if (walk || !nextCell(a, b, cell)) break;
-      range = bucketRange(cell, !particle);
-      continue;
+  // Rounds of two loops: the next candidates whose boxes meet (at most CONTACT_BATCH), then those
+  // weighed; a CPU device runs a loop's body as often as its busiest invocation needs, so the
+  // costly weighing runs once a candidate, not once an entry of the grid
+  uint batch[CONTACT_BATCH];
+  for (bool more = true; more;) {
+    uint found = 0u;
+    for (;;) {
+      if (range.x >= range.y) {
+        more = !walk && nextCell(a, b, cell);
+        if (!more) break;
+        range = bucketRange(cell, !particle);
+        continue;
+      }
+      uint m = range.x++;
+      if (walk) {
+        batch[found] = contact_lists[list + 1u + m];
+      } else {
+        uint e = contact_words[entries + m];
+        if (!particle && e - edges_from <= self) continue; // each pair from its first edge
+        vec3 elo, ehi;
+        loadBox(e, elo, ehi);
+        if (!boxesMeet(lo, hi, elo, ehi) || cellOf(max(lo, elo), inv) != cell) continue;
+        batch[found] = particle ? e : e - edges_from;
+      }
+      if (++found == CONTACT_BATCH) break;
     }
-    uint m = range.x++, other;
-    if (walk) {
-      other = contact_lists[list + 1u + m];
-    } else {
-      uint e = contact_words[entries + m];
-      if (!particle && e - edges_from <= self) continue; // each pair from its first edge
-      vec3 elo, ehi;
-      loadBox(e, elo, ehi);
-      if (!boxesMeet(lo, hi, elo, ehi) || cellOf(max(lo, elo), inv) != cell) continue;
-      other = particle ? e : e - edges_from;
+    for (uint j = 0u; j < found; ++j) {
+      uint other = batch[j];
+      // The pair's four particles: the particle and the triangle's three, or the two edges' two
+      uvec4 q;
+      if (particle) {
+        uvec4 tri = triangles[other];
+        if (k == tri.x || k == tri.y || k == tri.z) continue;
+        q = uvec4(k, tri.xyz);
+      } else {
+        uvec2 f = contactEdge(other).xy;
+        if (edge.x == f.x || edge.x == f.y || edge.y == f.x || edge.y == f.y) continue;
+        q = uvec4(edge, f);
+      }
+      bool free = contactFree(q.x) || contactFree(q.y) || contactFree(q.z) || contactFree(q.w);
+      if (free && into == SIM_NONE) continue;
+      vec3 x0 = vec3(SIM_POSITION(q.x)), x1 = vec3(SIM_POSITION(q.y)), x2 = vec3(SIM_POSITION(q.z)),
+           x3 = vec3(SIM_POSITION(q.w));
+      ContactPair c = particle ? pointTriangle(x0, x1, x2, x3) : segmentSegment(x0, x1, x2, x3);
+      if (into != SIM_NONE) listPair(into, c.d2, other);
+      if (!free) contactPair(q, c);
     }
-    // The pair's four particles: the particle and the triangle's three, or the two edges' two
-    uvec4 q;
-    if (particle) {
-      uvec4 tri = triangles[other];
-      if (k == tri.x || k == tri.y || k == tri.z) continue;
-      q = uvec4(k, tri.xyz);
-    } else {
-      uvec2 f = contactEdge(other).xy;
-      if (edge.x == f.x || edge.x == f.y || edge.y == f.x || edge.y == f.y) continue;
-      q = uvec4(edge, f);
-    }
-    bool free = contactFree(q.x) || contactFree(q.y) || contactFree(q.z) || contactFree(q.w);
-    if (free && into == SIM_NONE) continue;
-    vec3 x0 = vec3(SIM_POSITION(q.x)), x1 = vec3(SIM_POSITION(q.y)), x2 = vec3(SIM_POSITION(q.z)),
-         x3 = vec3(SIM_POSITION(q.w));
-    ContactPair c = particle ? pointTriangle(x0, x1, x2, x3) : segmentSegment(x0, x1, x2, x3);
-    if (into != SIM_NONE) listPair(into, c.d2, other);
-    if (!free) contactPair(q, c);
   }
+}
+
+// Query k (contactNearOf): the particles' and the edges' bodies apart, each weighing only its kind
+// of pair (a CPU device runs both bodies for a group of invocations, but each loop only as often as
+// its own queries need)
+void contactNear(uint k, uint only) {
+  if (k < u.particle_count)
+    contactNearOf(k, only, true);
+  else
+    contactNearOf(k, only, false);
 }
 
 // Where the queries that walk their lists are named, after the boxes (contact_emit)
