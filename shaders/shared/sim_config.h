@@ -228,7 +228,7 @@
 #define SIM_CONTACT_TRAVEL 0.45f
 // The GPU's pair lists: words of their header, and the pairs a query keeps (one with more searches
 // the grid every substep)
-#define SIM_CONTACT_LIST_HEADER 4u
+#define SIM_CONTACT_LIST_HEADER 5u
 #define SIM_CONTACT_LIST_CAPACITY 16u
 // The GPU's contact grid: words of its header in SIM_BIND_CONTACT_GRID (x the bits of the longest
 // live edge's squared length, y 1 when a triangle crosses another, z the particles in contact, w 1

@@ -33,6 +33,7 @@
 #define LIST_RADIUS 1u
 #define LIST_BUILDS 2u
 #define LIST_SEARCH 3u // 1: a query overflowed its slots at the last build (it searches the grid)
+#define LIST_NAMED 4u  // the builds when contact_emit last named the queries with pairs (contact_walk's)
 
 // The entries of the grid, after the header: an entry k is live triangle slot k
 // (k < u.triangle_count) or edge k - u.triangle_count
@@ -250,16 +251,19 @@ uvec2 bucketRange(ivec3 cell, bool edge) {
 // The passes' bodies, one element each (the contact_* kernels, and the fused tick's loops)
 
 // contact_begin: the header cleared (one invocation); the lists are built again in substep s when
-// none stand, the triangles or the radius changed, or the audit checks every triangle (a
-// particle that travelled too far says so in contact_clear), and the grid when they are, when a
+// none stand, the triangles or the radius changed, the audit checks every triangle, or (`passes`:
+// the contact_* passes, not the fused tick) contact_emit did not name the queries of the last build
+// (a particle that travelled too far says so in contact_clear), and the grid when they are, when a
 // list overflowed at the last build, or when crossingChecked may name a triangle: the audit, the
 // grab's (now or the last tick), or a particle free in the last substep (a triangle crossed)
-void contactBegin(uint s) {
+void contactBegin(uint s, bool passes) {
   bool crossed = contact_words[CONTACT_TANGLED] != 0u;
   for (uint w = 0u; w < SIM_CONTACT_HEADER; ++w) contact_words[w] = 0u;
   bool audit = s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u;
   bool stand = contact_lists[listHeader() + LIST_KEY] == counters.triangle_count + 1u &&
                contact_lists[listHeader() + LIST_RADIUS] == floatBitsToUint(u.contact.x) && !audit;
+  // The passes walk the queries contact_emit named: lists the fused tick built are built again
+  if (passes) stand = stand && contact_lists[listHeader() + LIST_NAMED] == contact_lists[listHeader() + LIST_BUILDS];
   bool check = audit || crossed || u.contact_check.y != SIM_NONE || u.contact_check.z != SIM_NONE;
   if (!stand) contact_words[CONTACT_REBUILD] = 1u;
   if (!stand || check || contact_lists[listHeader() + LIST_SEARCH] != 0u) contact_words[CONTACT_GRID] = 1u;
@@ -480,6 +484,8 @@ void contactEmit(uint k, uint flags) {
     uint walkers = scratch[flags + queries];
     hash_args[SIM_CONTACT_WALK_ARGS + 1u] =
         uvec4(groupGrid((walkers + SIM_WG_PARTICLES - 1u) / SIM_WG_PARTICLES), 1u, walkers);
+    // Named for this build (contact_bound counts it after the walk)
+    if (listsRebuilt()) contact_lists[listHeader() + LIST_NAMED] = contact_lists[listHeader() + LIST_BUILDS] + 1u;
   } else if (k < queries && !contactGoneWrong() && contactActive(k)) {
     contact_words[activeWord() + scratch[flags + k]] = k;
   }

@@ -8,5 +8,5 @@
 #include "sim_common.glsl"
 
 void main() {
-  if (threadIndex() == 0u) contactBegin(p.substep);
+  if (threadIndex() == 0u) contactBegin(p.substep, true);
 }

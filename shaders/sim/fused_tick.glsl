@@ -76,7 +76,7 @@ void scanWorkgroup(uint mode, uint offset, uint count, uint sums) {
 void contactSubstep(uint s, uint n) {
   uint lid = gl_LocalInvocationID.x;
   sync(); // the positions of other invocations' particles
-  if (lid == 0u) contactBegin(s);
+  if (lid == 0u) contactBegin(s, false);
   sync();
   uint slots = contactSlots(), boxes = u.triangle_count + contactEdgeCount();
   for (uint k = lid; k < slots; k += kInvocations) contactClear(k);

@@ -257,6 +257,22 @@ TEST_F(Parity, ContactIsTheSameOnTheGpu) {
     std::printf("%u pairs a list: the lists were built %u times in %u substeps\n", capacity, gpu.contactListBuilds(),
                 45 * p.substeps);
   }
+  {
+    // The fused tick (contact in its workgroup) and the per-colour passes by turns, each going on
+    // from the lists the other built: the passes walk the queries their own last build named only
+    // while those lists stand
+    gpu::GpuSolver gpu(ctx(), gpu::FusedShape{0, 0, 0.0f, 1});
+    Simulation g(p, gpu);
+    g.setScript(script(text.c_str()));
+    run(g, 29);
+    EXPECT_TRUE(gpu.usesFusedPath(g.lastUniforms()));
+    for (int t = 0; t < 44; ++t) {
+      gpu.setFusedPath(t % 2 == 0);
+      g.tick();
+    }
+    gpu.setFusedPath(false);
+    EXPECT_TRUE(sameState(cpu_end, run(g, 1))) << "the fused tick and the per-colour passes by turns";
+  }
   // A yank that tears the sheet with contact on from the start: torn triangles stop colliding at
   // once. Three ways: the fused tick with contact's bodies in its workgroup (a GPU's), the fused
   // tick after the contact passes each substep (a CPU device's), the per-colour passes.
