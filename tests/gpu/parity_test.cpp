@@ -310,6 +310,41 @@ TEST_F(Parity, ContactIsTheSameOnTheGpu) {
   EXPECT_EQ(plain.dispatchesPerTick() > yank.substeps, ctx().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
 }
 
+TEST_F(Parity, ContactListsStandWhileTheGpuPathsTakeTurns) {
+  // A sheet lying on the floor gathered into a ball by the closed hand and held there: its layers
+  // press on each other and come nearly to rest, so the lists of pairs stand for many substeps. The
+  // fused tick (contact in its workgroup) and the per-colour passes then take turns a tick each: the
+  // passes take over lists the fused tick built (which name no queries: they are built again) and
+  // the fused tick goes on from the passes' lists; the bits stay the CPU's, and the lists are not
+  // built every substep.
+  const SimParams p =
+      preset("crumple", {"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9", "contact_factor=0.5"});
+  const std::string text = "0 grab particle 102\n1 move 0 -8.8 -1.2\n4 squeeze 0.5\n12 squeeze 1\n";
+  constexpr int kSettle = 120, kTurns = 30;
+  CpuSolver cpu(cpuOptionsLike(ctx()));
+  Simulation a(p, cpu);
+  a.setScript(script(text.c_str()));
+  const SimState cpu_end = run(a, kSettle + kTurns);
+  EXPECT_GT(cpu.contacts(), 0);
+  EXPECT_EQ(intersectingPairs(cpu_end.pos, cpu_end.triangles, cpu_end.triangle_count).pairs, 0u);
+  gpu::GpuSolver gpu(ctx(), gpu::FusedShape{0, 0, 0.0f, 1});
+  Simulation g(p, gpu);
+  g.setScript(script(text.c_str()));
+  run(g, kSettle);
+  const uint32_t before = gpu.contactListBuilds();
+  for (int t = 0; t < kTurns; ++t) {
+    gpu.setFusedPath(t % 2 == 0);
+    g.tick();
+  }
+  const uint32_t builds = gpu.contactListBuilds() - before;
+  std::printf("resting layers, the paths by turns: %lld particles in contact, the lists built %u times in %u "
+              "substeps\n",
+              static_cast<long long>(cpu.contacts()), builds, kTurns * p.substeps);
+  EXPECT_EQ(cpu.contacts(), gpu.contacts());
+  EXPECT_LT(builds, uint32_t(kTurns) * p.substeps / 4);
+  EXPECT_TRUE(sameState(cpu_end, run(g, 0))) << "the fused tick and the per-colour passes by turns";
+}
+
 TEST_F(Parity, ScriptedYankTearsTheSameConstraints) {
   // Grab the bottom-right corner and pull it far away fast.
   SimParams p = preset("tender", {"wind=off"});
