@@ -16,6 +16,12 @@
 // a triangle or an edge passing an edge, so a sheet that starts a substep without crossing itself
 // ends it without. Pairs farther apart than r are not searched: they move at most 2 fraction r < r
 // towards each other. Particles held by a pin or the grab are moved by the user, not bounded.
+// The bound holds in a frame that moves with the sheet: a pair's distance falls by at most the
+// largest difference of its particles' displacements, so a translation t common to every particle
+// can be taken out of each step first: no particle ends farther than b(v) from its start + t
+// (contactFrame picks t from how the sheet moved in the last substep: the motion every particle
+// shares, none while one rests). A sheet falling or flying as a whole is not held back, and with
+// every start + t above the floor the floor stays out of the way.
 // Floats round: stepBound takes a margin m, far above the rounding, off d, so pairs close in on
 // m and stop there. The push that parts pairs closer than the thickness moves a particle on top of
 // its bound, by at most SIM_CONTACT_PUSH_FRACTION x d(v) (contactPushWithin): with
@@ -163,6 +169,38 @@ SIM_INLINE float contactReach(float radius) { return radius * (1.0f + SIM_CONTAC
 /// primitives close in by at most twice this, plus a rounding far below the rest of the skin).
 SIM_INLINE float contactTravel(float radius) { return SIM_CONTACT_TRAVEL * SIM_CONTACT_SKIN * radius; }
 
+/// True when the pair lists are built again: the particles' displacements since they were built
+/// (componentwise lowest `lo` and highest `hi`) no longer all lie within contactTravel of one
+/// point, the box's middle (a motion they share changes no pair's distance). NaN builds them.
+SIM_INLINE bool listsOutgrown(vec3 lo, vec3 hi, float radius) {
+  vec3 reach = (hi - lo) * 0.5f;
+  float travel = contactTravel(radius);
+  return !(dot3(reach, reach) < travel * travel);
+}
+
+/// The bits of a float in an order that is the floats' order (unsigned): minimums and maximums of
+/// them, atomic on the GPU, give the same bits in any order.
+SIM_INLINE uint orderedBits(float f) {
+  uint b = floatBitsToUint(f);
+  return (b & 0x80000000u) != 0u ? ~b : b | 0x80000000u;
+}
+SIM_INLINE float orderedFloat(uint o) { return uintBitsToFloat((o & 0x80000000u) != 0u ? o & 0x7FFFFFFFu : ~o); }
+
+/// The translation taken out of every step of the substep before the bound (the frame in the proof
+/// above), from the bounded particles' steps in the last substep (componentwise lowest `lo` and
+/// highest `hi`) and the lowest start of one above the floor, `lowest` (>= 0): the point of the box
+/// [lo, hi] nearest to no step, raised so that no start + it goes below the floor. Each component
+/// lies between 0 and every particle's own, so a step with the frame taken out and cut to its bound
+/// (a blend of the frame and the step) is in no direction longer than the step: while one particle
+/// rests the frame is none, and a sheet falling as a whole falls at least as fast as its slowest
+/// particle.
+SIM_INLINE vec3 contactFrame(vec3 lo, vec3 hi, float lowest) {
+  vec3 t = vec3(lo.x > 0.0f ? lo.x : (hi.x < 0.0f ? hi.x : 0.0f), lo.y > 0.0f ? lo.y : (hi.y < 0.0f ? hi.y : 0.0f),
+                lo.z > 0.0f ? lo.z : (hi.z < 0.0f ? hi.z : 0.0f));
+  t.y = max(t.y, -lowest);
+  return dot3(t, t) < 1e30f ? t : vec3(0.0f);
+}
+
 /// Where a particle that moved from x0 to x this substep ends when its step may not exceed
 /// `bound`: x, or the point `bound` from x0 towards x.
 SIM_INLINE vec3 boundedStep(vec3 x0, vec3 x, float bound) {
@@ -173,12 +211,13 @@ SIM_INLINE vec3 boundedStep(vec3 x0, vec3 x, float bound) {
 }
 
 /// A free particle's substep with contact (st: where it ends after the floor and its previous
-/// position; x0: where it started; push: contactPushWithin): the step is cut to `bound`
-/// (boundedStep), then the push moves it without speeding it up. A step cut short keeps the
-/// particle's speed at most, along the step it made: the contact never adds energy.
-SIM_INLINE VerletState contactStep(VerletState st, vec3 x0, vec3 push, float bound) {
+/// position; x0: where it started; push: contactPushWithin; frame: contactFrame): the step less the
+/// frame is cut to `bound` (boundedStep from x0 + frame), then the push moves it without speeding it
+/// up. A step cut short keeps the particle's speed at most, along the step it made: the contact
+/// never adds energy.
+SIM_INLINE VerletState contactStep(VerletState st, vec3 x0, vec3 push, float bound, vec3 frame) {
   vec3 p = vec3(st.position), q = vec3(st.previous);
-  vec3 x = boundedStep(x0, p, bound);
+  vec3 x = boundedStep(x0 + frame, p, bound);
   if (x != p) {
     vec3 step = x - x0, v = p - q;
     float s2 = dot3(step, step), v2 = dot3(v, v);

@@ -75,7 +75,8 @@
 // Penetration-free contact (contact.h, the contact_* passes), in words: the sheet's edges, each once
 // (four words: its particles a < b, then the ids of the one or two triangles that hold it, SIM_NONE
 // for none), sorted by (a, b); then the pair lists (contact.glsl): SIM_CONTACT_LIST_HEADER words
-// (the triangle count they stand for, the radius, the builds), where each particle was when they
+// (the triangle count they stand for, the radius, the builds, whether a query searches, the build
+// whose queries are named: contact.glsl's LIST_*), where each particle was when they
 // were built (four words each), and per query (particles, then edges) the count of its pairs and
 // SIM_CONTACT_LIST_CAPACITY slots for them
 #define SIM_BIND_CONTACT_LISTS 30
@@ -233,10 +234,12 @@
 // The GPU's contact grid: words of its header in SIM_BIND_CONTACT_GRID (x the bits of the longest
 // live edge's squared length, y 1 when a triangle crosses another, z the particles in contact, w 1
 // when the pair lists are built this substep, then 1 when the grid is built this substep and 1 when a
-// list overflowed in this substep's build), and
+// list overflowed in this substep's build; from word 8 what contact_clear gathers: contactFrame's lo
+// and hi as orderedBits and the bits of `lowest`, then the box of the particles' travel since the
+// lists were built, as orderedBits), and
 // the cells a box spans at most (cells as wide as the longest edge and the contact diameter, with
 // room to spare for rounding: two a side)
-#define SIM_CONTACT_HEADER 8u
+#define SIM_CONTACT_HEADER 24u
 #define SIM_CONTACT_CELLS_PER_BOX 8u
 #define SIM_CONTACT_CELL_ROOM 1.01f
 

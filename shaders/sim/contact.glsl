@@ -3,8 +3,8 @@
 // scatter; cells as wide as the longest edge and the contact diameter, so a box spans two cells a
 // side at most) is built in a substep that needs it; the crossing check looks its triangles up in
 // it. Each particle and each edge (a query) keeps a list of the primitives within contactReach of
-// it, as the CPU's lists do: built from the grid when a particle has travelled contactTravel since
-// the last build (or the triangles, the radius or the audit say so), in the query's own slots, in
+// it, as the CPU's lists do: built from the grid when the particles' travel since the last build
+// outgrew them (listsOutgrown; or the triangles, the radius or the audit say so), in the query's own slots, in
 // the order of the grid; a query with more than its slots (u.contact_check.w) looks the grid up
 // every substep. The grid's passes dispatch indirectly (contact_arm: no workgroups in a substep
 // that does not build it), and between builds contact_walk runs over the queries with pairs alone
@@ -27,6 +27,15 @@
 #define CONTACT_REBUILD 3u
 #define CONTACT_GRID 4u
 #define CONTACT_OVERFLOW 5u
+// contactFrame's inputs, gathered by contact_clear: the bounded particles' last steps, lowest (3
+// words) and highest (3 words) as orderedBits, and the bits of their lowest start above the floor
+#define CONTACT_FRAME_LO 8u
+#define CONTACT_FRAME_HI 11u
+#define CONTACT_LOWEST 14u
+// The particles' travel since the lists were built, lowest (3 words) and highest (3 words) as
+// orderedBits (contactTravelled)
+#define CONTACT_TRAVEL_LO 15u
+#define CONTACT_TRAVEL_HI 18u
 // Words of the lists' header (SIM_CONTACT_LIST_HEADER): the triangle count + 1 they were built for
 // (0: none stand), the bits of the radius, the builds so far
 #define LIST_KEY 0u
@@ -253,12 +262,17 @@ uvec2 bucketRange(ivec3 cell, bool edge) {
 // contact_begin: the header cleared (one invocation); the lists are built again in substep s when
 // none stand, the triangles or the radius changed, the audit checks every triangle, or (`passes`:
 // the contact_* passes, not the fused tick) contact_emit did not name the queries of the last build
-// (a particle that travelled too far says so in contact_clear), and the grid when they are, when a
+// (the particles' travel outgrew them: contactTravelled after contact_clear), and the grid when they are, when a
 // list overflowed at the last build, or when crossingChecked may name a triangle: the audit, the
 // grab's (now or the last tick), or a particle free in the last substep (a triangle crossed)
 void contactBegin(uint s, bool passes) {
   bool crossed = contact_words[CONTACT_TANGLED] != 0u;
   for (uint w = 0u; w < SIM_CONTACT_HEADER; ++w) contact_words[w] = 0u;
+  for (uint c = 0u; c < 3u; ++c) { // none yet
+    contact_words[CONTACT_FRAME_LO + c] = 0xFFFFFFFFu;
+    contact_words[CONTACT_TRAVEL_LO + c] = 0xFFFFFFFFu;
+  }
+  contact_words[CONTACT_LOWEST] = 0x7F800000u;
   bool audit = s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u;
   bool stand = contact_lists[listHeader() + LIST_KEY] == counters.triangle_count + 1u &&
                contact_lists[listHeader() + LIST_RADIUS] == floatBitsToUint(u.contact.x) && !audit;
@@ -269,25 +283,57 @@ void contactBegin(uint s, bool passes) {
   if (!stand || check || contact_lists[listHeader() + LIST_SEARCH] != 0u) contact_words[CONTACT_GRID] = 1u;
 }
 
+// Lowest (w = 0) or highest (w = 1) of a box contact_clear gathered at word w0 (orderedBits)
+vec3 gatheredCorner(uint w0) {
+  return vec3(orderedFloat(contact_words[w0]), orderedFloat(contact_words[w0 + 1u]),
+              orderedFloat(contact_words[w0 + 2u]));
+}
+
+// One invocation after contact_clear: the lists (and the grid) are built in this substep when the
+// particles' travel since the last build outgrew them (listsOutgrown)
+void contactTravelled() {
+  if (listsOutgrown(gatheredCorner(CONTACT_TRAVEL_LO), gatheredCorner(CONTACT_TRAVEL_HI), u.contact.x)) {
+    contact_words[CONTACT_REBUILD] = 1u;
+    contact_words[CONTACT_GRID] = 1u;
+  }
+}
+
+// The translation taken out of this substep's steps (contactFrame), from what contact_clear gathered
+vec3 contactFrameNow() {
+  if (contact_words[CONTACT_FRAME_LO] > contact_words[CONTACT_FRAME_HI]) return vec3(0.0f); // none bounded
+  return contactFrame(gatheredCorner(CONTACT_FRAME_LO), gatheredCorner(CONTACT_FRAME_HI),
+                      uintBitsToFloat(contact_words[CONTACT_LOWEST]));
+}
+
 // Elements contact_clear covers: the particles, the edges
 uint contactSlots() { return max(u.particle_count, contactEdgeCount()); }
 // Elements contact_grid_clear covers: the buckets and their end
 uint contactBucketSlots() { return 2u * (u.contact_grid.x + 1u) + 1u; }
 
-// contact_clear: particle k's start of the substep (one that travelled too far since the lists were
-// built has them built again, and the grid); edge k's squared length raises the longest
+// contact_clear: particle k's start of the substep, its travel since the lists were built into the
+// box contactTravelled looks at, and when it is bounded its last step and height above the floor
+// into the frame's inputs; edge k's squared length raises the longest
 void contactClear(uint k) {
   if (k < u.particle_count) {
     float r = u.contact.x;
+    vec4 x = SIM_POSITION(k);
+    if (x.w > 0.0f && k != u.contact_check.y) {
+      vec3 step = vec3(x) - vec3(prev[k]);
+      for (uint c = 0u; c < 3u; ++c) {
+        atomicMin(contact_words[CONTACT_FRAME_LO + c], orderedBits(step[c]));
+        atomicMax(contact_words[CONTACT_FRAME_HI + c], orderedBits(step[c]));
+      }
+      float height = x.y - u.floor_y;
+      atomicMin(contact_words[CONTACT_LOWEST], floatBitsToUint(height > 0.0f ? height : 0.0f));
+    }
     contact_particles[k].start = SIM_POSITION(k);
     // Free in the last substep: bit 1 (crossingChecked looks at its triangles again)
     contact_particles[k].state = uvec4(floatBitsToUint(r * r), (contact_particles[k].state.y & 1u) << 1, 0u, 0u);
     contact_particles[k].sum = uvec4(0u);
     vec3 d = vec3(SIM_POSITION(k)) - listBase(k);
-    float travel = contactTravel(r);
-    if (!(dot3(d, d) < travel * travel)) {
-      atomicOr(contact_words[CONTACT_REBUILD], 1u);
-      atomicOr(contact_words[CONTACT_GRID], 1u);
+    for (uint c = 0u; c < 3u; ++c) {
+      atomicMin(contact_words[CONTACT_TRAVEL_LO + c], orderedBits(d[c]));
+      atomicMax(contact_words[CONTACT_TRAVEL_HI + c], orderedBits(d[c]));
     }
   }
   if (k < contactEdgeCount() && contactEdgeLive(k)) {
@@ -297,11 +343,13 @@ void contactClear(uint k) {
   }
 }
 
-// contact_arm: the live indirect arguments of the grid's passes (Grid::Contact), their full grids
+// contact_arm: whether the particles' travel builds the lists (contactTravelled), then the live
+// indirect arguments of the grid's passes (Grid::Contact), their full grids
 // when the grid is built in this substep, else no workgroups: a substep that does not build it
 // dispatches none of them (a CPU device runs every instruction of a kernel for each group of
 // invocations, even those that return at once)
 void contactArm() {
+  contactTravelled();
   bool built = gridBuilt();
   for (uint k = 0u; k < SIM_CONTACT_GRID_DISPATCHES; ++k)
     hash_args[SIM_CONTACT_GRID_ARGS + k] =
@@ -507,6 +555,7 @@ void contactBound(uint i) {
     contact_lists[listHeader() + LIST_BUILDS] += 1u;
     contact_lists[listHeader() + LIST_SEARCH] = contact_words[CONTACT_OVERFLOW];
   }
+
   uint nearest = contactGoneWrong() ? 0u : contact_particles[i].state.x;
   if (nearest < floatBitsToUint(r * r)) atomicAdd(contact_words[CONTACT_COUNT], 1u);
   contact_particles[i].start.w =

@@ -4,6 +4,7 @@
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
 #define SIM_PUSH_TYPE SimPush
+#include "contact.glsl"
 #include "sim_common.glsl"
 #include "sim_elements.glsl"
 
@@ -15,7 +16,7 @@ void main() {
   bool placed = u.grab_target[p.substep].w > 0.5f && i == u.grab_index;
   if (u.contact.x > 0.0f && st.position.w > 0.0f && !placed)
     st = contactStep(st, vec3(contact_particles[i].start), vec3(contact_particles[i].push),
-                     contact_particles[i].start.w);
+                     contact_particles[i].start.w, contactFrameNow());
   pos[i] = st.position;
   prev[i] = st.previous;
 }

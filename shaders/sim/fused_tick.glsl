@@ -81,6 +81,8 @@ void contactSubstep(uint s, uint n) {
   uint slots = contactSlots(), boxes = u.triangle_count + contactEdgeCount();
   for (uint k = lid; k < slots; k += kInvocations) contactClear(k);
   sync();
+  if (lid == 0u) contactTravelled();
+  sync();
   for (uint k = lid; k < contactBucketSlots(); k += kInvocations) contactGridClear(k);
   sync();
   for (uint k = lid; k < boxes; k += kInvocations) contactInsert(k, false);
@@ -243,7 +245,7 @@ void main() {
       bool placed = u.grab_target[s].w > 0.5f && i == u.grab_index; // the grab is not bounded
       if (u.contact.x > 0.0f && st.position.w > 0.0f && !placed)
         st = contactStep(st, vec3(contact_particles[i].start), vec3(contact_particles[i].push),
-                         contact_particles[i].start.w);
+                         contact_particles[i].start.w, contactFrameNow());
 #endif
       s_pos[i] = st.position;
       prev[i] = st.previous;

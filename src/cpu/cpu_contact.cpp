@@ -54,6 +54,9 @@ void visitBox(const Grid& grid, const std::vector<vec3>& lows, const std::vector
 
 float length2(vec3 a) { return dot3(a, a); }
 
+/// The corner of a box whose components are gathered as orderedBits.
+vec3 orderedCorner(glm::uvec3 o) { return vec3(orderedFloat(o.x), orderedFloat(o.y), orderedFloat(o.z)); }
+
 bool less4(uvec4 a, uvec4 b) {
   if (a.x != b.x) return a.x < b.x;
   if (a.y != b.y) return a.y < b.y;
@@ -81,13 +84,48 @@ void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3
   for (uint32_t i = 0; i < n; ++i) cells(i, [&](uint32_t h) { entry[fill[h]++] = i; });
 }
 
-void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
-                               const SimUniforms& u, uint32_t s, std::vector<float>& bound,
-                               std::vector<glm::vec4>& push) {
+void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::vec4>& prev,
+                               const std::vector<uvec4>& triangles, uint32_t count, const SimUniforms& u, uint32_t s,
+                               std::vector<float>& bound, std::vector<glm::vec4>& push) {
   const uint32_t n = uint32_t(pos.size());
   const float radius = u.contact.x, thickness = u.contact.z, scale = u.contact.w;
   bound.resize(n);
   push.resize(n);
+  // What the GPU's contact_clear gathers, in orderedBits (the same bits in any order): the frame's
+  // inputs (the bounded particles' last steps, lowest and highest, and their lowest start above the
+  // floor) and the box of every particle's travel since the lists were built
+  struct Gathered {
+    glm::uvec3 lo{~0u}, hi{0u}, travel_lo{~0u}, travel_hi{0u};
+    uint32_t lowest = std::bit_cast<uint32_t>(INFINITY);
+  } all;
+  const bool based = base_.size() == n;
+  std::mutex merge;
+  pool_.parallelFor(n, kGrainParticles, [&](uint32_t begin, uint32_t end) {
+    Gathered g;
+    for (uint32_t i = begin; i < end; ++i) {
+      const vec3 step = vec3(pos[i]) - vec3(prev[i]), d = based ? vec3(pos[i]) - vec3(base_[i]) : vec3(0.0f);
+      const bool bounded = pos[i].w > 0.0f && i != u.contact_check.y;
+      for (int c = 0; c < 3; ++c) {
+        if (bounded) {
+          g.lo[c] = std::min(g.lo[c], orderedBits(step[c]));
+          g.hi[c] = std::max(g.hi[c], orderedBits(step[c]));
+        }
+        g.travel_lo[c] = std::min(g.travel_lo[c], orderedBits(d[c]));
+        g.travel_hi[c] = std::max(g.travel_hi[c], orderedBits(d[c]));
+      }
+      const float height = pos[i].y - u.floor_y;
+      if (bounded) g.lowest = std::min(g.lowest, std::bit_cast<uint32_t>(height > 0.0f ? height : 0.0f));
+    }
+    const std::lock_guard<std::mutex> lock(merge);
+    all.lo = glm::min(all.lo, g.lo);
+    all.hi = glm::max(all.hi, g.hi);
+    all.travel_lo = glm::min(all.travel_lo, g.travel_lo);
+    all.travel_hi = glm::max(all.travel_hi, g.travel_hi);
+    all.lowest = std::min(all.lowest, g.lowest);
+  });
+  frame_ = all.lo.x > all.hi.x
+               ? vec3(0.0f)
+               : contactFrame(orderedCorner(all.lo), orderedCorner(all.hi), std::bit_cast<float>(all.lowest));
   if (edges_key_ != count) {
     edges_.clear();
     for (uint32_t t = 0; t < count; ++t) {
@@ -101,14 +139,10 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
     lists_ = false;
   }
   const float r = radius, r2 = r * r;
-  // The pair lists hold every pair that can be closer than r while no particle has travelled
-  // contactTravel from where it was when they were built
-  bool fresh = lists_ && list_radius_ == radius && base_.size() == n;
-  const float travel = contactTravel(radius);
-  for (uint32_t i = 0; fresh && i < n; ++i) {
-    const vec3 d = vec3(pos[i]) - vec3(base_[i]);
-    fresh = dot3(d, d) < travel * travel;
-  }
+  // The pair lists hold every pair that can be closer than r while the particles' travel since
+  // they were built stays within contactTravel of one point (listsOutgrown)
+  const bool fresh = lists_ && list_radius_ == radius && based &&
+                     !listsOutgrown(orderedCorner(all.travel_lo), orderedCorner(all.travel_hi), radius);
   if (!fresh) buildLists(pos, triangles, count, radius);
   findCrossings(pos, triangles, count, s == 0 && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u, u.contact_check.y,
                 u.contact_check.z);
@@ -300,6 +334,7 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
   base_ = pos;
   list_radius_ = radius;
   lists_ = true;
+  ++builds_;
 }
 
 uint64_t CpuContact::memoryBytes() const {

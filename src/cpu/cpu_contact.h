@@ -17,16 +17,21 @@ class CpuContact {
 public:
   explicit CpuContact(WorkerPool& pool) : pool_(pool) {}
 
-  /// The step bound of each particle at `pos` (xyz; w inverse mass) in substep `s`, of the sheet
-  /// made of the first `count` triangles of `triangles` (xyz: their particles), for the contact of
-  /// `u` (SimUniforms::contact, contact_check), into `bound`, and in `push` the push that parts
-  /// the pairs closer than the thickness (contactPush, averaged over a particle's pairs). The edges
-  /// are worked out again when the triangles change (a tear).
-  void computeBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
-                     const shaderio::SimUniforms& u, uint32_t s, std::vector<float>& bound,
-                     std::vector<glm::vec4>& push);
+  /// The step bound of each particle at `pos` (xyz; w inverse mass; `prev` where each was a
+  /// substep before) in substep `s`, of the sheet made of the first `count` triangles of
+  /// `triangles` (xyz: their particles), for the contact of `u` (SimUniforms::contact,
+  /// contact_check), into `bound`, and in `push` the push that parts the pairs closer than the
+  /// thickness (contactPush, averaged over a particle's pairs); the frame of the substep's steps
+  /// (contactFrame) in frame(). The edges are worked out again when the triangles change (a tear).
+  void computeBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::vec4>& prev,
+                     const std::vector<glm::uvec4>& triangles, uint32_t count, const shaderio::SimUniforms& u,
+                     uint32_t s, std::vector<float>& bound, std::vector<glm::vec4>& push);
+  /// The translation taken out of the steps of the substep of the last call before their bounds.
+  glm::vec3 frame() const { return frame_; }
   /// Particles within the radius of a primitive at the last call.
   uint64_t contacts() const { return contacts_; }
+  /// The times the pair lists were built.
+  uint32_t listBuilds() const { return builds_; }
   /// True when the sheet crossed itself at the last call (the particles of the crossing triangles
   /// went unbounded to untangle it).
   bool crossedItself() const { return tangles_; }
@@ -76,6 +81,8 @@ private:
   std::vector<uint32_t> nearest2_; ///< the bits of each particle's smallest squared distance
   Grid grid_;
   uint64_t contacts_ = 0;
+  uint32_t builds_ = 0;
+  glm::vec3 frame_{0.0f};
 };
 
 } // namespace tender

@@ -179,13 +179,14 @@ void CpuSolver::repelPass(const SimUniforms& u) {
 void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
   const bool contact = u.contact.x > 0.0f;
   const bool placed = u.grab_target[s].w > 0.5f; // the grabbed particle goes where the user puts it
+  const vec3 frame = contact ? contact_.frame() : vec3(0.0f);
   pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
     vec4* pos = pos_.data();
     vec4* prev = prev_.data();
     for (uint32_t i = begin; i < end; ++i) {
       VerletState st = floorContact(pos[i], prev[i], u.floor_y, u.restitution, u.friction);
       if (contact && st.position.w > 0.0f && !(placed && i == u.grab_index))
-        st = contactStep(st, vec3(start_[i]), vec3(push_[i]), bound_[i]);
+        st = contactStep(st, vec3(start_[i]), vec3(push_[i]), bound_[i], frame);
       pos[i] = st.position;
       prev[i] = st.previous;
     }
@@ -329,7 +330,7 @@ void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint3
   case PassKind::integrate:
     contact_on_ = u.contact.x > 0.0f;
     if (contact_on_) { // the step bounds of the substep, from where the particles start it
-      contact_.computeBounds(pos_, triangles_, triangle_count_, u, s, bound_, push_);
+      contact_.computeBounds(pos_, prev_, triangles_, triangle_count_, u, s, bound_, push_);
       start_ = pos_;
     }
     integrate(u, s); // the air, then damped Verlet, gravity, wind; pins and the grab hold

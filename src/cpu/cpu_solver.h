@@ -62,6 +62,8 @@ public:
   Arithmetic arithmetic() const override;
   uint32_t dispatchesPerTick() const override { return passes_per_tick_; }
   int64_t contacts() const override { return contact_on_ ? int64_t(contact_.contacts()) : -1; }
+  /// The times contact's pair lists were built so far.
+  uint32_t contactListBuilds() const { return contact_.listBuilds(); }
   /// Bytes of host memory of the solver's own arrays (capacity, not size).
   uint64_t memoryBytes() const override;
   /// Worker threads in use, the caller included.
