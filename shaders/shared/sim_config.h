@@ -200,8 +200,10 @@
 // ... then contact_walk's live arguments (w: the queries it walks), then those contact_emit wrote at
 // the last build of the lists
 #define SIM_CONTACT_WALK_ARGS (SIM_CONTACT_GRID_ARGS + 2u * SIM_CONTACT_GRID_DISPATCHES)
+// ... then contact_cross's live arguments (contact_arm: every triangle, or none)
+#define SIM_CONTACT_CROSS_ARGS (SIM_CONTACT_WALK_ARGS + 2u)
 // The uvec4 of SIM_BIND_HASH_ARGS
-#define SIM_SHEET_ARGS (SIM_CONTACT_WALK_ARGS + 2u)
+#define SIM_SHEET_ARGS (SIM_CONTACT_CROSS_ARGS + 1u)
 
 // Penetration-free contact (contact.h): the part of the distance to its nearest primitive a particle
 // may move in a substep; below 1/2, with room for rounding
@@ -234,12 +236,15 @@
 // The GPU's contact grid: words of its header in SIM_BIND_CONTACT_GRID (x the bits of the longest
 // live edge's squared length, y 1 when a triangle crosses another, z the particles in contact, w 1
 // when the pair lists are built this substep, then 1 when the grid is built this substep and 1 when a
-// list overflowed in this substep's build; from word 8 what contact_clear gathers: contactFrame's lo
-// and hi as orderedBits and the bits of `lowest`, then the box of the particles' travel since the
-// lists were built, as orderedBits), and
+// list overflowed in this substep's build, 1 when the grab's triangles are named for the crossing
+// check instead of the grid; from word 8 what contact_clear gathers: contactFrame's lo and hi as
+// orderedBits and the bits of `lowest`, the box of the particles' travel since the lists were
+// built as orderedBits, and the grab's triangles named, their count then them), and
 // the cells a box spans at most (cells as wide as the longest edge and the contact diameter, with
 // room to spare for rounding: two a side)
-#define SIM_CONTACT_HEADER 24u
+#define SIM_CONTACT_HEADER 40u
+// The grab's triangles contact_clear names for contact_cross at most (more: the grid is built)
+#define SIM_CONTACT_NAMED_TRIANGLES 16u
 #define SIM_CONTACT_CELLS_PER_BOX 8u
 #define SIM_CONTACT_CELL_ROOM 1.01f
 

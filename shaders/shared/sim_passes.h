@@ -92,7 +92,9 @@
 //   grid      Threads (from the elements), Hash (the live hash arguments candidates_decide
 //             copies), Contact (the live arguments of contact's grid passes contact_arm copies:
 //             none in a substep that does not build the grid), Walk (contact_walk's, over the
-//             queries with pairs in their lists: none in a substep that builds them) or
+//             queries with pairs in their lists: none in a substep that builds them), Cross
+//             (contact_cross's, over the triangles: none in a substep whose crossing check looks
+//             at no triangle) or
 //             Compaction (the tear compaction's arguments): gpu::Grid
 //   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)
 //   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases),
@@ -107,7 +109,7 @@
   X(integrate, contact_count, CONTACT_BOXES, Contact, TICK, CONTACT, Contact)                                          \
   X(integrate, scan, CONTACT_CELLS, Contact, TICK, CONTACT, Contact)                                                   \
   X(integrate, contact_scatter, CONTACT_BOXES, Contact, TICK, CONTACT, Contact)                                        \
-  X(integrate, contact_cross, TRIANGLES, Contact, TICK, CONTACT, Contact)                                              \
+  X(integrate, contact_cross, TRIANGLES, Cross, TICK, CONTACT, Contact)                                                \
   X(integrate, contact_near, CONTACT_QUERIES, Contact, TICK, CONTACT, Contact)                                         \
   X(integrate, contact_active, CONTACT_ACTIVE, Contact, TICK, CONTACT, Contact)                                        \
   X(integrate, scan, CONTACT_ACTIVE_CELLS, Contact, TICK, CONTACT, Contact)                                            \

@@ -27,6 +27,11 @@
 #define CONTACT_REBUILD 3u
 #define CONTACT_GRID 4u
 #define CONTACT_OVERFLOW 5u
+// 1 when the crossing check looks at the grab's triangles alone and the grid is not built for it:
+// contact_clear names them (their count, then them) and contact_cross looks at every triangle
+#define CONTACT_FEW 6u
+#define CONTACT_NAMED_COUNT 21u
+#define CONTACT_NAMED 22u
 // contactFrame's inputs, gathered by contact_clear: the bounded particles' last steps, lowest (3
 // words) and highest (3 words) as orderedBits, and the bits of their lowest start above the floor
 #define CONTACT_FRAME_LO 8u
@@ -263,8 +268,9 @@ uvec2 bucketRange(ivec3 cell, bool edge) {
 // none stand, the triangles or the radius changed, the audit checks every triangle, or (`passes`:
 // the contact_* passes, not the fused tick) contact_emit did not name the queries of the last build
 // (the particles' travel outgrew them: contactTravelled after contact_clear), and the grid when they are, when a
-// list overflowed at the last build, or when crossingChecked may name a triangle: the audit, the
-// grab's (now or the last tick), or a particle free in the last substep (a triangle crossed)
+// list overflowed at the last build, or when crossingChecked may name many triangles: the audit or
+// a particle free in the last substep (a triangle crossed); the grab's triangles alone (now or the
+// last tick) are looked at without it (CONTACT_FEW)
 void contactBegin(uint s, bool passes) {
   bool crossed = contact_words[CONTACT_TANGLED] != 0u;
   for (uint w = 0u; w < SIM_CONTACT_HEADER; ++w) contact_words[w] = 0u;
@@ -278,9 +284,12 @@ void contactBegin(uint s, bool passes) {
                contact_lists[listHeader() + LIST_RADIUS] == floatBitsToUint(u.contact.x) && !audit;
   // The passes walk the queries contact_emit named: lists the fused tick built are built again
   if (passes) stand = stand && contact_lists[listHeader() + LIST_NAMED] == contact_lists[listHeader() + LIST_BUILDS];
-  bool check = audit || crossed || u.contact_check.y != SIM_NONE || u.contact_check.z != SIM_NONE;
+  bool grab = u.contact_check.y != SIM_NONE || u.contact_check.z != SIM_NONE;
   if (!stand) contact_words[CONTACT_REBUILD] = 1u;
-  if (!stand || check || contact_lists[listHeader() + LIST_SEARCH] != 0u) contact_words[CONTACT_GRID] = 1u;
+  if (!stand || audit || crossed || contact_lists[listHeader() + LIST_SEARCH] != 0u)
+    contact_words[CONTACT_GRID] = 1u;
+  else if (grab)
+    contact_words[CONTACT_FEW] = 1u; // the grab's few triangles, against every triangle
 }
 
 // Lowest (w = 0) or highest (w = 1) of a box contact_clear gathered at word w0 (orderedBits)
@@ -336,6 +345,15 @@ void contactClear(uint k) {
       atomicMax(contact_words[CONTACT_TRAVEL_HI + c], orderedBits(d[c]));
     }
   }
+  // The grab's triangles, named for contact_cross (a sheet's triangles are fewer than its edges)
+  if (contact_words[CONTACT_FEW] != 0u && k < counters.triangle_count &&
+      crossingChecked(false, triangles[k].xyz, u.contact_check.y, u.contact_check.z, false)) {
+    uint slot = atomicAdd(contact_words[CONTACT_NAMED_COUNT], 1u);
+    if (slot < SIM_CONTACT_NAMED_TRIANGLES)
+      contact_words[CONTACT_NAMED + slot] = k;
+    else
+      atomicOr(contact_words[CONTACT_GRID], 1u); // too many: the grid after all
+  }
   if (k < contactEdgeCount() && contactEdgeLive(k)) {
     uvec2 edge = contactEdge(k).xy;
     vec3 d = vec3(SIM_POSITION(edge.y)) - vec3(SIM_POSITION(edge.x));
@@ -356,6 +374,11 @@ void contactArm() {
         built ? hash_args[SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES + k] : uvec4(0u, 1u, 1u, 0u);
   // contact_walk: the queries with pairs at the last build, unless the lists are built now
   hash_args[SIM_CONTACT_WALK_ARGS] = listsRebuilt() ? uvec4(0u, 1u, 1u, 0u) : hash_args[SIM_CONTACT_WALK_ARGS + 1u];
+  // contact_cross: every triangle when the grid is built or the grab's triangles are named
+  bool cross = built || contact_words[CONTACT_FEW] != 0u;
+  hash_args[SIM_CONTACT_CROSS_ARGS] =
+      cross ? uvec4(groupGrid((u.triangle_count + SIM_WG_PARTICLES - 1u) / SIM_WG_PARTICLES), 1u, 0u)
+            : uvec4(0u, 1u, 1u, 0u);
 }
 
 // contact_grid_clear: bucket k cleared when the grid is built (dispatched only then: contact_arm)
@@ -366,16 +389,32 @@ void contactGridClear(uint k) {
   if (k < buckets) scratch[contactFill() + k] = 0u;
 }
 
-// contact_cross: live triangle slot t, when crossingChecked names it in substep s, against every
-// triangle whose box meets its box (once: in the cell of the low corner of the boxes' overlap, which
-// both boxes span); the particles of the two go free when they cross
+// contact_cross: live triangle slot t in substep s. With the grid built: when crossingChecked names
+// t, against every triangle whose box meets its box (once: in the cell of the low corner of the
+// boxes' overlap, which both boxes span). With the grab's triangles named instead (CONTACT_FEW):
+// t against each of them whose box meets its box. The same pairs either way; the particles of two
+// that cross go free.
 void contactCross(uint t, uint s) {
-  if (t >= counters.triangle_count || contactGoneWrong() || !gridBuilt()) return;
+  if (t >= counters.triangle_count || contactGoneWrong()) return;
+  vec3 lo, hi;
+  if (!gridBuilt()) {
+    if (contact_words[CONTACT_FEW] == 0u) return;
+    contactBox(t, lo, hi);
+    // Those whose boxes meet first, then those weighed: a CPU device runs the costly test once a
+    // meeting pair, not once a named triangle
+    uint named = min(contact_words[CONTACT_NAMED_COUNT], SIM_CONTACT_NAMED_TRIANGLES), meet = 0u;
+    for (uint j = 0u; j < named; ++j) {
+      vec3 clo, chi;
+      contactBox(contact_words[CONTACT_NAMED + j], clo, chi);
+      if (boxesMeet(clo, chi, lo, hi)) meet |= 1u << j;
+    }
+    for (; meet != 0u; meet &= meet - 1u) visitCrossing(contact_words[CONTACT_NAMED + uint(findLSB(meet))], t);
+    return;
+  }
   uvec4 tri = triangles[t];
   uint was = contact_particles[tri.x].state.y | contact_particles[tri.y].state.y | contact_particles[tri.z].state.y;
   bool all = s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u;
   if (!crossingChecked(all, tri.xyz, u.contact_check.y, u.contact_check.z, (was & 2u) != 0u)) return;
-  vec3 lo, hi;
   loadBox(t, lo, hi);
   float inv = contactInvCell();
   ivec3 a = cellOf(lo, inv), b = min(cellOf(hi, inv), a + ivec3(4)), cell = a;

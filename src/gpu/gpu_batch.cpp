@@ -434,6 +434,7 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
     break;
   case Grid::Contact:
   case Grid::Walk:
+  case Grid::Cross:
     // A sheet with contact runs its passes on its own (passOfSheet)
     vkCheckFailed(VK_ERROR_UNKNOWN, "contact in a batched pass", __FILE__, __LINE__);
   }

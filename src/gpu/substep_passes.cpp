@@ -12,6 +12,7 @@ glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets) {
 }
 
 uint32_t HashGrids::record(Grid grid, glm::uvec4 full) {
+  if (grid == Grid::Cross) return 0; // its own slot, amid the contact grid's passes
   if (grid != Grid::Hash && grid != Grid::Contact) {
     next_ = next_contact_ = 0;
     return 0;
@@ -29,7 +30,8 @@ uint32_t HashGrids::record(Grid grid, glm::uvec4 full) {
 bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& hash_grids, const ComputePipeline& p,
                      Grid grid, uint32_t count, const void* push, uint32_t push_size) {
   if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
-  if ((grid == Grid::Threads || grid == Grid::Contact || grid == Grid::Walk) && count == 0) return false;
+  if ((grid == Grid::Threads || grid == Grid::Contact || grid == Grid::Walk || grid == Grid::Cross) && count == 0)
+    return false;
   const glm::uvec4 full = fullGrid(p, count);
   const uint32_t hash_dispatch = hash_grids.record(grid, full);
   if (bound != p.pipeline) {
@@ -55,6 +57,10 @@ bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& has
   case Grid::Walk:
     // The queries with pairs in their lists at the last build, or none when they are built now
     vkCmdDispatchIndirect(t.cmd, t.hash_args, t.hash_offset + 16ull * SIM_CONTACT_WALK_ARGS);
+    break;
+  case Grid::Cross:
+    // Every triangle when the crossing check looks at one this substep, or none
+    vkCmdDispatchIndirect(t.cmd, t.hash_args, t.hash_offset + 16ull * SIM_CONTACT_CROSS_ARGS);
     break;
   }
   return true;

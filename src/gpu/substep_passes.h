@@ -17,7 +17,7 @@ namespace tender::gpu {
 /// workgroups when the candidate lists stand in for the hash), the next live argument of
 /// contact's grid passes (zero workgroups in a substep that does not build the grid), or
 /// contact_walk's (the queries with pairs in their lists; none in a substep that builds them).
-enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash, Contact, Walk };
+enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash, Contact, Walk, Cross };
 
 /// Timestamp categories of a tick, in Solver::passTimes() order (SIM_DISPATCHES' category column
 /// names the first six). kFused: the fused small-sheet tick, every pass in one dispatch.
