@@ -190,10 +190,10 @@ SIM_INLINE float orderedFloat(uint o) { return uintBitsToFloat((o & 0x80000000u)
 /// above), from the bounded particles' steps in the last substep (componentwise lowest `lo` and
 /// highest `hi`) and the lowest start of one above the floor, `lowest` (>= 0): the point of the box
 /// [lo, hi] nearest to no step, raised so that no start + it goes below the floor. Each component
-/// lies between 0 and every particle's own, so a step with the frame taken out and cut to its bound
-/// (a blend of the frame and the step) is in no direction longer than the step: while one particle
-/// rests the frame is none, and a sheet falling as a whole falls at least as fast as its slowest
-/// particle.
+/// lies between 0 and every particle's last step, and a step cut to its bound ends between the frame
+/// and the particle's own step, so a particle that goes on moving with the sheet is carried no
+/// farther than its own step along any axis; while one particle rests the frame is none, and a
+/// sheet falling as a whole falls at least as fast as its slowest particle.
 SIM_INLINE vec3 contactFrame(vec3 lo, vec3 hi, float lowest) {
   vec3 t = vec3(lo.x > 0.0f ? lo.x : (hi.x < 0.0f ? hi.x : 0.0f), lo.y > 0.0f ? lo.y : (hi.y < 0.0f ? hi.y : 0.0f),
                 lo.z > 0.0f ? lo.z : (hi.z < 0.0f ? hi.z : 0.0f));
