@@ -239,10 +239,11 @@
 // list overflowed in this substep's build, 1 when the grab's triangles are named for the crossing
 // check instead of the grid; from word 8 what contact_clear gathers: contactFrame's lo and hi as
 // orderedBits and the bits of `lowest`, the box of the particles' travel since the lists were
-// built as orderedBits, and the grab's triangles named, their count then them), and
+// built as orderedBits, the grab's triangles named, their count then them, and the frame that
+// contact_bound works out from what was gathered), and
 // the cells a box spans at most (cells as wide as the longest edge and the contact diameter, with
 // room to spare for rounding: two a side)
-#define SIM_CONTACT_HEADER 40u
+#define SIM_CONTACT_HEADER 44u
 // The grab's triangles contact_clear names for contact_cross at most (more: the grid is built)
 #define SIM_CONTACT_NAMED_TRIANGLES 16u
 #define SIM_CONTACT_CELLS_PER_BOX 8u

@@ -41,6 +41,8 @@
 // orderedBits (contactTravelled)
 #define CONTACT_TRAVEL_LO 15u
 #define CONTACT_TRAVEL_HI 18u
+// The substep's frame (3 words, float bits): contact_bound works it out once for the floor's steps
+#define CONTACT_FRAME 38u
 // Words of the lists' header (SIM_CONTACT_LIST_HEADER): the triangle count + 1 they were built for
 // (0: none stand), the bits of the radius, the builds so far
 #define LIST_KEY 0u
@@ -307,11 +309,11 @@ void contactTravelled() {
   }
 }
 
-// The translation taken out of this substep's steps (contactFrame), from what contact_clear gathered
+// The translation taken out of this substep's steps (contactFrame, from what contact_clear
+// gathered), as contact_bound kept it
 vec3 contactFrameNow() {
-  if (contact_words[CONTACT_FRAME_LO] > contact_words[CONTACT_FRAME_HI]) return vec3(0.0f); // none bounded
-  return contactFrame(gatheredCorner(CONTACT_FRAME_LO), gatheredCorner(CONTACT_FRAME_HI),
-                      uintBitsToFloat(contact_words[CONTACT_LOWEST]));
+  return uintBitsToFloat(
+      uvec3(contact_words[CONTACT_FRAME], contact_words[CONTACT_FRAME + 1u], contact_words[CONTACT_FRAME + 2u]));
 }
 
 // Elements contact_clear covers: the particles, the edges
@@ -584,7 +586,7 @@ void contactWalk(uint j) {
 }
 
 // contact_bound: particle i's step bound (stepBound; unbounded when free) and push
-// (contactAverage); the particles in contact counted
+// (contactAverage); the particles in contact counted; the substep's frame (contactFrame)
 void contactBound(uint i) {
   float r = u.contact.x;
   if (i == 0u && listsRebuilt()) {
@@ -594,7 +596,16 @@ void contactBound(uint i) {
     contact_lists[listHeader() + LIST_BUILDS] += 1u;
     contact_lists[listHeader() + LIST_SEARCH] = contact_words[CONTACT_OVERFLOW];
   }
-
+  if (i == 0u) {
+    // The substep's frame, once (contactFrameNow)
+    bool none = contact_words[CONTACT_FRAME_LO] > contact_words[CONTACT_FRAME_HI]; // no particle bounded
+    vec3 t = none ? vec3(0.0f)
+                  : contactFrame(gatheredCorner(CONTACT_FRAME_LO), gatheredCorner(CONTACT_FRAME_HI),
+                                 uintBitsToFloat(contact_words[CONTACT_LOWEST]));
+    contact_words[CONTACT_FRAME] = floatBitsToUint(t.x);
+    contact_words[CONTACT_FRAME + 1u] = floatBitsToUint(t.y);
+    contact_words[CONTACT_FRAME + 2u] = floatBitsToUint(t.z);
+  }
   uint nearest = contactGoneWrong() ? 0u : contact_particles[i].state.x;
   if (nearest < floatBitsToUint(r * r)) atomicAdd(contact_words[CONTACT_COUNT], 1u);
   contact_particles[i].start.w =
