@@ -11,7 +11,7 @@
 namespace tender::render {
 
 std::optional<std::string> renderSequence(const HeadlessOptions& o, const FrameSequence& seq,
-                                          uint32_t* validation_messages) {
+                                          uint32_t* validation_messages, std::string* device) {
   gpu::ContextOptions co;
   co.device = o.device;
   co.validation = o.validation;
@@ -20,6 +20,7 @@ std::optional<std::string> renderSequence(const HeadlessOptions& o, const FrameS
   auto created = gpu::VulkanContext::create(co);
   if (!created) return created.error();
   std::unique_ptr<gpu::VulkanContext> ctx = std::move(created.value());
+  if (device) *device = ctx->info().name;
   try {
     // The receipt first: a missing font is reported before any work.
     ReceiptImage receipt = rasterizeReceipt(receiptText(o.params.preset));
@@ -77,7 +78,7 @@ HeadlessResult renderHeadless(const HeadlessOptions& o) {
     result.picture = picture;
     return std::nullopt;
   };
-  if (auto err = renderSequence(o, one, &result.validation_messages)) result.error = *err;
+  if (auto err = renderSequence(o, one, &result.validation_messages, &result.device)) result.error = *err;
   return result;
 }
 

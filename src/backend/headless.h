@@ -29,6 +29,7 @@ struct HeadlessOptions {
 struct HeadlessResult {
   Picture picture;
   uint32_t validation_messages = 0; ///< warnings and errors reported by the validation layers
+  std::string device;               ///< the device that drew it (its name)
   std::string error;                ///< empty on success
 };
 
@@ -46,8 +47,9 @@ struct FrameSequence {
 };
 
 /// Runs the simulation once and renders every frame of the sequence; returns the first error (of
-/// Vulkan, the font, or the sink). `validation_messages`, when given, receives their count.
+/// Vulkan, the font, or the sink). `validation_messages`, when given, receives their count, and
+/// `device` the name of the device.
 std::optional<std::string> renderSequence(const HeadlessOptions& options, const FrameSequence& sequence,
-                                          uint32_t* validation_messages = nullptr);
+                                          uint32_t* validation_messages = nullptr, std::string* device = nullptr);
 
 } // namespace tender::render

@@ -3,7 +3,11 @@
 //
 // Tolerance: a pixel differs when a channel is off by more than 24 levels; at most 0.5% of the
 // pixels may differ and the mean absolute channel error must stay below 1.5 levels (rasteriser
-// and driver rounding, not a changed picture).
+// and driver rounding, not a changed picture). The goldens are lavapipe's pictures: on another
+// device, whose texture filtering (level of detail, anisotropy) Vulkan leaves to the driver, a
+// pixel differs only when no golden pixel within one pixel of it is within the 24 levels (the
+// edges of the printed text move by up to a pixel: 0.6-0.8% of the pixels on an NVIDIA H200,
+// mean error 0.8-0.9 levels); the mean error stays the whole picture's.
 // On failure the actual picture and a diff are written next to the test binary's working
 // directory as golden_<name>_actual.png and golden_<name>_diff.png.
 // Regenerate the goldens after an intended change with
@@ -55,7 +59,16 @@ std::string testDataDir() {
   return dir && *dir ? dir : TENDER_TEST_DATA;
 }
 
-void compareWithGolden(const std::string& name, const render::Picture& actual) {
+/// True when pixel p of `actual` is within the tolerance of pixel q of `golden` in every channel.
+bool within(const render::Picture& actual, size_t p, const render::Picture& golden, size_t q) {
+  for (int c = 0; c < 3; ++c)
+    if (std::abs(int(actual.rgba[p * 4 + c]) - int(golden.rgba[q * 4 + c])) > kChannelTolerance) return false;
+  return true;
+}
+
+void compareWithGolden(const std::string& name, const render::HeadlessResult& result) {
+  const render::Picture& actual = result.picture;
+  const bool lavapipe = result.device.rfind("llvmpipe", 0) == 0;
   const std::string golden_path = testDataDir() + "/golden_" + name + ".png";
   if (const char* u = std::getenv("TENDER_UPDATE_GOLDEN"); u && std::string(u) == "1") {
     ASSERT_FALSE(render::writePng(golden_path, actual));
@@ -70,18 +83,22 @@ void compareWithGolden(const std::string& name, const render::Picture& actual) {
   double total = 0.0;
   const size_t pixels = size_t(actual.width) * actual.height;
   for (size_t p = 0; p < pixels; ++p) {
-    int worst = 0;
-    for (int c = 0; c < 3; ++c) {
-      int d = std::abs(int(actual.rgba[p * 4 + c]) - int(golden.rgba[p * 4 + c]));
-      worst = std::max(worst, d);
-      total += d;
-    }
-    different += worst > kChannelTolerance;
+    for (int c = 0; c < 3; ++c) total += std::abs(int(actual.rgba[p * 4 + c]) - int(golden.rgba[p * 4 + c]));
+    bool close = within(actual, p, golden, p);
+    const int x = int(p % actual.width), y = int(p / actual.width);
+    for (int dy = -1; dy <= 1 && !close && !lavapipe; ++dy)
+      for (int dx = -1; dx <= 1 && !close; ++dx) {
+        const int nx = x + dx, ny = y + dy;
+        if (nx >= 0 && ny >= 0 && nx < int(actual.width) && ny < int(actual.height))
+          close = within(actual, p, golden, size_t(ny) * actual.width + size_t(nx));
+      }
+    const bool differs = !close;
+    different += differs;
     // Diff image: differences in red over a faded copy of the golden.
     uint8_t g = uint8_t(golden.rgba[p * 4 + 1] / 3 + 170);
-    diff.rgba[p * 4 + 0] = worst > kChannelTolerance ? 255 : g;
-    diff.rgba[p * 4 + 1] = worst > kChannelTolerance ? 0 : g;
-    diff.rgba[p * 4 + 2] = worst > kChannelTolerance ? 0 : g;
+    diff.rgba[p * 4 + 0] = differs ? 255 : g;
+    diff.rgba[p * 4 + 1] = differs ? 0 : g;
+    diff.rgba[p * 4 + 2] = differs ? 0 : g;
     diff.rgba[p * 4 + 3] = 255;
   }
   const double fraction = double(different) / double(pixels);
@@ -91,8 +108,9 @@ void compareWithGolden(const std::string& name, const render::Picture& actual) {
     (void)render::writePng("golden_" + name + "_actual.png", actual);
     (void)render::writePng("golden_" + name + "_diff.png", diff);
   }
-  EXPECT_TRUE(ok) << name << ": " << different << " pixels (" << fraction * 100.0 << "%) differ, mean error " << mean
-                  << "; wrote " << std::filesystem::absolute("golden_" + name + "_actual.png") << " and _diff.png";
+  EXPECT_TRUE(ok) << name << " (" << result.device << "): " << different << " pixels (" << fraction * 100.0
+                  << "%) differ, mean error " << mean << "; wrote "
+                  << std::filesystem::absolute("golden_" + name + "_actual.png") << " and _diff.png";
 }
 
 // Printed ink in the picture: pixels much darker than the background, the ground and the shadow.
@@ -127,7 +145,7 @@ TEST(Golden, TenderPresetHangingFromItsPins) {
   EXPECT_EQ(r.validation_messages, 0u);
   ASSERT_EQ(r.picture.width, 320u);
   EXPECT_GT(inkPixels(r.picture), 150u); // the receipt's text and barcode
-  compareWithGolden("tender_60", r.picture);
+  compareWithGolden("tender_60", r);
 }
 
 TEST(Golden, TornSheetShowsTheGap) {
@@ -137,14 +155,14 @@ TEST(Golden, TornSheetShowsTheGap) {
                         "15 move 0 -10 0\n");
   SKIP_OR_FAIL_ON_ERROR(r);
   EXPECT_EQ(r.validation_messages, 0u);
-  compareWithGolden("tender_torn", r.picture);
+  compareWithGolden("tender_torn", r);
 }
 
 TEST(Golden, CrumplePresetPrintsItsReceipt) {
   auto r = renderPreset("crumple", 30, "");
   SKIP_OR_FAIL_ON_ERROR(r);
   EXPECT_EQ(r.validation_messages, 0u);
-  compareWithGolden("crumple_30", r.picture);
+  compareWithGolden("crumple_30", r);
 }
 
 TEST(Golden, AHandCrumpledReceiptShowsItsCreases) {
@@ -155,7 +173,7 @@ TEST(Golden, AHandCrumpledReceiptShowsItsCreases) {
   auto r = renderPreset("crumple", 90, text);
   SKIP_OR_FAIL_ON_ERROR(r);
   EXPECT_EQ(r.validation_messages, 0u);
-  compareWithGolden("crumple_hand", r.picture);
+  compareWithGolden("crumple_hand", r);
 }
 
 // The GPU backend: the renderer binds the solver's own buffers and draws the live triangles with
@@ -165,7 +183,7 @@ TEST(Golden, GpuSolverBuffersDrawTheSamePicture) {
   SKIP_OR_FAIL_ON_ERROR(r);
   EXPECT_EQ(r.validation_messages, 0u);
   if (std::getenv("TENDER_UPDATE_GOLDEN")) GTEST_SKIP() << "the CPU render is the golden";
-  compareWithGolden("tender_60", r.picture);
+  compareWithGolden("tender_60", r);
 }
 
 TEST(Golden, GpuSolverTornSheet) {
@@ -176,5 +194,5 @@ TEST(Golden, GpuSolverTornSheet) {
   SKIP_OR_FAIL_ON_ERROR(r);
   EXPECT_EQ(r.validation_messages, 0u);
   if (std::getenv("TENDER_UPDATE_GOLDEN")) GTEST_SKIP() << "the CPU render is the golden";
-  compareWithGolden("tender_torn", r.picture);
+  compareWithGolden("tender_torn", r);
 }
