@@ -17,16 +17,25 @@
 
 namespace tender::test {
 
-/// CPU reference options that treat denormals as the device does for the simulation's shaders
-/// (GpuSolver::arithmetic): flushed where it can only flush them, kept otherwise.
-inline CpuOptions cpuOptionsLike(gpu::VulkanContext& ctx, CpuOptions o = {}) {
-  o.flush_denormals = gpu::floatRulesFor(ctx.floatControls()).denormals == gpu::Denormals::FlushToZero;
-  return o;
+/// The shared context of this test process (see testContext).
+inline std::unique_ptr<gpu::VulkanContext>& sharedContext() {
+  static std::unique_ptr<gpu::VulkanContext> ctx;
+  return ctx;
 }
+
+/// Destroys the shared context when the tests end, while the driver is still loaded: left to the
+/// static destructors, it would outlive the driver's own teardown at exit (NVIDIA's driver then
+/// crashes the process after every test passed).
+class ReleaseSharedContext : public ::testing::Environment {
+public:
+  void TearDown() override { sharedContext().reset(); }
+};
+inline ::testing::Environment* const kReleaseSharedContext =
+    ::testing::AddGlobalTestEnvironment(new ReleaseSharedContext);
 
 /// The shared context of this test process, or nullptr (and `why`) when there is no device.
 inline gpu::VulkanContext* testContext(std::string& why) {
-  static std::unique_ptr<gpu::VulkanContext> ctx;
+  std::unique_ptr<gpu::VulkanContext>& ctx = sharedContext();
   static std::string error;
   static bool tried = false;
   if (!tried) {
