@@ -1,6 +1,7 @@
 #include "spirv_rules.h"
 
 #include <algorithm>
+#include <unordered_map>
 #include <unordered_set>
 
 namespace tender::gpu {
@@ -11,8 +12,8 @@ namespace {
 constexpr uint32_t kOpCapability = 17, kOpEntryPoint = 15, kOpExecutionMode = 16, kOpExecutionModeId = 331;
 constexpr uint32_t kOpDecorate = 71;
 constexpr uint32_t kDecorationNoContraction = 42;
-constexpr uint32_t kCapDenormPreserve = 4464, kCapDenormFlushToZero = 4465, kCapRoundingModeRTE = 4467;
-constexpr uint32_t kModeDenormPreserve = 4459, kModeDenormFlushToZero = 4460, kModeRoundingModeRTE = 4462;
+constexpr uint32_t kCapDenormFlushToZero = 4465, kCapRoundingModeRTE = 4467;
+constexpr uint32_t kModeDenormFlushToZero = 4460, kModeRoundingModeRTE = 4462;
 
 constexpr uint32_t word(uint32_t count, uint32_t op) { return count << 16 | op; }
 
@@ -30,22 +31,12 @@ bool isPreamble(uint32_t op) {
 FloatRules floatRulesFor(const FloatControls& fc) {
   FloatRules r;
   r.rounding_rte = fc.rounding_rte;
-  r.denormals = fc.denorm_preserve ? Denormals::Preserve
-                : fc.denorm_flush  ? Denormals::FlushToZero
-                                   : Denormals::DeviceDefault;
+  r.denormals = fc.denorm_flush ? Denormals::FlushToZero : Denormals::FlushInShader;
   return r;
 }
 
 const char* denormalsName(Denormals d) {
-  switch (d) {
-  case Denormals::Preserve:
-    return "preserve";
-  case Denormals::FlushToZero:
-    return "flush to zero";
-  case Denormals::DeviceDefault:
-    break;
-  }
-  return "device default";
+  return d == Denormals::FlushToZero ? "flush to zero (device)" : "flush to zero (shader)";
 }
 
 bool isFloatArithmetic(uint32_t op) {
@@ -53,11 +44,85 @@ bool isFloatArithmetic(uint32_t op) {
   return op == 127 || op == 129 || op == 131 || op == 133 || op == 136 || (op >= 140 && op <= 148);
 }
 
+namespace {
+
+/// The float arithmetic whose result can be a denormal when its operands are not (OpFNegate, a
+/// sign flip, cannot; the matrix products are not used by the shaders and are left alone).
+bool canMakeDenormal(uint32_t op) {
+  return op == 129 || op == 131 || op == 133 || op == 136 || op == 140 || op == 141 || op == 142 || op == 148;
+}
+
+/// The types and constants a module's flushes need, found among its own declarations or added
+/// (a module may not declare a scalar or vector type twice).
+struct FlushTypes {
+  uint32_t bound = 0;
+  uint32_t f32 = 0, u32 = 0, boolean = 0;
+  uint32_t vec_f[5] = {}, vec_u[5] = {}, vec_b[5] = {};
+  std::vector<uint32_t> declarations; // added before the first function
+  // per component count (1: scalar): the uint type, bool type, and the constants exponent mask,
+  // sign mask and zero
+  struct Width {
+    uint32_t uint_type = 0, bool_type = 0, exponent = 0, sign = 0, zero = 0;
+  } widths[5];
+
+  uint32_t fresh() { return bound++; }
+
+  /// The component count of float type `type` (1 for the scalar), or 0 when it is not one.
+  uint32_t floatWidth(uint32_t type) const {
+    if (type != 0 && type == f32) return 1;
+    for (uint32_t n = 2; n <= 4; ++n)
+      if (type != 0 && type == vec_f[n]) return n;
+    return 0;
+  }
+
+  const Width& width(uint32_t n) {
+    Width& w = widths[n];
+    if (w.uint_type) return w;
+    if (!u32) {
+      u32 = fresh();
+      declarations.insert(declarations.end(), {word(4, 21 /*TypeInt*/), u32, 32u, 0u});
+    }
+    if (!boolean) {
+      boolean = fresh();
+      declarations.insert(declarations.end(), {word(2, 20 /*TypeBool*/), boolean});
+    }
+    const uint32_t scalar[3] = {0x7F800000u, 0x80000000u, 0u};
+    uint32_t ids[3];
+    for (int k = 0; k < 3; ++k) {
+      ids[k] = fresh();
+      declarations.insert(declarations.end(), {word(4, 43 /*Constant*/), u32, ids[k], scalar[k]});
+    }
+    if (n == 1) {
+      w = {u32, boolean, ids[0], ids[1], ids[2]};
+      return w;
+    }
+    for (auto [table, component] : {std::pair{vec_u, u32}, std::pair{vec_b, boolean}})
+      if (!table[n]) {
+        table[n] = fresh();
+        declarations.insert(declarations.end(), {word(4, 23 /*TypeVector*/), table[n], component, n});
+      }
+    w.uint_type = vec_u[n];
+    w.bool_type = vec_b[n];
+    uint32_t* out[3] = {&w.exponent, &w.sign, &w.zero};
+    for (int k = 0; k < 3; ++k) {
+      *out[k] = fresh();
+      declarations.insert(declarations.end(), {word(3 + n, 44 /*ConstantComposite*/), vec_u[n], *out[k]});
+      for (uint32_t c = 0; c < n; ++c) declarations.push_back(ids[k]);
+    }
+    return w;
+  }
+};
+
+} // namespace
+
 std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const FloatRules& rules) {
   if (code.size() < 5) return {code.begin(), code.end()};
+  const bool flush_in_shader = rules.denormals == Denormals::FlushInShader;
   std::vector<uint32_t> entries, arithmetic;
   std::unordered_set<uint32_t> decorated;
-  size_t after_caps = 5, after_modes = 5, preamble_end = 5;
+  FlushTypes types;
+  types.bound = code[3];
+  size_t after_caps = 5, after_modes = 5, preamble_end = 5, functions = code.size();
   bool in_preamble = true;
   for (size_t w = 5; w < code.size();) {
     const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
@@ -70,30 +135,123 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
       preamble_end = w + count;
     else
       in_preamble = false;
+    if (op == 54 /*Function*/ && functions == code.size()) functions = w;
+    if (op == 22 /*TypeFloat*/ && count == 3 && code[w + 2] == 32) types.f32 = code[w + 1];
+    if (op == 21 /*TypeInt*/ && count == 4 && code[w + 2] == 32 && code[w + 3] == 0) types.u32 = code[w + 1];
+    if (op == 20 /*TypeBool*/ && count == 2) types.boolean = code[w + 1];
+    if (op == 23 /*TypeVector*/ && count == 4 && code[w + 3] >= 2 && code[w + 3] <= 4) {
+      const uint32_t component = code[w + 2], n = code[w + 3];
+      if (component == types.f32) types.vec_f[n] = code[w + 1];
+      if (component == types.u32) types.vec_u[n] = code[w + 1];
+      if (component == types.boolean) types.vec_b[n] = code[w + 1];
+    }
     if (isFloatArithmetic(op) && count >= 3) arithmetic.push_back(code[w + 2]);
     w += count;
   }
+  // With the flush in the shader, each such result %r is computed into a new id %raw, and %r becomes
+  // the flushed value: every use of %r (and each decoration of the instruction) follows unchanged.
+  std::unordered_map<uint32_t, uint32_t> raw;                  // %r -> %raw
+  std::unordered_map<uint32_t, std::vector<uint32_t>> flushes; // %r -> the instructions that flush %raw into it
+  // A float loaded from the host's memory (a buffer, a uniform, a push constant) or made from bits
+  // is flushed too: a denormal the host wrote reads as zero, as the CPU's DAZ reads it.
+  std::unordered_map<uint32_t, uint32_t> pointer_class; // pointer type or pointer -> storage class
+  auto fromHost = [&](uint32_t pointer) {
+    auto it = pointer_class.find(pointer);
+    return it != pointer_class.end() && (it->second == 2 || it->second == 9 || it->second == 12);
+  };
+  for (size_t w = 5; flush_in_shader && w < code.size();) {
+    const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
+    if (op == 32 /*TypePointer*/ && count == 4) pointer_class[code[w + 1]] = code[w + 2];
+    // Variable, AccessChain, InBoundsAccessChain, PtrAccessChain: the class of their pointer type
+    if ((op == 59 || op == 65 || op == 66 || op == 67) && count >= 3)
+      if (auto it = pointer_class.find(code[w + 1]); it != pointer_class.end()) pointer_class[code[w + 2]] = it->second;
+    w += count;
+  }
+  auto flushed = [&](uint32_t op, size_t w, uint32_t count) {
+    return count >= 3 &&
+           (canMakeDenormal(op) || op == 124 /*Bitcast*/ || (op == 61 /*Load*/ && count >= 4 && fromHost(code[w + 3])));
+  };
+  if (flush_in_shader)
+    for (size_t w = functions; w < code.size();) {
+      const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
+      const uint32_t n = flushed(op, w, count) ? types.floatWidth(code[w + 1]) : 0;
+      if (n) {
+        const uint32_t type = code[w + 1], result = code[w + 2], in = types.fresh();
+        const FlushTypes::Width& t = types.width(n);
+        const uint32_t bits = types.fresh(), exponent = types.fresh(), tiny = types.fresh(), sign = types.fresh(),
+                       zero = types.fresh();
+        raw[result] = in;
+        flushes[result] = {word(4, 124 /*Bitcast*/),
+                           t.uint_type,
+                           bits,
+                           in,
+                           word(5, 199 /*BitwiseAnd*/),
+                           t.uint_type,
+                           exponent,
+                           bits,
+                           t.exponent,
+                           word(5, 170 /*IEqual*/),
+                           t.bool_type,
+                           tiny,
+                           exponent,
+                           t.zero,
+                           word(5, 199 /*BitwiseAnd*/),
+                           t.uint_type,
+                           sign,
+                           bits,
+                           t.sign,
+                           word(4, 124 /*Bitcast*/),
+                           type,
+                           zero,
+                           sign,
+                           word(6, 169 /*Select*/),
+                           type,
+                           result,
+                           tiny,
+                           zero,
+                           in};
+      }
+      w += count;
+    }
+  auto renamed = [&](uint32_t id) {
+    auto it = raw.find(id);
+    return it == raw.end() ? id : it->second;
+  };
   std::vector<uint32_t> caps, modes, decorations;
   auto mode = [&](uint32_t cap, uint32_t m) {
     caps.insert(caps.end(), {word(2, kOpCapability), cap});
     for (uint32_t e : entries) modes.insert(modes.end(), {word(4, kOpExecutionMode), e, m, 32u});
   };
   if (rules.rounding_rte) mode(kCapRoundingModeRTE, kModeRoundingModeRTE);
-  if (rules.denormals == Denormals::Preserve) mode(kCapDenormPreserve, kModeDenormPreserve);
   if (rules.denormals == Denormals::FlushToZero) mode(kCapDenormFlushToZero, kModeDenormFlushToZero);
   for (uint32_t id : arithmetic)
     if (decorated.insert(id).second)
-      decorations.insert(decorations.end(), {word(3, kOpDecorate), id, kDecorationNoContraction});
-  // Splice the three runs in at their sections (capabilities < modes < decorations in the module)
+      decorations.insert(decorations.end(), {word(3, kOpDecorate), renamed(id), kDecorationNoContraction});
+  // Splice the runs in at their sections (capabilities < modes < decorations < types < functions)
   std::vector<uint32_t> out;
-  out.reserve(code.size() + caps.size() + modes.size() + decorations.size());
-  out.insert(out.end(), code.begin(), code.begin() + long(after_caps));
-  out.insert(out.end(), caps.begin(), caps.end());
-  out.insert(out.end(), code.begin() + long(after_caps), code.begin() + long(after_modes));
-  out.insert(out.end(), modes.begin(), modes.end());
-  out.insert(out.end(), code.begin() + long(after_modes), code.begin() + long(preamble_end));
-  out.insert(out.end(), decorations.begin(), decorations.end());
-  out.insert(out.end(), code.begin() + long(preamble_end), code.end());
+  out.reserve(code.size() + caps.size() + modes.size() + decorations.size() + types.declarations.size() +
+              flushes.size() * 30);
+  out.insert(out.end(), code.begin(), code.begin() + 5);
+  out[3] = types.bound;
+  for (size_t w = 5; w < code.size();) {
+    const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
+    if (w == after_caps) out.insert(out.end(), caps.begin(), caps.end());
+    if (w == after_modes) out.insert(out.end(), modes.begin(), modes.end());
+    if (w == preamble_end) out.insert(out.end(), decorations.begin(), decorations.end());
+    if (w == functions) out.insert(out.end(), types.declarations.begin(), types.declarations.end());
+    const size_t at = out.size();
+    out.insert(out.end(), code.begin() + long(w), code.begin() + long(w + count));
+    if ((op == kOpDecorate || op == 332 /*DecorateId*/ || op == 5632 /*DecorateString*/) && count >= 2)
+      out[at + 1] = renamed(out[at + 1]);
+    if (w >= functions && count >= 3)
+      if (auto it = flushes.find(code[w + 2]); it != flushes.end() && flushed(op, w, count)) {
+        out[at + 2] = raw[code[w + 2]];
+        out.insert(out.end(), it->second.begin(), it->second.end());
+      }
+    w += count;
+  }
+  if (functions == code.size()) out.insert(out.end(), types.declarations.begin(), types.declarations.end());
+  if (preamble_end == code.size()) out.insert(out.end(), decorations.begin(), decorations.end());
   return out;
 }
 

@@ -16,22 +16,24 @@ struct FloatControls {
   bool denorm_flush = false;    ///< shaderDenormFlushToZeroFloat32
 };
 
-/// How the simulation's shaders treat denormals on a device.
+/// How the simulation's shaders flush denormals on a device. Every device and the CPU reference
+/// treat them alike, as x86 does with FTZ and DAZ set (a result below the smallest normal is a
+/// zero of its sign), since that is what every GPU can be held to: NVIDIA's can be asked neither
+/// to keep nor to flush them, and its compiler flushes some operations and keeps others.
 enum class Denormals {
-  Preserve,      ///< requested (DenormPreserve): as the CPU reference does by default
-  FlushToZero,   ///< requested (DenormFlushToZero): the CPU reference must flush too
-  DeviceDefault, ///< the device can be asked for neither: Vulkan lets it flush or keep them
+  FlushToZero,   ///< the device flushes them, asked to (DenormFlushToZero)
+  FlushInShader, ///< the device cannot be asked to: every float result is flushed by the shader's own code
 };
 
 /// The execution modes the simulation's shaders request on a device with `fc`: round to nearest
-/// even when it can be asked for, and denormals kept, else flushed, else left to the device.
+/// even when it can be asked for, and denormals flushed by the device when it can be asked to.
 struct FloatRules {
   bool rounding_rte = false;
-  Denormals denormals = Denormals::DeviceDefault;
+  Denormals denormals = Denormals::FlushInShader;
 };
 FloatRules floatRulesFor(const FloatControls& fc);
 
-/// "preserve", "flush to zero" or "device default".
+/// "flush to zero (device)" or "flush to zero (shader)".
 const char* denormalsName(Denormals d);
 
 /// True for the SPIR-V opcodes of float arithmetic (OpFAdd, OpFMul, OpDot, ...) that a device may
@@ -39,8 +41,12 @@ const char* denormalsName(Denormals d);
 bool isFloatArithmetic(uint32_t opcode);
 
 /// `code` with NoContraction on the result of every float arithmetic instruction and the
-/// execution modes (and capabilities) of `rules` on every entry point. `code` must be a valid
-/// module of SPIR-V 1.4 or later (float controls are core there).
+/// execution modes (and capabilities) of `rules` on every entry point; with
+/// Denormals::FlushInShader, each float arithmetic result in a function, and each float loaded
+/// from a buffer, uniform or push constant, and each made from bits (OpBitcast), also passes through a flush (a
+/// denormal becomes the zero of its sign: bitcast, mask, compare, select), so that no denormal ever reaches the
+/// device's arithmetic and its own handling of them never shows. `code` must be a valid module of SPIR-V 1.4 or
+/// later (float controls are core there).
 std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const FloatRules& rules);
 
 } // namespace tender::gpu

@@ -260,19 +260,8 @@ int runDiff(const CommonOptions& common, const DiffOptions& o) {
   }
   a.label = o.a == o.b ? "a:" + o.a : o.a;
   b.label = o.a == o.b ? "b:" + o.b : o.b;
-  // The GPU sides first: a CPU side treats denormals as the devices do (flushed where a device can
-  // only flush them)
-  bool flush = false;
   for (auto [opt, side] : {std::pair{&oa, &a}, std::pair{&ob, &b}})
-    if (opt->backend != "cpu") {
-      if (auto err = createBackend(*opt, side->backend)) return fail(*err);
-      flush = flush || side->backend.solver->arithmetic().denormals == "flush to zero";
-    }
-  for (auto [opt, side] : {std::pair{&oa, &a}, std::pair{&ob, &b}})
-    if (opt->backend == "cpu") {
-      opt->flush_denormals = flush;
-      if (auto err = createBackend(*opt, side->backend)) return fail(*err);
-    }
+    if (auto err = createBackend(*opt, side->backend)) return fail(*err);
 
   Diff diff(common, *script, a, b);
   const auto tick = diff.firstDifferingTick(o.ticks);

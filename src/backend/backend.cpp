@@ -54,7 +54,6 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
     co.threads = o.threads;
     co.min_chunk = o.min_chunk;
     co.simd = o.simd;
-    co.flush_denormals = o.flush_denormals;
     auto cpu = std::make_unique<CpuSolver>(co);
     cpu->setPlantedUlp(o.plant);
     out.cpu = cpu.get();
@@ -127,7 +126,6 @@ std::optional<std::string> createBatch(const BackendOptions& o, uint32_t sheets,
   if (o.backend == "cpu") {
     CpuOptions co;
     co.simd = o.simd;
-    co.flush_denormals = o.flush_denormals;
     out = std::make_unique<CpuBatch>(sheets, o.threads, co);
     return std::nullopt;
   }

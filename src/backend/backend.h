@@ -30,7 +30,6 @@ struct BackendOptions {
   uint32_t min_chunk = 0;          ///< CPU solver: smallest loop share worth a thread; 0 = tuned (CpuOptions)
   bool simd = true;                ///< CPU solver SIMD kernels (SimParams::simd)
   std::optional<PlantedUlp> plant; ///< CPU solver: the test hook of `tender diff` (CpuSolver::setPlantedUlp)
-  bool flush_denormals = false;    ///< CPU solver: flush denormals, as a device that can only flush (CpuOptions)
   /// Run the GPU solver on this context (the renderer's) instead of creating one; it must outlive
   /// the backend.
   gpu::VulkanContext* context = nullptr;

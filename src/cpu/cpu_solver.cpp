@@ -14,7 +14,7 @@ using namespace shaderio;
 
 CpuSolver::CpuSolver(CpuOptions options)
     : options_(options), simd_(options.simd && simd::kBuilt),
-      pool_(std::make_unique<WorkerPool>(options.threads, options.flush_denormals)),
+      pool_(std::make_unique<WorkerPool>(options.threads, true)),
       collision_(*pool_, options.simd, options.candidate_lists), contact_(*pool_) {}
 
 // The constraints of each colour, reordered by their first particle, into one array per field
@@ -280,12 +280,12 @@ void CpuSolver::resetPass(const SimUniforms& u) {
 
 Arithmetic CpuSolver::arithmetic() const {
   Arithmetic a;
-  a.denormals = options_.flush_denormals ? "flush to zero" : "preserve";
+  a.denormals = "flush to zero (FTZ, DAZ)";
   return a;
 }
 
 void CpuSolver::tick(const SimUniforms& u) {
-  const DenormalMode mode(options_.flush_denormals);
+  const DenormalMode mode(true);
   const uint32_t stop = stop_after_;
   stop_after_ = SIM_NONE;
   const uint64_t tick = ticks_++;
@@ -374,12 +374,12 @@ void CpuSolver::beginReset() {
 }
 
 void CpuSolver::computeNormals() {
-  const DenormalMode mode(options_.flush_denormals);
+  const DenormalMode mode(true);
   gridNormals(pos_, topo_->cols, topo_->rows, normal_);
 }
 
 PickResult CpuSolver::pick(glm::vec3 o, glm::vec3 d, float radius) {
-  const DenormalMode mode(options_.flush_denormals);
+  const DenormalMode mode(true);
   return pickNearest(pos_, o, d, radius);
 }
 

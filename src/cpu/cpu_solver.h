@@ -36,9 +36,6 @@ struct CpuOptions {
   /// the tear test and the collision gather; off runs the scalar reference alone. The results are
   /// bitwise the same either way.
   bool simd = true;
-  /// Flush denormals (x86 FTZ and DAZ) in every pass, as a device that can only flush them does
-  /// (its shaders then flush too: SIM_FLUSH_DENORMALS in exact_math.h); off keeps them (IEEE).
-  bool flush_denormals = false;
 };
 
 class CpuSolver final : public Solver {

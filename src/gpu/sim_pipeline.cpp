@@ -36,10 +36,9 @@ VkPipeline createSimPipeline(VulkanContext& ctx, std::string_view key, VkPipelin
   mi.codeSize = code.size() * sizeof(uint32_t);
   mi.pCode = code.data();
   VK_CHECK(vkCreateShaderModule(ctx.device(), &mi, nullptr, &module));
-  // exact_math.h flushes denormals where the device's arithmetic is asked to
-  const bool flush = rules.denormals == Denormals::FlushToZero || math.flush;
+  // exact_math.h flushes denormals as the rest of the arithmetic does (FloatRules), on every device
   const uint32_t values[4] = {spec0.value_or(0u), math.inexact ? VK_TRUE : VK_FALSE,
-                              math.corrected ? VK_TRUE : VK_FALSE, flush ? VK_TRUE : VK_FALSE};
+                              math.corrected ? VK_TRUE : VK_FALSE, VK_TRUE};
   const VkSpecializationMapEntry entries[4] = {
       {0, 0, 4}, {SIM_SPEC_INEXACT_MATH, 4, 4}, {SIM_SPEC_CORRECT_MATH, 8, 4}, {SIM_SPEC_FLUSH_DENORMALS, 12, 4}};
   // Constant 0 only where the pass has one; the math switches everywhere (a shader without them ignores them)

@@ -20,9 +20,6 @@ namespace tender::gpu {
 struct MathSwitches {
   bool inexact = false;
   bool corrected = true;
-  /// exactSqrt and exactDiv flush denormals (SIM_FLUSH_DENORMALS) even where the device's own
-  /// arithmetic is not asked to (tests; a device that can only flush gets it from its FloatRules)
-  bool flush = false;
   static MathSwitches fromEnvironment();
 };
 

@@ -25,7 +25,7 @@ TEST_F(GpuBatchTest, EachSheetOfAMixedBatchMatchesItsRunAlone) {
 TEST_F(GpuBatchTest, TheFleetMatchesTheCpuReference) {
   const std::vector<FleetSheet> sheets = mixedFleet(9);
   gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()));
-  CpuSolver alone(cpuOptionsLike(ctx()));
+  CpuSolver alone;
   expectFleetMatchesAlone(batch, alone, sheets, 40);
 }
 
@@ -57,7 +57,7 @@ TEST_F(GpuBatchTest, ContactSheetsMatchTheirRunsAloneAndTheCpu) {
   gpu::GpuSolver alone(ctx());
   expectFleetMatchesAlone(batch, alone, sheets, 20);
   gpu::GpuBatch again(ctx(), uint32_t(sheets.size()));
-  CpuSolver cpu(cpuOptionsLike(ctx()));
+  CpuSolver cpu;
   expectFleetMatchesAlone(again, cpu, sheets, 20);
 }
 
@@ -100,7 +100,7 @@ TEST_P(GpuBatchPasses, SheetsTooLargeForTheFusedTickMatchTheirRunsAlone) {
 TEST_P(GpuBatchPasses, ThePerColourFleetMatchesTheCpuReference) {
   const std::vector<FleetSheet> sheets = mixedFleet(3, 48, 48);
   gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
-  CpuSolver alone(cpuOptionsLike(ctx()));
+  CpuSolver alone;
   expectFleetMatchesAlone(batch, alone, sheets, 20);
 }
 
@@ -108,7 +108,7 @@ TEST_P(GpuBatchPasses, LargeContactSheetsMatchTheirRunsAlone) {
   // Sheet 1 has contact on: its passes run sheet by sheet, in either mode
   const std::vector<FleetSheet> sheets = withContact(mixedFleet(2, 40, 52));
   gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
-  CpuSolver alone(cpuOptionsLike(ctx()));
+  CpuSolver alone;
   expectFleetMatchesAlone(batch, alone, sheets, 8);
 }
 

@@ -27,7 +27,7 @@ protected:
 std::pair<SimState, SimState> runBoth(gpu::VulkanContext& ctx, const SimParams& p, const char* text, int ticks,
                                       bool fused = true, gpu::FusedShape shape = {}) {
   gpu::GpuSolver gpu(ctx, shape);
-  CpuSolver cpu(cpuOptionsLike(ctx));
+  CpuSolver cpu;
   gpu.setFusedPath(fused);
   Simulation a(p, cpu), b(p, gpu);
   a.setScript(script(text));
@@ -80,7 +80,7 @@ TEST_F(Parity, HashBucketsMatchTheCpu) {
   SimState after_gpu;
   gpu.readback(after_gpu);
 
-  CpuSolver cpu(cpuOptionsLike(ctx()));
+  CpuSolver cpu;
   cpu.upload(sim.topology());
   for (uint32_t i = 0; i < s.pos.size(); ++i) cpu.positions()[i] = s.pos[i];
   cpu.previous() = s.prev;
@@ -106,7 +106,7 @@ TEST_F(Parity, HugeHashTableUsesThreeScanLevelsAndTallGrids) {
   gpu.setCandidateLists(false); // a hash in every substep
   CpuOptions no_lists;
   no_lists.candidate_lists = false;
-  CpuSolver cpu(cpuOptionsLike(ctx(), no_lists));
+  CpuSolver cpu(no_lists);
   gpu.upload(topo);
   cpu.upload(topo);
   shaderio::SimUniforms u = sim.makeUniforms();
@@ -230,7 +230,7 @@ TEST_F(Parity, ContactIsTheSameOnTheGpu) {
   path(8, front, high, 12);
   path(20, high, high - glm::vec3(0.0f, 0.0f, 1.6f), 8);
   text += "29 set contact_factor 0.5\n32 release\n";
-  CpuSolver cpu(cpuOptionsLike(ctx()));
+  CpuSolver cpu;
   Simulation a(p, cpu);
   a.setScript(script(text.c_str()));
   const SimState forced = run(a, 29);
@@ -334,7 +334,7 @@ TEST_F(Parity, ContactListsStandWhileTheGpuPathsTakeTurns) {
       "crumple", {"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9", "contact_factor=0.5", "collision=off"});
   const std::string text = "0 grab particle 102\n1 move 0 -8.8 -1.2\n4 squeeze 0.5\n12 squeeze 1\n";
   constexpr int kSettle = 120, kTurns = 30;
-  CpuSolver cpu(cpuOptionsLike(ctx()));
+  CpuSolver cpu;
   Simulation a(p, cpu);
   a.setScript(script(text.c_str()));
   const SimState cpu_end = run(a, kSettle + kTurns);
@@ -431,7 +431,7 @@ TEST_F(Parity, FusedSmallSheetPathMatchesSeparatePasses) {
     return s;
   };
   SimState fused = runGpu(true), separate = runGpu(false);
-  CpuSolver cpu(cpuOptionsLike(ctx()));
+  CpuSolver cpu;
   Simulation sim(p, cpu);
   sim.setScript(script(text));
   SimState ref = run(sim, 40);
@@ -460,11 +460,12 @@ TEST_F(Parity, FusedTickInTheShapesOfBothKindsOfDevice) {
        false},
       // the air pass first in every substep
       {preset("paper", {"tear_factor=1.6"}), "0 grab particle 1036\n1 move 0.2 0.6 0.1\n8 release\n", true}};
-  const gpu::FusedShape gpu_shape{SIM_WG_FUSED, SIM_MAX_SUBSTEPS, -1.0f};
+  const gpu::FusedShape gpu_shape{SIM_WG_FUSED, SIM_MAX_SUBSTEPS, -1.0f, 1};
+  const gpu::FusedShape cpu_shape{SIM_WG_FUSED_CPU, SIM_FUSED_SUBSTEPS_CPU, SIM_FUSED_CPU_MAX_CELL_SPACINGS, -1};
   for (const Case& c : cases)
     for (bool gpu_like : {true, false}) {
       const SimParams& p = c.params;
-      gpu::GpuSolver gpu(ctx(), gpu_like ? gpu_shape : gpu::FusedShape{});
+      gpu::GpuSolver gpu(ctx(), gpu_like ? gpu_shape : cpu_shape);
       Simulation gpu_sim(p, gpu);
       const bool fused = gpu.usesFusedPath(gpu_sim.makeUniforms());
       ASSERT_EQ(fused, gpu_like || c.fused_on_cpu_device);
@@ -474,7 +475,7 @@ TEST_F(Parity, FusedTickInTheShapesOfBothKindsOfDevice) {
       if (fused) {
         EXPECT_EQ(dispatches, gpu_like ? 1u : p.substeps);
       }
-      CpuSolver cpu(cpuOptionsLike(ctx()));
+      CpuSolver cpu;
       Simulation cpu_sim(p, cpu);
       cpu_sim.setScript(script(c.script));
       SimState ref = run(cpu_sim, 40);
@@ -570,7 +571,7 @@ void Parity::checkCandidateLists(const SimParams& p, bool fused, bool expect_ent
   Simulation sim(p, gpu);
   ASSERT_EQ(gpu.usesFusedPath(sim.makeUniforms()), fused);
   ASSERT_TRUE(gpu.usesCandidateLists());
-  CpuSolver cpu(cpuOptionsLike(ctx()));
+  CpuSolver cpu;
   Simulation ref(p, cpu);
   const SheetTopology& topo = sim.topology();
   const uint32_t n = topo.particleCount();
@@ -640,7 +641,7 @@ TEST_F(Parity, OverflowingCandidateListsFallBackToTheHash) {
     gpu.setFusedPath(fused);
     Simulation sim(p, gpu);
     ASSERT_EQ(gpu.usesFusedPath(sim.makeUniforms()), fused);
-    CpuSolver cpu(cpuOptionsLike(ctx()));
+    CpuSolver cpu;
     Simulation ref(p, cpu);
     int waiting = 0;
     const int ticks = 20;

@@ -59,10 +59,10 @@ const std::set<uint32_t> kExactExtInsts = {2 /*RoundEven*/,
                                            74,
                                            75 /*FindILsb, FindSMsb, FindUMsb*/};
 
-const FloatRules kAllRules[] = {{false, Denormals::DeviceDefault},
-                                {true, Denormals::Preserve},
+const FloatRules kAllRules[] = {{false, Denormals::FlushInShader},
+                                {true, Denormals::FlushInShader},
                                 {true, Denormals::FlushToZero},
-                                {false, Denormals::Preserve}};
+                                {false, Denormals::FlushToZero}};
 
 } // namespace
 
@@ -82,7 +82,7 @@ TEST(SpirvRules, EveryFloatOperationOfEverySimShaderIsNoContraction) {
         EXPECT_GT(arithmetic.size(), 10u) << key;
       }
       for (uint32_t id : arithmetic) EXPECT_TRUE(no_contraction.count(id)) << key << ": %" << id << " may be fused";
-      EXPECT_EQ(modes, uint32_t(rules.rounding_rte) + uint32_t(rules.denormals != Denormals::DeviceDefault)) << key;
+      EXPECT_EQ(modes, uint32_t(rules.rounding_rte) + uint32_t(rules.denormals == Denormals::FlushToZero)) << key;
     }
   }
 }

@@ -59,7 +59,7 @@ TEST_F(StoppedTick, EveryPassMatchesTheCpuFusedAndPerColour) {
 
   gpu::GpuSolver fused(ctx()), percolor(ctx());
   percolor.setFusedPath(false);
-  CpuSolver cpu(cpuOptionsLike(ctx()));
+  CpuSolver cpu;
   std::set<uint64_t> distinct;
   bool deltas_compared = false;
   uint32_t torn_before_last = 0, torn_at_end = 0;
