@@ -36,7 +36,15 @@ FloatRules floatRulesFor(const FloatControls& fc) {
 }
 
 const char* denormalsName(Denormals d) {
-  return d == Denormals::FlushToZero ? "flush to zero (device)" : "flush to zero (shader)";
+  switch (d) {
+  case Denormals::FlushToZero:
+    return "flush to zero (device)";
+  case Denormals::FlushInShader:
+    return "flush to zero (shader)";
+  case Denormals::AsWritten:
+    break;
+  }
+  return "as written";
 }
 
 bool isFloatArithmetic(uint32_t op) {

@@ -23,6 +23,7 @@ struct FloatControls {
 enum class Denormals {
   FlushToZero,   ///< the device flushes them, asked to (DenormFlushToZero)
   FlushInShader, ///< the device cannot be asked to: every float result is flushed by the shader's own code
+  AsWritten,     ///< neither asked for nor written in (the build's pass before spirv-opt, which marks NoContraction)
 };
 
 /// The execution modes the simulation's shaders request on a device with `fc`: round to nearest

@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < words.size(); ++i) out << words[i] << (i % 8 == 7 ? ",\n" : ",");
     out << "\n";
   } else {
-    const std::vector<uint32_t> ruled = tender::gpu::applyFloatRules(words, {});
+    const std::vector<uint32_t> ruled = tender::gpu::applyFloatRules(words, {false, tender::gpu::Denormals::AsWritten});
     out.write(reinterpret_cast<const char*>(ruled.data()), std::streamsize(ruled.size() * 4));
   }
   out.close();

@@ -62,7 +62,8 @@ const std::set<uint32_t> kExactExtInsts = {2 /*RoundEven*/,
 const FloatRules kAllRules[] = {{false, Denormals::FlushInShader},
                                 {true, Denormals::FlushInShader},
                                 {true, Denormals::FlushToZero},
-                                {false, Denormals::FlushToZero}};
+                                {false, Denormals::FlushToZero},
+                                {false, Denormals::AsWritten}};
 
 } // namespace
 
