@@ -29,9 +29,9 @@ struct PassTimes {
 /// How a backend's float arithmetic runs (the stats JSON and `tender diff` report it).
 struct Arithmetic {
   std::string rounding = "nearest even"; ///< "nearest even", or "device default" where it cannot be asked for
-  std::string denormals = "preserve";    ///< "preserve", "flush to zero" or "device default"
-  bool inexact_math_emulated = false;    ///< sqrt and divide start from deliberately inexact ones
-  bool corrected = true;                 ///< sqrt and divide corrected to the correctly rounded result
+  std::string denormals = "flush to zero (FTZ, DAZ)"; ///< the CPU's; a device's "flush to zero (device)" or "(shader)"
+  bool inexact_math_emulated = false;                 ///< sqrt and divide start from deliberately inexact ones
+  bool corrected = true;                              ///< sqrt and divide corrected to the correctly rounded result
 };
 
 /// A simulation backend: the CPU reference or the Vulkan compute solver.
