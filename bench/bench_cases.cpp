@@ -129,6 +129,7 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
 
   BackendOptions bo = backendOptionsFor(backend, p);
   bo.device = o.device;
+  bo.fused_workgroup = o.fused_workgroup;
   Backend made;
   std::optional<Simulation> sim;
   try {
@@ -152,6 +153,7 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
     r["device"] = std::string(gpu_solver->context().properties().deviceName);
     const bool fused = gpu_solver->usesFusedPath(sim->makeUniforms());
     r["fused"] = fused;
+    r["fused_workgroup"] = gpu_solver->fusedWorkgroup();
     layout = fused ? bench::Layout::GpuFused : bench::Layout::Gpu;
     candidate_lists = gpu_solver->usesCandidateLists();
     r["candidate_lists"] = candidate_lists;
@@ -254,6 +256,7 @@ nlohmann::json runBatchCase(const BenchOptions& o, const Size& size, const std::
   if (auto err = batchMemoryError(p, backend, sheets, o.device)) return skip(*err);
   BackendOptions bo = backendOptionsFor(backend, p);
   bo.device = o.device;
+  bo.fused_workgroup = o.fused_workgroup;
   std::unique_ptr<SheetBatch> batch;
   std::optional<Fleet> fleet;
   try {

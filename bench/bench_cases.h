@@ -24,6 +24,7 @@ struct BenchOptions {
   uint32_t ticks = 60;
   uint32_t warmup = 10;
   int device = -1;
+  uint32_t fused_workgroup = 0; ///< the GPU's fused tick's workgroup (BackendOptions); 0 = the device kind's
   std::string json, csv;
   uint64_t max_cpu_particles = 400000;
   double max_seconds = 30.0;

@@ -46,6 +46,11 @@ int main(int argc, char** argv) {
   app.add_option("--ticks", o.ticks, "timed ticks per case")->check(CLI::Range(1u, 1000000u))->capture_default_str();
   app.add_option("--warmup", o.warmup, "untimed ticks first")->check(CLI::Range(0u, 1000000u))->capture_default_str();
   app.add_option("--device", o.device, "Vulkan device index (see `tender devices`)");
+  app.add_option("--fused-workgroup", o.fused_workgroup,
+                 "invocations of the GPU's fused tick's workgroup (0: the device kind's; at most 1024 and the "
+                 "device's limit)")
+      ->check(CLI::Range(0u, 1024u))
+      ->capture_default_str();
   app.add_option("--json", o.json, "write the results as JSON here");
   app.add_option("--csv", o.csv, "write the results as CSV here");
   std::string max_cpu_particles = std::to_string(o.max_cpu_particles);

@@ -141,9 +141,11 @@
 
 // Elements one workgroup of the block scan covers
 #define SIM_SCAN_BLOCK (SIM_WG_SCAN * SIM_SCAN_PER_THREAD)
-// Workgroup size of the fused small-sheet tick (every pass of every substep in one workgroup);
-// the largest the tick is specialised to (specialization constant 0)
+// Workgroup size of the fused small-sheet tick on a GPU (every pass of every substep in one
+// workgroup; specialization constant 0), and the largest it can be asked for (FusedShape; the
+// device's limits may allow less)
 #define SIM_WG_FUSED 256
+#define SIM_WG_FUSED_MAX 1024
 // Workgroup size of the fused tick on a CPU device: lavapipe runs a workgroup on one thread, its
 // SIMD groups (8 invocations) taking turns at every barrier, and sets up each group's state at
 // every dispatch, so fewer invocations pay less per barrier and per dispatch; but each group

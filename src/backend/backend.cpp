@@ -26,6 +26,13 @@ std::optional<std::string> createContext(const BackendOptions& o, std::unique_pt
   return std::nullopt;
 }
 
+/// The fused tick's shape the options ask for (the rest is the device kind's).
+gpu::FusedShape fusedShapeOf(const BackendOptions& o) {
+  gpu::FusedShape shape;
+  shape.workgroup = o.fused_workgroup;
+  return shape;
+}
+
 } // namespace
 #endif
 
@@ -66,11 +73,11 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
     std::unique_ptr<gpu::GpuSolver> solver;
     std::unique_ptr<gpu::VulkanContext> ctx;
     if (o.context) {
-      solver = std::make_unique<gpu::GpuSolver>(*o.context);
+      solver = std::make_unique<gpu::GpuSolver>(*o.context, fusedShapeOf(o));
     } else if (auto err = createContext(o, ctx)) {
       return err;
     } else {
-      solver = std::make_unique<gpu::GpuSolver>(std::move(ctx));
+      solver = std::make_unique<gpu::GpuSolver>(std::move(ctx), fusedShapeOf(o));
     }
     if (o.backend == "gpu-percolor") solver->setFusedPath(false);
     out.gpu = solver.get();
@@ -134,11 +141,11 @@ std::optional<std::string> createBatch(const BackendOptions& o, uint32_t sheets,
   try {
     std::unique_ptr<gpu::VulkanContext> ctx;
     if (o.context) {
-      out = std::make_unique<gpu::GpuBatch>(*o.context, sheets);
+      out = std::make_unique<gpu::GpuBatch>(*o.context, sheets, gpu::BatchPasses::Auto, fusedShapeOf(o));
     } else if (auto err = createContext(o, ctx)) {
       return err;
     } else {
-      out = std::make_unique<gpu::GpuBatch>(std::move(ctx), sheets);
+      out = std::make_unique<gpu::GpuBatch>(std::move(ctx), sheets, fusedShapeOf(o));
     }
   } catch (const std::exception& e) {
     out.reset();

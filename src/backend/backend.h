@@ -30,6 +30,10 @@ struct BackendOptions {
   uint32_t min_chunk = 0;          ///< CPU solver: smallest loop share worth a thread; 0 = tuned (CpuOptions)
   bool simd = true;                ///< CPU solver SIMD kernels (SimParams::simd)
   std::optional<PlantedUlp> plant; ///< CPU solver: the test hook of `tender diff` (CpuSolver::setPlantedUlp)
+  /// GPU solver and fleet: invocations of the fused tick's workgroup, at most SIM_WG_FUSED_MAX and
+  /// the device's limit (FusedShape::workgroup); 0 = the device kind's (`tender-bench
+  /// --fused-workgroup`)
+  uint32_t fused_workgroup = 0;
   /// Run the GPU solver on this context (the renderer's) instead of creating one; it must outlive
   /// the backend.
   gpu::VulkanContext* context = nullptr;

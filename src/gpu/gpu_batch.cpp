@@ -54,14 +54,16 @@ private:
   uint32_t index_;
 };
 
-GpuBatch::GpuBatch(VulkanContext& ctx, uint32_t sheets, BatchPasses passes) : ctx_(ctx) { create(sheets, passes); }
-
-GpuBatch::GpuBatch(std::unique_ptr<VulkanContext> ctx, uint32_t sheets)
-    : owned_ctx_(std::move(ctx)), ctx_(*owned_ctx_) {
-  create(sheets, BatchPasses::Auto);
+GpuBatch::GpuBatch(VulkanContext& ctx, uint32_t sheets, BatchPasses passes, FusedShape fused) : ctx_(ctx) {
+  create(sheets, passes, fused);
 }
 
-void GpuBatch::create(uint32_t sheets, BatchPasses passes) {
+GpuBatch::GpuBatch(std::unique_ptr<VulkanContext> ctx, uint32_t sheets, FusedShape fused)
+    : owned_ctx_(std::move(ctx)), ctx_(*owned_ctx_) {
+  create(sheets, BatchPasses::Auto, fused);
+}
+
+void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
   // A sheet per workgroup: x of the fused tick's grid, z of a pass's
   const uint32_t most = std::min(ctx_.properties().limits.maxComputeWorkGroupCount[0],
                                  ctx_.properties().limits.maxComputeWorkGroupCount[2]);
@@ -85,7 +87,7 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes) {
   // The fused tick's shape on this kind of device (see FusedShape in gpu_solver.h); a device with
   // too little shared memory for it runs every sheet's per-colour passes, as a sheet alone does.
   const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
-  const FusedShape shape = resolveFusedShape(ctx_);
+  const FusedShape shape = resolveFusedShape(ctx_, fused);
   substeps_per_dispatch_ = shape.substeps_per_dispatch;
   fused_max_cell_spacings_ = shape.max_cell_spacings;
   sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;

@@ -14,6 +14,7 @@
 
 #include "core/fleet.h"
 #include "gpu/context.h"
+#include "gpu/gpu_solver.h"
 #include "gpu/sheet_buffers.h"
 #include "gpu/sim_pipeline.h"
 #include "gpu/substep_passes.h"
@@ -34,9 +35,9 @@ class GpuBatch final : public SheetBatch, private PassSink {
 public:
   /// A batch of `sheets` sheets on an existing context (it must outlive the batch). Throws with
   /// one line when the device cannot run it (no device addresses).
-  GpuBatch(VulkanContext& ctx, uint32_t sheets, BatchPasses passes = BatchPasses::Auto);
+  GpuBatch(VulkanContext& ctx, uint32_t sheets, BatchPasses passes = BatchPasses::Auto, FusedShape fused = {});
   /// A batch that owns its context.
-  GpuBatch(std::unique_ptr<VulkanContext> ctx, uint32_t sheets);
+  GpuBatch(std::unique_ptr<VulkanContext> ctx, uint32_t sheets, FusedShape fused = {});
   /// True when the per-colour passes run sheet by sheet (BatchPasses::PerSheet).
   bool passesPerSheet() const { return per_sheet_; }
   /// Keeps (default) or drops the collision candidate lists, as GpuSolver::setCandidateLists.
@@ -59,7 +60,7 @@ private:
   class Sheet;
   friend class Sheet;
 
-  void create(uint32_t sheets, BatchPasses passes);
+  void create(uint32_t sheets, BatchPasses passes, FusedShape fused);
   // PassSink: a pass of the per-colour path for the sheets at queue[pass_first_, + pass_sheets_)
   void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t substep,
             uint32_t gate, uint32_t gate_arg) override;

@@ -19,8 +19,9 @@ using namespace shaderio;
 static_assert(sizeof(ScanPush) == 16);
 static_assert(sizeof(PickPush) == 48);
 
-GpuSolver::GpuSolver(std::unique_ptr<VulkanContext> ctx) : owned_ctx_(std::move(ctx)), ctx_(*owned_ctx_) {
-  createPipelines({});
+GpuSolver::GpuSolver(std::unique_ptr<VulkanContext> ctx, FusedShape fused)
+    : owned_ctx_(std::move(ctx)), ctx_(*owned_ctx_) {
+  createPipelines(fused);
 }
 
 GpuSolver::GpuSolver(VulkanContext& ctx, FusedShape fused) : ctx_(ctx) { createPipelines(fused); }
@@ -273,10 +274,13 @@ Arithmetic GpuSolver::arithmetic() const { return arithmeticOf(float_rules_, mat
 FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested) {
   const bool cpu_device = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   FusedShape shape;
+  const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
+  const uint32_t most =
+      std::min({uint32_t(SIM_WG_FUSED_MAX), limits.maxComputeWorkGroupInvocations, limits.maxComputeWorkGroupSize[0]});
   shape.workgroup = std::min<uint32_t>(requested.workgroup ? requested.workgroup
                                        : cpu_device        ? SIM_WG_FUSED_CPU
                                                            : SIM_WG_FUSED,
-                                       SIM_WG_FUSED);
+                                       most);
   shape.substeps_per_dispatch = requested.substeps_per_dispatch ? requested.substeps_per_dispatch
                                 : cpu_device                    ? SIM_FUSED_SUBSTEPS_CPU
                                                                 : SIM_MAX_SUBSTEPS;

@@ -22,7 +22,7 @@ namespace tender::gpu {
 /// cells of at most SIM_FUSED_CPU_MAX_CELL_SPACINGS grid spacings; on a GPU: SIM_WG_FUSED
 /// invocations, the whole tick in one dispatch, any cell.
 struct FusedShape {
-  uint32_t workgroup = 0;             ///< invocations of the workgroup, at most SIM_WG_FUSED
+  uint32_t workgroup = 0;             ///< invocations of the workgroup, at most SIM_WG_FUSED_MAX
   uint32_t substeps_per_dispatch = 0; ///< substeps each dispatch runs
   float max_cell_spacings = 0.0f;     ///< largest hash cell (in grid spacings) with collision on; < 0: any
   /// With contact on: 1, the fused tick's workgroup runs contact's bodies too; -1, the contact
@@ -64,7 +64,7 @@ public:
   /// `fused` overrides the shape of the fused tick (the tests run a GPU's shape on lavapipe).
   explicit GpuSolver(VulkanContext& ctx, FusedShape fused = {});
   /// A solver that owns its context.
-  explicit GpuSolver(std::unique_ptr<VulkanContext> ctx);
+  explicit GpuSolver(std::unique_ptr<VulkanContext> ctx, FusedShape fused = {});
   ~GpuSolver() override;
   GpuSolver(const GpuSolver&) = delete;
   GpuSolver& operator=(const GpuSolver&) = delete;
@@ -109,6 +109,8 @@ public:
   void setFusedPath(bool allowed) { fused_allowed_ = allowed; }
   /// True when the sheet is small enough for the fused small-sheet tick (and it is allowed).
   bool usesFusedPath() const;
+  /// Invocations of the fused tick's workgroup (FusedShape::workgroup as resolved for the device).
+  uint32_t fusedWorkgroup() const { return fused_workgroup_; }
   /// Keeps (default) or drops the collision candidate lists (SIM_CANDIDATE_* in sim_config.h); without
   /// them every substep with collision builds the hash and searches it. Lists are kept only when
   /// their buffer fits the device (one SIM_CANDIDATE_STRIDE record per particle).
@@ -217,7 +219,7 @@ private:
   bool fused_allowed_ = true;
   FloatRules float_rules_;                ///< what the shaders' SPIR-V asks of the device's float arithmetic
   MathSwitches math_;                     ///< the switches of exact_math.h (from the environment)
-  uint32_t fused_workgroup_ = 0;          ///< invocations of the fused tick's workgroup
+  uint32_t fused_workgroup_ = 0;          ///< invocations of the fused tick's workgroup (fusedWorkgroup)
   uint32_t fused_substeps_ = 1;           ///< substeps per dispatch of the fused tick
   float fused_max_cell_spacings_ = -1.0f; ///< largest hash cell of the fused tick (< 0: any)
   bool fused_contact_ = true;             ///< the fused tick's workgroup runs contact too (FusedShape)

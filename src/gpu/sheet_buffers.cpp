@@ -124,7 +124,7 @@ SheetLayout SheetLayout::of(const SheetTopology& topo, VkDeviceSize max_range, b
     const uint32_t boxes = topo.triangleCount() + l.contact_edges;
     l.contact_buckets = 2 * std::bit_ceil(std::max(boxes, 16u)); // two halves: triangles, edges
     // After the hash's sums and the fused tick's scan totals (which meet after the compaction slots)
-    l.contact_counts = std::max(l.hash_sums + scanSumsSize(topo.hash_size), l.tear_slots + SIM_WG_FUSED);
+    l.contact_counts = std::max(l.hash_sums + scanSumsSize(topo.hash_size), l.tear_slots + SIM_WG_FUSED_MAX);
     l.contact_fill = l.contact_counts + l.contact_buckets + 1;
     l.contact_sums = l.contact_fill + l.contact_buckets;
     const uint32_t queries = topo.particleCount() + l.contact_edges;
@@ -143,10 +143,10 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
                                        bool particle_data) {
   const uint32_t n = topo.particleCount(), m = topo.constraintCount(), t = topo.triangleCount();
   const uint32_t cells = topo.hash_size;
-  // The fused tick's scans meet their per-invocation totals in the SIM_WG_FUSED slots after the
+  // The fused tick's scans meet their per-invocation totals in the SIM_WG_FUSED_MAX slots after the
   // compaction slots (the per-colour passes' block sums, unused on that path).
   const uint32_t scratch = std::max(
-      {layout.hash_sums + scanSumsSize(cells), layout.tear_slots + SIM_WG_FUSED,
+      {layout.hash_sums + scanSumsSize(cells), layout.tear_slots + SIM_WG_FUSED_MAX,
        layout.contact ? layout.contact_active_sums + scanSumsSize(layout.contact_active_sums - layout.contact_active)
                       : 0u});
   const VkDeviceSize list_bytes = layout.candidates_fit ? 4ull * SIM_CANDIDATE_STRIDE * n : 16,

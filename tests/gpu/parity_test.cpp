@@ -488,6 +488,32 @@ TEST_F(Parity, FusedTickInTheShapesOfBothKindsOfDevice) {
     }
 }
 
+TEST_F(Parity, FusedTickOfAnyWorkgroupSize) {
+  // The fused tick's loops stride by its workgroup, whatever its size (tender-bench
+  // --fused-workgroup): from a few SIMD groups (a substep a dispatch: each invocation's loops run
+  // long, and lavapipe caps a dispatch's loop iterations) to SIM_WG_FUSED_MAX (the whole tick in
+  // one dispatch), the CPU's bits through a yank that tears.
+  const SimParams p = preset("tender", {"wind=on"});
+  const char* text = "0 grab particle 1535\n1 move 6 -5 6\n12 release\n";
+  CpuSolver cpu;
+  Simulation cpu_sim(p, cpu);
+  cpu_sim.setScript(script(text));
+  const SimState ref = run(cpu_sim, 16);
+  EXPECT_GT(tornCount(ref), 0u);
+  for (auto [workgroup, substeps] :
+       {std::pair{32u, 1u}, std::pair{uint32_t(SIM_WG_FUSED_MAX), uint32_t(SIM_MAX_SUBSTEPS)}}) {
+    gpu::GpuSolver gpu(ctx(), gpu::FusedShape{workgroup, substeps, -1.0f, 1});
+    Simulation sim(p, gpu);
+    ASSERT_TRUE(gpu.usesFusedPath(sim.makeUniforms()));
+    EXPECT_EQ(gpu.fusedWorkgroup(), workgroup);
+    sim.setScript(script(text));
+    const SimState got = run(sim, 16);
+    EXPECT_EQ(gpu.dispatchesPerTick(), (p.substeps + substeps - 1) / substeps) << workgroup;
+    EXPECT_TRUE(sameState(ref, got)) << workgroup << " invocations";
+    expectSameTopology(ref, got);
+  }
+}
+
 TEST_F(Parity, BucketsLongerThanTheGatherWindow) {
   // Cells 10 spacings wide: a bucket holds far more particles than the collision gather's
   // 32-slot window, so buckets are read in several windows. The fused tick runs with any cell
