@@ -29,6 +29,27 @@ TEST_F(GpuBatchTest, TheFleetMatchesTheCpuReference) {
   expectFleetMatchesAlone(batch, alone, sheets, 40);
 }
 
+TEST_F(GpuBatchTest, AFusedTickOfAnyWorkgroupSizeMatchesTheCpuReference) {
+  // The fleet's fused tick with the largest workgroup it can be asked for (tender-bench
+  // --fused-workgroup): each sheet's scans meet in SIM_WG_FUSED_MAX slots of its own.
+  const std::vector<FleetSheet> sheets = mixedFleet(3);
+  gpu::FusedShape shape;
+  shape.workgroup = SIM_WG_FUSED_MAX;
+  {
+    // every sheet in the fused tick: one dispatch a tick on a GPU; on a CPU device one a substep
+    // for each group of sheets (OneDispatchRunsEveryQueuedSheetsTick)
+    gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), gpu::BatchPasses::Auto, shape);
+    Fleet fleet(batch, sheets);
+    fleet.tick();
+    const bool cpu_device = ctx().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    const uint32_t group = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
+    EXPECT_EQ(batch.dispatchesPerFlush(), cpu_device ? (3 + group - 1) / group * 8 : 1u);
+  }
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), gpu::BatchPasses::Auto, shape);
+  CpuSolver alone;
+  EXPECT_GT(expectFleetMatchesAlone(batch, alone, sheets, 20), 0u);
+}
+
 TEST_F(GpuBatchTest, OneDispatchRunsEveryQueuedSheetsTick) {
   const std::vector<FleetSheet> sheets = mixedFleet(4);
   gpu::GpuBatch batch(ctx(), 4);
