@@ -156,10 +156,6 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
     if (isFloatArithmetic(op) && count >= 3) arithmetic.push_back(code[w + 2]);
     w += count;
   }
-  // With the flush in the shader, each such result %r is computed into a new id %raw, and %r becomes
-  // the flushed value: every use of %r (and each decoration of the instruction) follows unchanged.
-  std::unordered_map<uint32_t, uint32_t> raw;                  // %r -> %raw
-  std::unordered_map<uint32_t, std::vector<uint32_t>> flushes; // %r -> the instructions that flush %raw into it
   // A float loaded from the host's memory (a buffer, a uniform, a push constant) or made from bits
   // is flushed too: a denormal the host wrote reads as zero, as the CPU's DAZ reads it.
   std::unordered_map<uint32_t, uint32_t> pointer_class; // pointer type or pointer -> storage class
@@ -175,51 +171,21 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
       if (auto it = pointer_class.find(code[w + 1]); it != pointer_class.end()) pointer_class[code[w + 2]] = it->second;
     w += count;
   }
-  auto flushed = [&](uint32_t op, size_t w, uint32_t count) {
-    return count >= 3 &&
-           (canMakeDenormal(op) || op == 124 /*Bitcast*/ || (op == 61 /*Load*/ && count >= 4 && fromHost(code[w + 3])));
+  // The component count of the float result of the instruction at w when it is flushed, else 0
+  auto flushedWidth = [&](size_t w) -> uint32_t {
+    const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
+    const bool flushed =
+        flush_in_shader && w >= functions && count >= 3 &&
+        (canMakeDenormal(op) || op == 124 /*Bitcast*/ || (op == 61 /*Load*/ && count >= 4 && fromHost(code[w + 3])));
+    return flushed ? types.floatWidth(code[w + 1]) : 0;
   };
-  if (flush_in_shader)
-    for (size_t w = functions; w < code.size();) {
-      const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
-      const uint32_t n = flushed(op, w, count) ? types.floatWidth(code[w + 1]) : 0;
-      if (n) {
-        const uint32_t type = code[w + 1], result = code[w + 2], in = types.fresh();
-        const FlushTypes::Width& t = types.width(n);
-        const uint32_t bits = types.fresh(), exponent = types.fresh(), tiny = types.fresh(), sign = types.fresh(),
-                       zero = types.fresh();
-        raw[result] = in;
-        flushes[result] = {word(4, 124 /*Bitcast*/),
-                           t.uint_type,
-                           bits,
-                           in,
-                           word(5, 199 /*BitwiseAnd*/),
-                           t.uint_type,
-                           exponent,
-                           bits,
-                           t.exponent,
-                           word(5, 170 /*IEqual*/),
-                           t.bool_type,
-                           tiny,
-                           exponent,
-                           t.zero,
-                           word(5, 199 /*BitwiseAnd*/),
-                           t.uint_type,
-                           sign,
-                           bits,
-                           t.sign,
-                           word(4, 124 /*Bitcast*/),
-                           type,
-                           zero,
-                           sign,
-                           word(6, 169 /*Select*/),
-                           type,
-                           result,
-                           tiny,
-                           zero,
-                           in};
-      }
-      w += count;
+  // Each flushed result %r is computed into a new id %raw, and %r becomes the flushed value: every
+  // use of %r (and each decoration of the instruction) follows unchanged.
+  std::unordered_map<uint32_t, uint32_t> raw; // %r -> %raw
+  for (size_t w = functions; w < code.size(); w += code[w] >> 16)
+    if (const uint32_t n = flushedWidth(w)) {
+      raw[code[w + 2]] = types.fresh();
+      types.width(n); // declares the types and constants of its flush
     }
   auto renamed = [&](uint32_t id) {
     auto it = raw.find(id);
@@ -238,9 +204,8 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
   // Splice the runs in at their sections (capabilities < modes < decorations < types < functions)
   std::vector<uint32_t> out;
   out.reserve(code.size() + caps.size() + modes.size() + decorations.size() + types.declarations.size() +
-              flushes.size() * 30);
+              raw.size() * 30);
   out.insert(out.end(), code.begin(), code.begin() + 5);
-  out[3] = types.bound;
   for (size_t w = 5; w < code.size();) {
     const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
     if (w == after_caps) out.insert(out.end(), caps.begin(), caps.end());
@@ -251,15 +216,27 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
     out.insert(out.end(), code.begin() + long(w), code.begin() + long(w + count));
     if ((op == kOpDecorate || op == 332 /*DecorateId*/ || op == 5632 /*DecorateString*/) && count >= 2)
       out[at + 1] = renamed(out[at + 1]);
-    if (w >= functions && count >= 3)
-      if (auto it = flushes.find(code[w + 2]); it != flushes.end() && flushed(op, w, count)) {
-        out[at + 2] = raw[code[w + 2]];
-        out.insert(out.end(), it->second.begin(), it->second.end());
-      }
+    if (const uint32_t n = flushedWidth(w)) {
+      // %r = the zero of %raw's sign where %raw's exponent is 0 (a denormal), else %raw
+      const uint32_t type = code[w + 1], result = code[w + 2], in = raw[result];
+      const FlushTypes::Width& t = types.width(n);
+      const uint32_t bits = types.fresh(), exponent = types.fresh(), tiny = types.fresh(), sign = types.fresh(),
+                     zero = types.fresh();
+      out[at + 2] = in;
+      // clang-format off
+      out.insert(out.end(), {word(4, 124 /*Bitcast*/),    t.uint_type, bits,     in,
+                             word(5, 199 /*BitwiseAnd*/), t.uint_type, exponent, bits,     t.exponent,
+                             word(5, 170 /*IEqual*/),     t.bool_type, tiny,     exponent, t.zero,
+                             word(5, 199 /*BitwiseAnd*/), t.uint_type, sign,     bits,     t.sign,
+                             word(4, 124 /*Bitcast*/),    type,        zero,     sign,
+                             word(6, 169 /*Select*/),     type,        result,   tiny,     zero, in});
+      // clang-format on
+    }
     w += count;
   }
   if (functions == code.size()) out.insert(out.end(), types.declarations.begin(), types.declarations.end());
   if (preamble_end == code.size()) out.insert(out.end(), decorations.begin(), decorations.end());
+  out[3] = types.bound; // the ids the flushes took
   return out;
 }
 
