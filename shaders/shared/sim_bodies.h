@@ -92,6 +92,37 @@ SIM_INLINE bool edgeCut(uint a, uint b) {
   return !held && (t.x != SIM_NONE || t.y != SIM_NONE);
 }
 
+/// The stretch limit on particle i, in its ring of the limit from `root` (after the projection,
+/// ring after ring, so its parents have their places): a free particle farther than u.limit.x from
+/// a parent it is still joined to moves to the nearest point within that reach of its parents
+/// (intoBothReaches). An edge stretched to its tear length (shouldTear) is left to tear. The move
+/// is a placement, not a step: the previous position moves with it, so the particle keeps its
+/// velocity. (A limit whose moves were steps fought the next projection through the shear
+/// diagonals, which it does not hold, and pumped energy into the sheet.)
+SIM_INLINE void limitParticle(uint i, uint root) {
+  vec4 q = SIM_POSITION(i);
+  if (!(q.w > 0.0f)) return;
+  uvec2 parent = limitParents(i, root, u.cols);
+  vec4 limit = u.limit;
+  float reach = limit.x;
+  vec4 px = parent.x != SIM_NONE ? SIM_POSITION(parent.x) : q, py = parent.y != SIM_NONE ? SIM_POSITION(parent.y) : q;
+  bool far_x = !withinReach(vec3(q), vec3(px), reach), far_y = !withinReach(vec3(q), vec3(py), reach);
+  if (!far_x && !far_y) return;
+  // The parents it is joined to by an edge that holds
+  bool use_x = parent.x != SIM_NONE && !edgeCut(min(i, parent.x), max(i, parent.x)) &&
+               !shouldTear(q, px, limit.y, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds);
+  bool use_y = parent.y != SIM_NONE && !edgeCut(min(i, parent.y), max(i, parent.y)) &&
+               !shouldTear(q, py, limit.y, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds);
+  if (!(far_x && use_x) && !(far_y && use_y)) return;
+  vec3 to = use_x && use_y ? intoBothReaches(vec3(q), vec3(px), vec3(py), reach)
+                           : intoReach(vec3(q), vec3(use_x ? px : py), reach);
+  // (the previous position read whole, once: lavapipe (Mesa 22), in a fleet's shaders, which reach
+  // the buffers by device address, gave a w read on its own the x of an earlier read)
+  vec4 before = prev[i];
+  SIM_POSITION(i) = vec4(to, q.w);
+  prev[i] = vec4(vec3(before) + (to - vec3(q)), before.w);
+}
+
 /// After the tear marks of a substep (and only when something tore): marks a constraint that no
 /// longer stands on the sheet, so that no constraint ties two pieces of the triangle mesh: a
 /// structural edge no live triangle holds, a bend over such an edge, a shear, tri-bend or hinge

@@ -10,6 +10,8 @@
 #define SIM_WG_COLLIDE 64
 // Workgroup size for tear marking and compaction (one thread per constraint or triangle)
 #define SIM_WG_TEAR 64
+// Workgroup size of the stretch limit: one workgroup a sheet walks its rings (limit.comp)
+#define SIM_WG_LIMIT 256
 // Workgroup size of the block scan; each thread scans SIM_SCAN_PER_THREAD elements
 #define SIM_WG_SCAN 256
 // Elements scanned per thread in the block scan
@@ -127,6 +129,8 @@
 #define SIM_GATE_RESET 6u
 // SIM_GATE_CREASE: the sheet has hinges and creases (crease)
 #define SIM_GATE_CREASE 7u
+// SIM_GATE_LIMIT: the sheet has a stretch limit (limit)
+#define SIM_GATE_LIMIT 8u
 // Sheets per hardware thread that one dispatch of a fleet takes on a CPU device, which runs a
 // substep per dispatch: each thread keeps its sheet's arrays (under 1 MiB for 32 x 48) in its
 // cache through every substep before the next sheets start (lavapipe, 2 threads, 64 sheets of

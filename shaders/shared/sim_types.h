@@ -72,6 +72,10 @@ struct SimUniforms {
   // the triangles' buckets are the first x + 1, the edges' the next x + 1
   uvec4 contact_grid;
 
+  // The stretch limit (limitParticle in sim_bodies.h): x the longest a structural edge may be after
+  // the projection (stretch_limit x spacing; 0: off), y its rest length (the spacing)
+  vec4 limit;
+
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
   vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet
   vec4 grab_target[SIM_MAX_SUBSTEPS]; // grabbed particle position per substep; w: 0 free, 1 held, 2 tossed

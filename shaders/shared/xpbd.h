@@ -201,6 +201,81 @@ SIM_INLINE uvec2 edgeTriangles(uint a, uint b, uint cols, uint rows) {
   return uvec2(x + 1u < cols ? 2u * (y * quads + x) : SIM_NONE, x > 0u ? 2u * (y * quads + x - 1u) + 1u : SIM_NONE);
 }
 
+/// The stretch limit (SimUniforms::limit) runs out from a root particle, ring after ring: ring k
+/// holds the particles k steps along the grid's rows and columns from it, and each particle is
+/// held within reach of its parents, its neighbours one step nearer the root in its row and in its
+/// column, which ring k - 1 has already placed. The root: the grabbed particle, else the sheet's
+/// middle.
+SIM_INLINE uint limitRoot(uint grab_index, uint cols, uint rows) {
+  return grab_index != SIM_NONE ? grab_index : (rows / 2u) * cols + cols / 2u;
+}
+
+/// The last ring of the stretch limit from `root` (its farthest corner).
+SIM_INLINE uint limitRings(uint root, uint cols, uint rows) {
+  uint x = root % cols, y = root / cols;
+  return max(x, cols - 1u - x) + max(y, rows - 1u - y);
+}
+
+/// Slots of a ring (ringParticle): two for each line of the grid's shorter side.
+SIM_INLINE uint limitSlots(uint cols, uint rows) { return 2u * min(cols, rows); }
+
+/// The particle of ring k around `root` that slot t (< limitSlots) names, or SIM_NONE: line t / 2
+/// of the grid's shorter side (a row when rows <= cols, else a column), on the side of the root
+/// that t's lowest bit says. No two slots of a ring name one particle.
+SIM_INLINE uint ringParticle(uint root, uint k, uint t, uint cols, uint rows) {
+  bool by_row = rows <= cols;
+  uint lines = by_row ? rows : cols, along = by_row ? cols : rows;
+  uint line0 = by_row ? root / cols : root % cols, at0 = by_row ? root % cols : root / cols;
+  uint line = t >> 1u, side = t & 1u;
+  if (line >= lines) return SIM_NONE;
+  uint across = line > line0 ? line - line0 : line0 - line;
+  if (across > k) return SIM_NONE;
+  uint d = k - across;
+  if ((d == 0u && side == 1u) || (side == 0u ? d > at0 : at0 + d >= along)) return SIM_NONE;
+  uint at = side == 0u ? at0 - d : at0 + d;
+  return by_row ? line * cols + at : at * cols + line;
+}
+
+/// The parents of particle i (not the root) in the stretch limit from `root`: x its neighbour one
+/// step nearer the root's column in its row, y one step nearer the root's row in its column
+/// (SIM_NONE where it shares the root's column or row).
+SIM_INLINE uvec2 limitParents(uint i, uint root, uint cols) {
+  uint x = i % cols, y = i / cols, rx = root % cols, ry = root / cols;
+  uint in_row = x == rx ? SIM_NONE : (x < rx ? i + 1u : i - 1u);
+  uint in_col = y == ry ? SIM_NONE : (y < ry ? i + cols : i - cols);
+  return uvec2(in_row, in_col);
+}
+
+/// True when c lies within `reach` of a.
+SIM_INLINE bool withinReach(vec3 c, vec3 a, float reach) {
+  vec3 d = c - a;
+  return !(dot3(d, d) > reach * reach);
+}
+
+/// The point nearest c within `reach` of a.
+SIM_INLINE vec3 intoReach(vec3 c, vec3 a, float reach) {
+  vec3 d = c - a;
+  float len = simSqrt(dot3(d, d));
+  return len > reach ? a + d * simDiv(reach, len) : c;
+}
+
+/// The point nearest c within `reach` of both a and b (the two parents of the stretch limit):
+/// within one of the balls and inside the other, else on the circle where their spheres meet;
+/// their midpoint where the balls do not meet, or where c lies on the line through a and b.
+SIM_INLINE vec3 intoBothReaches(vec3 c, vec3 a, vec3 b, float reach) {
+  vec3 ca = intoReach(c, a, reach);
+  if (withinReach(ca, b, reach)) return ca;
+  vec3 cb = intoReach(c, b, reach);
+  if (withinReach(cb, a, reach)) return cb;
+  vec3 m = (a + b) * 0.5f, ab = b - a;
+  float half2 = dot3(ab, ab) * 0.25f, reach2 = reach * reach;
+  if (!(half2 < reach2)) return m;
+  vec3 v = c - m;
+  v = v - ab * simDiv(dot3(v, ab), dot3(ab, ab)); // c's offset from the axis, in the circle's plane
+  float len = simSqrt(dot3(v, v));
+  return len > 0.0f ? m + v * simDiv(simSqrt(reach2 - half2), len) : m;
+}
+
 /// Hinges of a cols x rows grid (SIM_KIND_HINGE, numbered as gridHinge takes them): one across each
 /// interior row edge, each interior column edge and the diagonal of each quad.
 SIM_INLINE uint hingeCount(uint cols, uint rows) {

@@ -133,6 +133,7 @@ void main() {
   uint per_substep = passesPerSubstep(u.iterations, u.color_count, collision);
   uint integrate_pass = stageFirstPass(SIM_STAGE_integrate, u.iterations, u.color_count, collision);
   uint project_pass = stageFirstPass(SIM_STAGE_project, u.iterations, u.color_count, collision);
+  uint limit_pass = stageFirstPass(SIM_STAGE_limit, u.iterations, u.color_count, collision);
   uint crease_pass = stageFirstPass(SIM_STAGE_crease, u.iterations, u.color_count, collision);
   uint collide_pass = stageFirstPass(SIM_STAGE_collide, u.iterations, u.color_count, collision);
   uint floor_pass = stageFirstPass(SIM_STAGE_floor, u.iterations, u.color_count, collision);
@@ -229,7 +230,23 @@ void main() {
           return;
         }
       }
-    // 4. The creases (as crease.comp)
+    // 4. The stretch limit (as limit.comp): ring after ring from the root
+    if (u.limit.x > 0.0f) {
+      uint root = limitRoot(u.grab_index, u.cols, u.rows), slots = limitSlots(u.cols, u.rows);
+      uint rings = limitRings(root, u.cols, u.rows);
+      for (uint k = 1u; k <= rings; ++k) {
+        for (uint t = lid; t < slots; t += kInvocations) {
+          uint i = ringParticle(root, k, t, u.cols, u.rows);
+          if (i != SIM_NONE) limitParticle(i, root);
+        }
+        sync();
+      }
+    }
+    if (stopsAfter(first_pass + limit_pass)) {
+      storePositions(n);
+      return;
+    }
+    // 5. The creases (as crease.comp)
     if (creasing(u.hinge.y, u.crease.y)) {
       for (uint k = lid; k < u.hinge.y; k += kInvocations) creaseHinge(k);
       sync();
@@ -238,7 +255,7 @@ void main() {
       storePositions(n);
       return;
     }
-    // 5. The floor (as floor.comp)
+    // 6. The floor (as floor.comp)
     for (uint i = lid; i < n; i += kInvocations) {
       VerletState st = floorContact(s_pos[i], prev[i], u.floor_y, u.restitution, u.friction);
 #ifdef SIM_FUSED_CONTACT
@@ -255,7 +272,7 @@ void main() {
       storePositions(n);
       return;
     }
-    // 6. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
+    // 7. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
     // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
     // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
     // substep it tore in removed it), and kinds that cannot tear skip the position loads.

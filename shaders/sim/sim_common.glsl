@@ -263,6 +263,8 @@ bool batchGateTakes() {
     return counters.compact_dispatch.x != 0u;
   case SIM_GATE_CREASE:
     return creasing(u.hinge.y, u.crease.y);
+  case SIM_GATE_LIMIT:
+    return u.limit.x > 0.0f;
   default:
     return true;
   }

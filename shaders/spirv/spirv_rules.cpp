@@ -156,12 +156,14 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
     if (isFloatArithmetic(op) && count >= 3) arithmetic.push_back(code[w + 2]);
     w += count;
   }
-  // A float loaded from the host's memory (a buffer, a uniform, a push constant) or made from bits
-  // is flushed too: a denormal the host wrote reads as zero, as the CPU's DAZ reads it.
+  // A float loaded from the host's memory (a buffer, a uniform, a push constant, a buffer reached by
+  // device address) or made from bits is flushed too: a denormal the host wrote reads as zero, as
+  // the CPU's DAZ reads it.
   std::unordered_map<uint32_t, uint32_t> pointer_class; // pointer type or pointer -> storage class
   auto fromHost = [&](uint32_t pointer) {
     auto it = pointer_class.find(pointer);
-    return it != pointer_class.end() && (it->second == 2 || it->second == 9 || it->second == 12);
+    return it != pointer_class.end() &&
+           (it->second == 2 || it->second == 9 || it->second == 12 || it->second == 5349 /*PhysicalStorageBuffer*/);
   };
   for (size_t w = 5; flush_in_shader && w < code.size();) {
     const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;

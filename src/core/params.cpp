@@ -80,6 +80,18 @@ Param boolParam(const char* key, bool SimParams::*m, const char* help) {
           [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); },
           [m](const SimParams& p) { return std::string(p.*m ? "on" : "off"); }};
 }
+/// A float key that is 0 (off) or at least 1 (a ratio to a rest length), at most `hi`.
+Param ratioParam(const char* key, float SimParams::*m, float hi, const char* help) {
+  Param p = floatParam(key, m, 0.0f, hi, help);
+  p.set = [m, hi](SimParams& s, const std::string& v) -> std::optional<std::string> {
+    float f = 0.0f;
+    if (auto err = parseFloat(v, 0.0f, hi, f)) return err;
+    if (f > 0.0f && f < 1.0f) return v + " is neither 0 (off) nor at least 1";
+    s.*m = f;
+    return std::nullopt;
+  };
+  return p;
+}
 /// `p` with the scope of its changes.
 Param scoped(Param p, ParamScope scope) {
   p.info.scope = scope;
@@ -149,6 +161,8 @@ const std::vector<Param>& params() {
                  "degrees a hinge bends past its rest angle before it creases (0: elastic)"),
       floatParam("crease_hardening", &SimParams::crease_hardening, 0.0f, 1000.0f,
                  "yield a crease adds per radian it moves the rest angle"),
+      ratioParam("stretch_limit", &SimParams::stretch_limit, 10.0f,
+                 "longest a structural edge may be after each substep, x rest (0: off)"),
       floatParam("tear_factor", &SimParams::tear_factor, 0.0f, 100.0f, "tear beyond factor x rest; 0: never"),
       boolParam("tear_structural", &SimParams::tear_structural, "structural constraints may tear"),
       boolParam("tear_shear", &SimParams::tear_shear, "shear constraints may tear"),
@@ -237,6 +251,7 @@ std::optional<SimParams> presetParams(const std::string& name) {
     p.bending_rigidity = 0.02f;
     p.crease_yield = kPaperCreaseYield;
     p.crease_hardening = kPaperCreaseHardening;
+    p.stretch_limit = kPaperStretchLimit;
     p.cell_size = 0.375f; // 2.5 x spacing, as in `tender`
     p.floor_y = -10.0f;
     p.restitution = 0.3f;
@@ -264,6 +279,7 @@ std::optional<SimParams> presetParams(const std::string& name) {
     p.bending_rigidity = kPaperRigidity;
     p.crease_yield = kPaperCreaseYield;
     p.crease_hardening = kPaperCreaseHardening;
+    p.stretch_limit = kPaperStretchLimit;
     p.cell_size = 2.5f * p.spacing;
     p.restitution = 0.05f;
     p.friction = 0.6f;

@@ -57,6 +57,9 @@ struct SimParams {
   float bend_stiffness = 1.0f; ///< bend and tri-bend projection stiffness
   /// Bending rigidity D of the paper (N m) the hinges have: E t^3 / (12 (1 - nu^2))
   float bending_rigidity = 6.4e-5f;
+  /// The stretch limit (SimUniforms::limit): no structural edge longer than this x rest after a
+  /// substep's projection, unless it tears; 0: off
+  float stretch_limit = 0.0f;
   float crease_yield = 0.0f;     ///< degrees a hinge bends past its rest angle before it creases; 0: elastic
   float crease_hardening = 0.0f; ///< the yield a crease adds per radian it moves the rest angle
   float tear_factor = 2.5f;      ///< tear beyond this x rest; 0 disables tearing
@@ -111,6 +114,9 @@ constexpr float kPaperRigidity = 7.9e-5f;
 constexpr float kPaperCreaseYield = 11.5f;
 /// The yield a crease adds per radian it moves: refolding a crease takes more than folding it.
 constexpr float kPaperCreaseHardening = 0.5f;
+/// Paper stretches well under 1 % before it tears; a sheet's edges are held within 1 % of rest
+/// (the stretch limit), which the projection then closes further.
+constexpr float kPaperStretchLimit = 1.01f;
 
 /// Names of the presets, in the order `--help` lists them.
 std::vector<std::string> presetNames();

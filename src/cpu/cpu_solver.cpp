@@ -170,6 +170,18 @@ void CpuSolver::creasePass(const SimUniforms& u) {
   });
 }
 
+void CpuSolver::limitPass(const SimUniforms& u) {
+  if (!(u.limit.x > 0.0f)) return;
+  SheetElements e = elements(u);
+  const uint32_t root = limitRoot(u.grab_index, u.cols, u.rows), slots = limitSlots(u.cols, u.rows);
+  const uint32_t rings = limitRings(root, u.cols, u.rows);
+  for (uint32_t k = 1; k <= rings; ++k)
+    for (uint32_t t = 0; t < slots; ++t) {
+      const uint32_t i = ringParticle(root, k, t, u.cols, u.rows);
+      if (i != SIM_NONE) e.limitParticle(i, root);
+    }
+}
+
 void CpuSolver::repelPass(const SimUniforms& u) {
   pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
     for (uint32_t i = begin; i < end; ++i) pos_[i] = repelParticle(pos_[i], collision_.delta(i), u.flags);
@@ -337,6 +349,9 @@ void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint3
     break;
   case PassKind::project:
     projectColors(u, first, count); // Gauss-Seidel over the colours
+    break;
+  case PassKind::limit:
+    limitPass(u); // no structural edge longer than the limit
     break;
   case PassKind::crease:
     creasePass(u); // hinges bent past their yield move their rest angles

@@ -89,6 +89,8 @@ public:
   void projectColors(const shaderio::SimUniforms& u, uint32_t first, uint32_t count);
   /// The creases of the substep (creaseHinge), when the sheet creases.
   void creasePass(const shaderio::SimUniforms& u);
+  /// The stretch limit: the rings around its root one after the other (limitParticle).
+  void limitPass(const shaderio::SimUniforms& u);
   /// The collision of one substep (CpuCollision::substep); returns the mode (SIM_CANDIDATE_*).
   uint32_t collide(const shaderio::SimUniforms& u) { return collision_.substep(u, pos_.data()); }
   /// Moves the free particles by the collision deltas (repelParticle), before the projection.

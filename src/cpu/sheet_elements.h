@@ -10,7 +10,7 @@ namespace shaderio {
 struct SheetElements {
   const SimUniforms& u;
   vec4* pos;
-  const vec4* prev;
+  vec4* prev;
   SharedWords torn; ///< read while markUnsupported marks edges no triangle holds
 
   const uvec2* tri_edges;

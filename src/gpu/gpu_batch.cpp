@@ -261,6 +261,7 @@ void GpuBatch::flush() {
     plan.air = plan.air || (u.flags & SIM_FLAG_AIR) != 0u;
     plan.crease = plan.crease || creasing(u.hinge.y, u.crease.y);
     plan.contact = plan.contact || u.contact.x > 0.0f;
+    plan.limit = plan.limit || u.limit.x > 0.0f;
   }
   if (fused.empty() && passes.empty()) return;
   last_dispatches_ = 0;
@@ -350,8 +351,10 @@ void GpuBatch::flush() {
         pass(sheet_passes_.reset, Grid::Threads, n, &all, sizeof(all), 0, SIM_GATE_RESET, 0);
         continue;
       }
-      const SubstepPlan sheet_plan{u.iterations, (u.flags & SIM_FLAG_COLLISION) != 0u, (u.flags & SIM_FLAG_AIR) != 0u,
-                                   SIM_NONE,     creasing(u.hinge.y, u.crease.y),      u.contact.x > 0.0f};
+      const SubstepPlan sheet_plan{
+          u.iterations,    (u.flags & SIM_FLAG_COLLISION) != 0u, (u.flags & SIM_FLAG_AIR) != 0u,
+          SIM_NONE,        creasing(u.hinge.y, u.crease.y),      u.contact.x > 0.0f,
+          u.limit.x > 0.0f};
       for (uint32_t s = 0; s < substepCount(u.substeps); ++s)
         recordSubstep(*this, sheet_passes_, topo_, sizes_, sheet_plan, s, count);
     }

@@ -168,7 +168,8 @@ void GpuSolver::tick(const SimUniforms& u) {
                 stop_after_,
                 (u.flags & SIM_FLAG_AIR) != 0u,
                 creasing(u.hinge.y, u.crease.y),
-                contact};
+                contact,
+                u.limit.x > 0.0f};
   stop_after_ = SIM_NONE;
   if (flight.recorded != key) recordTick(flight, index, key);
   ctx_.submit(flight.tick, flight.fence);

@@ -143,6 +143,7 @@ private:
     bool air = false;         ///< the air pass runs before integration (SIM_FLAG_AIR)
     bool crease = false;      ///< the crease pass runs after the projection (creasing)
     bool contact = false;     ///< the contact passes run (SimUniforms::contact)
+    bool limit = false;       ///< the stretch limit runs after the projection (SimUniforms::limit)
     bool operator==(const RecordKey&) const = default;
   };
   struct InFlight {

@@ -89,7 +89,7 @@ enum class Elements : uint8_t {
   CONTACT_CELLS
 };
 /// When a sheet records a dispatch (SIM_DISPATCHES' needs column).
-enum class Needs : uint8_t { ALWAYS, AIR, CREASE, CONSTRAINTS, CONTACT };
+enum class Needs : uint8_t { ALWAYS, AIR, CREASE, LIMIT, CONSTRAINTS, CONTACT };
 
 /// One row of SIM_DISPATCHES.
 struct Dispatch {
@@ -242,6 +242,7 @@ bool recordSubstep(PassSink& sink, const SimPipelines& pipes, const SheetTopolog
         if (d.stage != stage) continue;
         const bool needed = d.needs == Needs::ALWAYS || (d.needs == Needs::AIR && plan.air) ||
                             (d.needs == Needs::CREASE && plan.crease && topo.hingeCount() > 0) ||
+                            (d.needs == Needs::LIMIT && plan.limit) ||
                             (d.needs == Needs::CONSTRAINTS && has_constraints) ||
                             (d.needs == Needs::CONTACT && plan.contact);
         if (needed) recordDispatch(sink, pipes, topo, sizes, d, s, k);

@@ -106,6 +106,7 @@ struct SubstepPlan {
   uint32_t stop = SIM_NONE; ///< last pass to record (SIM_STAGES numbering; Solver::stopNextTickAfter)
   bool crease = false;      ///< the crease pass runs (creasing in xpbd.h)
   bool contact = false;     ///< the contact passes run (SimUniforms::contact)
+  bool limit = false;       ///< the stretch limit runs (SimUniforms::limit)
 };
 
 /// Timestamps a substep of the per-colour path records (one where each category ends).

@@ -13,6 +13,10 @@ expect_bad "${sim[@]}" --set cols=16384 --set rows=16384
 expect_bad "${sim[@]}" --set damping=1.5
 expect_bad "${sim[@]}" --set damping=abc
 expect_bad "${sim[@]}" --set gravity=nan
+# The stretch limit is a ratio to rest: 0 (off) or at least 1
+expect_bad "${sim[@]}" --set stretch_limit=0.5
+expect_bad "${sim[@]}" --set stretch_limit=-1
+expect_bad "${sim[@]}" --set stretch_limit=inf
 expect_bad "${sim[@]}" --set pins=middle
 expect_bad "${sim[@]}" --set substeps=0
 expect_bad "${sim[@]}" --set collision=maybe

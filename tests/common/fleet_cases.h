@@ -15,8 +15,8 @@ namespace tender::test {
 /// parameters and its script from i, so a batch of 37 holds every combination below several times:
 /// tearing yanks and sheets left hanging, a reset, a pause, a ray grab and a hand closing around it, three pin modes,
 /// both winds, and different stiffness, damping, gravity, tear factor, restitution, floor, substeps, iterations,
-/// release, collision, air and hash cell (sheets 5, 13, ... have cells of 5 spacings, which a CPU device's fused tick
-/// does not take).
+/// release, collision, air, stretch limit and hash cell (sheets 5, 13, ... have cells of 5 spacings, which a CPU
+/// device's fused tick does not take).
 inline std::vector<FleetSheet> mixedFleet(uint32_t count, uint32_t cols = 12, uint32_t rows = 16) {
   static const char* kScripts[] = {
       "",
@@ -51,10 +51,55 @@ inline std::vector<FleetSheet> mixedFleet(uint32_t count, uint32_t cols = 12, ui
         std::string("collision=") + (i % 9 == 4 ? "off" : "on"),
         std::string("air=") + (i % 5 == 1 ? "on" : "off"),
         std::string("cell_size=") + (i % 8 == 5 ? "0.8" : "0.4"),
+        std::string("stretch_limit=") + ((i / 2) % 3 == 0   ? "0"
+                                         : (i / 2) % 3 == 1 ? "1.01"
+                                                            : "1.05"),
     };
     FleetSheet s;
     s.params = preset("tender", sets);
     s.script = script(kScripts[i % 4]);
+    sheets.push_back(std::move(s));
+  }
+  return sheets;
+}
+
+/// A fleet of `count` sheets of paper: the `crumple` preset's 12 x 16 sheet (hinges, creases, the
+/// stretch limit) lying on its floor, free or pinned at its corners, folded, crumpled by the hand
+/// and yanked; or, with `receipt`, the `paper` preset's receipt falling through the air and folded.
+inline std::vector<FleetSheet> paperFleet(uint32_t count, bool receipt = false) {
+  static const char* kSheetScripts[] = {
+      "",
+      // A fold: the far edge lifted over the sheet and pressed down
+      "0 grab particle 186\n5 move 0.1 -9 -2\n12 move 0.1 -9.8 -0.2\n30 release\n",
+      // The hand closing around the middle
+      "0 grab particle 102\n1 move 0 -8.8 -1.2\n4 squeeze 0.5\n12 squeeze 1\n24 move 1 -8 -1\n30 release\n",
+      // A yank
+      "0 grab particle 186\n1 move 3 -6 4\n20 release\n",
+  };
+  static const char* kReceiptScripts[] = {"", "2 grab particle 1020\n3 move 0.05 0.9 0.1\n10 release\n"};
+  std::vector<FleetSheet> sheets;
+  for (uint32_t i = 0; i < count; ++i) {
+    std::vector<std::string> sets = {
+        std::string("crease_yield=") + (i % 3 == 0   ? "0"
+                                        : i % 3 == 1 ? "5"
+                                                     : "11.5"),
+        std::string("stretch_limit=") + (i % 4 == 3   ? "0"
+                                         : i % 4 == 1 ? "1.05"
+                                                      : "1.01"),
+        "crease_hardening=" + std::to_string(0.25 * (i % 3)),
+        "iterations=" + std::to_string(3 + i % 2),
+    };
+    if (receipt) {
+      sets.push_back(std::string("air=") + (i % 5 == 4 ? "off" : "on"));
+    } else {
+      // (the rest lengths come from the start: every sheet of a fleet lies flat)
+      for (const char* s : {"cols=12", "rows=16", "wind=off", "tilt=90", "top_y=-9.9"}) sets.push_back(s);
+      sets.push_back(std::string("pins=") + (i % 5 == 4 ? "corners" : "none"));
+      sets.push_back(std::string("tear_factor=") + (i % 6 == 5 ? "0" : "2.5"));
+    }
+    FleetSheet s;
+    s.params = preset(receipt ? "paper" : "crumple", sets);
+    s.script = script(receipt ? kReceiptScripts[i % 2] : kSheetScripts[i % 4]);
     sheets.push_back(std::move(s));
   }
   return sheets;

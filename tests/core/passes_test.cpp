@@ -20,18 +20,20 @@ shaderio::SimUniforms uniforms(uint32_t substeps, uint32_t iterations, uint32_t 
 
 TEST(Passes, OrderOfOneSubstep) {
   const shaderio::SimUniforms u = uniforms(3, 2, 5, true);
-  ASSERT_EQ(passesPerTick(u), 3u * (1u + 10u + 1u + 1u + 1u + 1u));
+  ASSERT_EQ(passesPerTick(u), 3u * (1u + 10u + 1u + 1u + 1u + 1u + 1u));
   EXPECT_EQ(passAt(u, 0), (PassPoint{0, PassKind::integrate}));
   EXPECT_EQ(passAt(u, 1), (PassPoint{0, PassKind::collide}));
   EXPECT_EQ(passAt(u, 2), (PassPoint{0, PassKind::project, 0, 0}));
   EXPECT_EQ(passAt(u, 8), (PassPoint{0, PassKind::project, 1, 1}));
   EXPECT_EQ(passAt(u, 11), (PassPoint{0, PassKind::project, 1, 4}));
-  EXPECT_EQ(passAt(u, 12), (PassPoint{0, PassKind::crease}));
-  EXPECT_EQ(passAt(u, 13), (PassPoint{0, PassKind::floor}));
-  EXPECT_EQ(passAt(u, 14), (PassPoint{0, PassKind::tear}));
-  EXPECT_EQ(passAt(u, 15), (PassPoint{1, PassKind::integrate}));
-  EXPECT_EQ(describePass(passAt(u, 23)), "substep 1, project (iteration 1, colour 1)");
-  EXPECT_EQ(describePass(passAt(u, 27)), "substep 1, crease");
+  EXPECT_EQ(passAt(u, 12), (PassPoint{0, PassKind::limit}));
+  EXPECT_EQ(passAt(u, 13), (PassPoint{0, PassKind::crease}));
+  EXPECT_EQ(passAt(u, 14), (PassPoint{0, PassKind::floor}));
+  EXPECT_EQ(passAt(u, 15), (PassPoint{0, PassKind::tear}));
+  EXPECT_EQ(passAt(u, 16), (PassPoint{1, PassKind::integrate}));
+  EXPECT_EQ(describePass(passAt(u, 24)), "substep 1, project (iteration 1, colour 1)");
+  EXPECT_EQ(describePass(passAt(u, 28)), "substep 1, limit");
+  EXPECT_EQ(describePass(passAt(u, 29)), "substep 1, crease");
 }
 
 TEST(Passes, IndexIsTheInverseOfPassAt) {
@@ -41,7 +43,7 @@ TEST(Passes, IndexIsTheInverseOfPassAt) {
       for (uint32_t k = 0; k < n; ++k) EXPECT_EQ(passIndex(u, passAt(u, k)), k);
     }
   shaderio::SimUniforms u = uniforms(2, 2, 3, false);
-  EXPECT_EQ(passesPerTick(u), 2u * 10u);
+  EXPECT_EQ(passesPerTick(u), 2u * 11u);
   EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::collide}));
   EXPECT_FALSE(passIndex(u, PassPoint{2, PassKind::floor}));
   EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::project, 2, 0}));

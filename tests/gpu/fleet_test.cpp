@@ -29,6 +29,17 @@ TEST_F(GpuBatchTest, TheFleetMatchesTheCpuReference) {
   expectFleetMatchesAlone(batch, alone, sheets, 40);
 }
 
+TEST_F(GpuBatchTest, SheetsOfPaperMatchTheCpuReference) {
+  // Hinges, creases, the stretch limit and the hand in a fleet, and the receipt in the air: every
+  // value the shaders read of a fleet's uniforms, by device address, is the sheet's own
+  for (bool receipt : {false, true}) {
+    const std::vector<FleetSheet> sheets = paperFleet(receipt ? 4 : 12, receipt);
+    gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()));
+    CpuSolver alone;
+    expectFleetMatchesAlone(batch, alone, sheets, 36);
+  }
+}
+
 TEST_F(GpuBatchTest, AFusedTickOfAnyWorkgroupSizeMatchesTheCpuReference) {
   // The fleet's fused tick with the largest workgroup it can be asked for (tender-bench
   // --fused-workgroup): each sheet's scans meet in SIM_WG_FUSED_MAX slots of its own.

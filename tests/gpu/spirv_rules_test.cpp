@@ -9,6 +9,7 @@
 #include <fstream>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "gpu/shaders.h"
@@ -86,6 +87,36 @@ TEST(SpirvRules, EveryFloatOperationOfEverySimShaderIsNoContraction) {
       EXPECT_EQ(modes, uint32_t(rules.rounding_rte) + uint32_t(rules.denormals == Denormals::FlushToZero)) << key;
     }
   }
+}
+
+TEST(SpirvRules, EveryFloatTheHostWroteIsFlushedWhereTheShaderFlushes) {
+  // A float loaded from memory the host writes (a uniform, a push constant, a storage buffer, or a
+  // fleet's buffers reached by device address) goes through the flush (a bitcast first) before
+  // any use, as the CPU's DAZ reads a denormal as zero
+  const std::set<uint32_t> host = {2 /*Uniform*/, 9 /*PushConstant*/, 12 /*StorageBuffer*/,
+                                   5349 /*PhysicalStorageBuffer*/};
+  uint32_t batch_loads = 0;
+  for (std::string_view key : simShaderKeys()) {
+    const std::vector<uint32_t> code = applyFloatRules(simShader(key), {false, Denormals::FlushInShader});
+    std::unordered_set<uint32_t> floats, host_pointers;
+    std::unordered_map<uint32_t, uint32_t> pointer_class;
+    std::vector<uint32_t> loads;
+    std::unordered_set<uint32_t> bitcast_operands;
+    for (const Instruction& in : instructions(code)) {
+      if (in.op == 22 /*TypeFloat*/ && in.words[2] == 32) floats.insert(in.words[1]);
+      if (in.op == 23 /*TypeVector*/ && floats.count(in.words[2])) floats.insert(in.words[1]);
+      if (in.op == 32 /*TypePointer*/) pointer_class[in.words[1]] = in.words[2];
+      if ((in.op == 59 || in.op == 65 || in.op == 66 || in.op == 67) && pointer_class.count(in.words[1]) &&
+          host.count(pointer_class[in.words[1]]))
+        host_pointers.insert(in.words[2]);
+      if (in.op == 61 /*Load*/ && floats.count(in.words[1]) && host_pointers.count(in.words[3]))
+        loads.push_back(in.words[2]);
+      if (in.op == 124 /*Bitcast*/) bitcast_operands.insert(in.words[3]);
+    }
+    if (key.find(".batch") != std::string_view::npos || key == "tick_batch.comp") batch_loads += uint32_t(loads.size());
+    for (uint32_t id : loads) EXPECT_TRUE(bitcast_operands.count(id)) << key << ": %" << id << " is used unflushed";
+  }
+  EXPECT_GT(batch_loads, 100u); // the fleet's shaders load their floats by device address
 }
 
 TEST(SpirvRules, NoSimShaderUsesABuiltInWhoseResultTheDeviceChooses) {

@@ -82,7 +82,7 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   const SimPipelines pipes = fakePipelines();
   RecordingSink sink(pipes);
   uint32_t pass = 0;
-  const SubstepPlan plan{2, true, true, SIM_NONE, true, true};
+  const SubstepPlan plan{2, true, true, SIM_NONE, true, true, true};
   EXPECT_FALSE(recordSubstep(sink, pipes, topo, sizes, plan, 0, pass));
   EXPECT_EQ(pass, shaderio::passesPerSubstep(2, topo.colorCount(), true));
   EXPECT_EQ(sink.barriers_due, 0u); // every pass is followed by a barrier
@@ -109,6 +109,7 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
         expected.push_back("project");
         iterations.push_back(it);
       }
+  expected.push_back("limit");
   expected.push_back("crease");
   for (const char* k : {"floor", "tear_mark", "tear_unsupported", "tear_flags", "scan", "tear_compact"})
     expected.push_back(k);
@@ -118,8 +119,8 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
       EXPECT_EQ(sink.passes[k].gate, SIM_GATE_ITERATION);
       EXPECT_EQ(sink.passes[k].gate_arg, iterations[project++]);
     }
-  EXPECT_EQ(sink.marks,
-            (std::vector<PassCategory>{kContact, kIntegrate, kHash, kCollide, kProject, kProject, kFloor, kTear}));
+  EXPECT_EQ(sink.marks, (std::vector<PassCategory>{kContact, kIntegrate, kHash, kCollide, kProject, kProject, kProject,
+                                                   kFloor, kTear}));
   EXPECT_EQ(marksPerSubstep(), sink.marks.size());
 }
 
@@ -140,6 +141,8 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
       return "integrate";
     case PassKind::project:
       return "project";
+    case PassKind::limit:
+      return "limit";
     case PassKind::crease:
       return "crease";
     case PassKind::collide:
@@ -156,7 +159,8 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
   for (uint32_t stop = 0; stop < passesPerTick(u); ++stop) {
     RecordingSink sink(pipes);
     uint32_t pass = 0;
-    EXPECT_TRUE(recordSubstep(sink, pipes, topo, sizes, SubstepPlan{1, true, false, stop, true}, 0, pass)) << stop;
+    EXPECT_TRUE(recordSubstep(sink, pipes, topo, sizes, SubstepPlan{1, true, false, stop, true, false, true}, 0, pass))
+        << stop;
     EXPECT_EQ(pass, stop + 1);
     const PassPoint at = passAt(u, stop);
     ASSERT_FALSE(sink.passes.empty());
