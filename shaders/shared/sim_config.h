@@ -10,8 +10,13 @@
 #define SIM_WG_COLLIDE 64
 // Workgroup size for tear marking and compaction (one thread per constraint or triangle)
 #define SIM_WG_TEAR 64
-// Workgroup size of the stretch limit: one workgroup a sheet walks its rings (limit.comp)
-#define SIM_WG_LIMIT 256
+// Workgroup size of the stretch limit: one workgroup a sheet walks its rings (limit.comp); few
+// invocations, as a CPU device pays for each at every barrier
+#define SIM_WG_LIMIT 64
+// Loop iterations one invocation of the stretch limit runs in a dispatch at most (rings, and the
+// slots of each): lavapipe ends every loop of a shader after 65535 in all (LP_MAX_TGSI_LOOP_ITERATIONS,
+// bench/README.md), so a large sheet's rings take several dispatches (limitRingsPerDispatch)
+#define SIM_LIMIT_LOOP_BUDGET 16384u
 // Workgroup size of the block scan; each thread scans SIM_SCAN_PER_THREAD elements
 #define SIM_WG_SCAN 256
 // Elements scanned per thread in the block scan

@@ -83,7 +83,8 @@
 //   kernel    its row in SIM_KERNELS (scan: a scan of several blocks adds scan and scan_add)
 //   elements  what it covers and its push constants: PARTICLES, COLOUR (the stage's colour),
 //             HINGES, CONSTRAINTS, ONE (one invocation), HASH_ARGS (one invocation, the hash's
-//             arguments), HASH_CELLS and TEAR_SLOTS (a scan of the hash's cells or of the
+//             arguments), RINGS (one workgroup a sheet, a dispatch for each limitRingsPerDispatch
+//             rings of the stretch limit), HASH_CELLS and TEAR_SLOTS (a scan of the hash's cells or of the
 //             compaction's slots), INDIRECT (the grid's arguments, no push constants); contact's:
 //             TRIANGLES (the triangle slots), CONTACT_SLOTS (whatever its clearing covers),
 //             CONTACT_BUCKETS (its grid's buckets and their end),
@@ -131,7 +132,7 @@
   X(collide, candidates_finish, ONE, Threads, COLLISION, ALWAYS, Collide)                                              \
   X(collide, repel, PARTICLES, Threads, COLLISION, ALWAYS, Collide)                                                    \
   X(project, project, COLOUR, Threads, ITERATION, ALWAYS, Project)                                                     \
-  X(limit, limit, ONE, Threads, LIMIT, LIMIT, Project)                                                                 \
+  X(limit, limit, RINGS, Threads, LIMIT, LIMIT, Project)                                                               \
   X(crease, crease, HINGES, Threads, CREASE, CREASE, Project)                                                          \
   X(floor, floor, PARTICLES, Threads, TICK, ALWAYS, Floor)                                                             \
   X(tear, tear_mark, CONSTRAINTS, Threads, TICK, CONSTRAINTS, Tear)                                                    \

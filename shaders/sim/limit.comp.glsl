@@ -1,7 +1,7 @@
 #version 460
-// The stretch limit of a substep: one workgroup a sheet walks the rings around its root
-// (limitRoot), a barrier after each, so every particle is placed after its parents
-// (limitParticle).
+// The stretch limit of a substep: one workgroup a sheet walks rings p.first to p.first + p.count - 1
+// around its root (limitRoot), a barrier after each, so every particle is placed after its parents
+// (limitParticle); a large sheet's rings take several dispatches (limitRingsPerDispatch).
 // Workgroup size (sim_common.glsl declares it)
 #define SIM_LOCAL_SIZE SIM_WG_LIMIT
 // Invocations read the particles other invocations placed in the ring before
@@ -13,8 +13,8 @@
 void main() {
   if (!(u.limit.x > 0.0f)) return; // the same branch for the whole workgroup
   uint root = limitRoot(u.grab_index, u.cols, u.rows), slots = limitSlots(u.cols, u.rows);
-  uint rings = limitRings(root, u.cols, u.rows);
-  for (uint k = 1u; k <= rings; ++k) {
+  uint last = min(limitRings(root, u.cols, u.rows), p.first + p.count - 1u);
+  for (uint k = p.first; k <= last; ++k) {
     for (uint t = gl_LocalInvocationID.x; t < slots; t += gl_WorkGroupSize.x) {
       uint i = ringParticle(root, k, t, u.cols, u.rows);
       if (i != SIM_NONE) limitParticle(i, root);

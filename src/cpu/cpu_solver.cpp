@@ -173,13 +173,18 @@ void CpuSolver::creasePass(const SimUniforms& u) {
 void CpuSolver::limitPass(const SimUniforms& u) {
   if (!(u.limit.x > 0.0f)) return;
   SheetElements e = elements(u);
-  const uint32_t root = limitRoot(u.grab_index, u.cols, u.rows), slots = limitSlots(u.cols, u.rows);
-  const uint32_t rings = limitRings(root, u.cols, u.rows);
-  for (uint32_t k = 1; k <= rings; ++k)
-    for (uint32_t t = 0; t < slots; ++t) {
-      const uint32_t i = ringParticle(root, k, t, u.cols, u.rows);
-      if (i != SIM_NONE) e.limitParticle(i, root);
-    }
+  // A particle's place depends on its parents' alone, so any order that places the parents first
+  // gives the bits of the GPU's rings: row by row outwards from the root's row, each row outwards
+  // from its column, one quadrant after the other (the root's row and column with the first
+  // quadrants that reach them, before those that lean on them)
+  const int cols = int(u.cols), rows = int(u.rows);
+  const uint32_t root = limitRoot(u.grab_index, u.cols, u.rows);
+  const int rx = int(root) % cols, ry = int(root) / cols;
+  for (const int dy : {1, -1})
+    for (const int dx : {1, -1})
+      for (int y = dy > 0 ? ry : ry - 1; y >= 0 && y < rows; y += dy)
+        for (int x = dx > 0 ? rx : rx - 1; x >= 0 && x < cols; x += dx)
+          if (x != rx || y != ry) e.limitParticle(uint32_t(y * cols + x), root);
 }
 
 void CpuSolver::repelPass(const SimUniforms& u) {

@@ -75,6 +75,7 @@ enum class Elements : uint8_t {
   HINGES,
   CONSTRAINTS,
   ONE,
+  RINGS,
   HASH_ARGS,
   HASH_CELLS,
   TEAR_SLOTS,
@@ -165,6 +166,15 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
   case Elements::ONE:
     record(sink, p, d.grid, 1, SimPush{0, n, s, 0}, s, d.gate);
     break;
+  case Elements::RINGS: {
+    // One workgroup walks each run of rings, a barrier after it
+    const uint32_t per = limitRingsPerDispatch(topo.cols, topo.rows), most = limitMostRings(topo.cols, topo.rows);
+    for (uint32_t first = 1; first <= most; first += per) {
+      record(sink, p, d.grid, 1, SimPush{first, per, s, 0}, s, d.gate);
+      if (first + per <= most) sink.barrier();
+    }
+    break;
+  }
   case Elements::HASH_ARGS:
     record(sink, p, d.grid, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0}, s, d.gate);
     break;

@@ -405,6 +405,42 @@ TEST(Stretch, TheHandDragsFoldsAndCrumplesPaperWithinThreePercent) {
   EXPECT_GT(most, 1.1f);
 }
 
+TEST(Stretch, TheRingsVisitEveryParticleOnceAfterItsParents) {
+  // Wider and longer grids, roots at corners, edges and inside: ring k holds the particles k grid
+  // steps from the root, each once, and a particle's parents are one ring nearer
+  for (const glm::uvec2 size : {glm::uvec2(7, 5), glm::uvec2(5, 9), glm::uvec2(1, 6), glm::uvec2(6, 1)})
+    for (const uint32_t root : {0u, size.x * size.y - 1u, size.x / 2u, (size.y / 2u) * size.x + size.x / 2u}) {
+      const uint32_t cols = size.x, rows = size.y, rings = shaderio::limitRings(root, cols, rows);
+      std::vector<int> seen(cols * rows, 0), ring(cols * rows, -1);
+      ring[root] = 0;
+      for (uint32_t k = 1; k <= rings; ++k)
+        for (uint32_t t = 0; t < shaderio::limitSlots(cols, rows); ++t) {
+          const uint32_t i = shaderio::ringParticle(root, k, t, cols, rows);
+          if (i == SIM_NONE) continue;
+          ASSERT_LT(i, cols * rows);
+          ++seen[i];
+          ring[i] = int(k);
+          const int dx = std::abs(int(i % cols) - int(root % cols)), dy = std::abs(int(i / cols) - int(root / cols));
+          EXPECT_EQ(dx + dy, int(k));
+          const glm::uvec2 parent = shaderio::limitParents(i, root, cols);
+          for (uint32_t q : {parent.x, parent.y}) {
+            if (q != SIM_NONE) {
+              EXPECT_EQ(ring[q], int(k) - 1) << cols << "x" << rows << " root " << root << " " << i;
+            }
+          }
+        }
+      for (uint32_t i = 0; i < cols * rows; ++i) EXPECT_EQ(seen[i], i == root ? 0 : 1) << i;
+    }
+  // A large sheet's rings take several dispatches, each within lavapipe's loop count
+  for (const glm::uvec2 size : {glm::uvec2(32, 48), glm::uvec2(512, 768), glm::uvec2(4096, 4096)}) {
+    const uint32_t per = shaderio::limitRingsPerDispatch(size.x, size.y);
+    const uint32_t slots_per_invocation = (shaderio::limitSlots(size.x, size.y) + SIM_WG_LIMIT - 1) / SIM_WG_LIMIT;
+    EXPECT_LE(per * (1 + slots_per_invocation), SIM_LIMIT_LOOP_BUDGET);
+    EXPECT_GE(per, 1u);
+  }
+  EXPECT_GT(shaderio::limitMostRings(4096, 4096), shaderio::limitRingsPerDispatch(4096, 4096));
+}
+
 TEST(Stretch, AHeldSheetYankedTearsAndALyingOneIsLeftAlone) {
   // The sheet hanging from its corners, its bottom middle yanked down at 20 sheet lengths a second:
   // the limit draws the sheet after the hand, the pins hold their corners, and the paper tears

@@ -222,6 +222,11 @@ TEST_F(Parity, TheStretchLimitIsTheSameOnEveryPath) {
       }
     }
   }
+  // A sheet whose rings take two dispatches (limitRingsPerDispatch), its corner carried far off
+  const SimParams big = preset("crumple", {"cols=512", "rows=520", "wind=off"});
+  ASSERT_GT(shaderio::limitMostRings(big.cols, big.rows), shaderio::limitRingsPerDispatch(big.cols, big.rows));
+  auto [cpu, gpu] = runBoth(ctx(), big, "0 grab particle 1000\n1 move -20 -5 3\n", 2, false);
+  EXPECT_TRUE(sameState(cpu, gpu));
 }
 
 TEST_F(Parity, ContactIsTheSameOnTheGpu) {
