@@ -99,6 +99,9 @@ SIM_INLINE bool edgeCut(uint a, uint b) {
 /// is a placement, not a step: the previous position moves with it, so the particle keeps its
 /// velocity. (A limit whose moves were steps fought the next projection through the shear
 /// diagonals, which it does not hold, and pumped energy into the sheet.)
+/// (u.limit and the previous position are read whole: in a fleet's shaders, which reach the buffers
+/// by device address, a y or a w read on its own came out wrong on lavapipe, a w as the x of an
+/// earlier read; the SPIR-V of a small case is right, so the cause is not known.)
 SIM_INLINE void limitParticle(uint i, uint root) {
   vec4 q = SIM_POSITION(i);
   if (!(q.w > 0.0f)) return;
@@ -116,8 +119,6 @@ SIM_INLINE void limitParticle(uint i, uint root) {
   if (!(far_x && use_x) && !(far_y && use_y)) return;
   vec3 to = use_x && use_y ? intoBothReaches(vec3(q), vec3(px), vec3(py), reach)
                            : intoReach(vec3(q), vec3(use_x ? px : py), reach);
-  // (the previous position read whole, once: lavapipe (Mesa 22), in a fleet's shaders, which reach
-  // the buffers by device address, gave a w read on its own the x of an earlier read)
   vec4 before = prev[i];
   SIM_POSITION(i) = vec4(to, q.w);
   prev[i] = vec4(vec3(before) + (to - vec3(q)), before.w);
