@@ -232,13 +232,9 @@ void main() {
       }
     // 4. The stretch limit (as limit.comp): ring after ring from the root
     if (u.limit.x > 0.0f) {
-      uint root = limitRoot(u.grab_index, u.cols, u.rows), slots = limitSlots(u.cols, u.rows);
-      uint rings = limitRings(root, u.cols, u.rows);
+      uint root = limitRoot(u.grab_index, u.cols, u.rows), rings = limitRings(root, u.cols, u.rows);
       for (uint k = 1u; k <= rings; ++k) {
-        for (uint t = lid; t < slots; t += kInvocations) {
-          uint i = ringParticle(root, k, t, u.cols, u.rows);
-          if (i != SIM_NONE) limitParticle(i, root);
-        }
+        limitRing(root, k, lid, kInvocations);
         sync();
       }
     }

@@ -12,13 +12,10 @@
 
 void main() {
   if (!(u.limit.x > 0.0f)) return; // the same branch for the whole workgroup
-  uint root = limitRoot(u.grab_index, u.cols, u.rows), slots = limitSlots(u.cols, u.rows);
+  uint root = limitRoot(u.grab_index, u.cols, u.rows);
   uint last = min(limitRings(root, u.cols, u.rows), p.first + p.count - 1u);
   for (uint k = p.first; k <= last; ++k) {
-    for (uint t = gl_LocalInvocationID.x; t < slots; t += gl_WorkGroupSize.x) {
-      uint i = ringParticle(root, k, t, u.cols, u.rows);
-      if (i != SIM_NONE) limitParticle(i, root);
-    }
+    limitRing(root, k, gl_LocalInvocationID.x, gl_WorkGroupSize.x);
     memoryBarrierBuffer();
     barrier();
   }

@@ -245,4 +245,14 @@ void tearCompact(uint k) {
   }
 }
 
+// Ring k of the stretch limit from `root` (limitParticle), slots `first`, first + `stride`, ... of it:
+// a workgroup's invocations share a ring, and a barrier follows it (limit.comp, the fused tick).
+void limitRing(uint root, uint k, uint first, uint stride) {
+  uint slots = limitSlots(u.cols, u.rows);
+  for (uint t = first; t < slots; t += stride) {
+    uint i = ringParticle(root, k, t, u.cols, u.rows);
+    if (i != SIM_NONE) limitParticle(i, root);
+  }
+}
+
 #endif
