@@ -10,9 +10,13 @@
 #define SIM_WG_COLLIDE 64
 // Workgroup size for tear marking and compaction (one thread per constraint or triangle)
 #define SIM_WG_TEAR 64
-// Workgroup size of the stretch limit: one workgroup a sheet walks its rings (limit.comp); few
-// invocations, as a CPU device pays for each at every barrier
+// Workgroup size of the stretch limit: one workgroup a sheet walks its rings (limit.comp;
+// specialization constant 0). On a CPU device few invocations, as it pays for each at every
+// barrier; on a GPU as many as a ring of a 1024-wide sheet has slots (limitSlots: 2 x the shorter
+// side), so that a ring is one round of loads and stores: with 64, each of a 512 x 768 sheet's 16
+// rounds a ring waits on device memory (an H100: 395 ms a tick of the crumple preset)
 #define SIM_WG_LIMIT 64
+#define SIM_WG_LIMIT_GPU 1024
 // Loop iterations one invocation of the stretch limit runs in a dispatch at most (rings, and the
 // slots of each): lavapipe ends every loop of a shader after 65535 in all (LP_MAX_TGSI_LOOP_ITERATIONS,
 // bench/README.md), so a large sheet's rings take several dispatches (limitRingsPerDispatch)
@@ -151,9 +155,13 @@
 // Elements one workgroup of the block scan covers
 #define SIM_SCAN_BLOCK (SIM_WG_SCAN * SIM_SCAN_PER_THREAD)
 // Workgroup size of the fused small-sheet tick on a GPU (every pass of every substep in one
-// workgroup; specialization constant 0), and the largest it can be asked for (FusedShape; the
-// device's limits may allow less)
-#define SIM_WG_FUSED 256
+// workgroup; specialization constant 0) for a sheet alone and for a fleet's sheets, and the
+// largest it can be asked for (FusedShape; the device's limits may allow less). Measured on an
+// H100 (bench/README.md, "On a GPU"): a 32 x 48 sheet alone ticks in 2.30 ms with 256 invocations,
+// 1.79 with 512, 1.36 with 1024; a fleet of 1,024 of them in 22.3, 18.3 and 22.9 ms (a workgroup
+// of 1,024 leaves an SM room for one sheet at a time, 512 for two)
+#define SIM_WG_FUSED 1024
+#define SIM_WG_FUSED_FLEET 512
 #define SIM_WG_FUSED_MAX 1024
 // Workgroup size of the fused tick on a CPU device: lavapipe runs a workgroup on one thread, its
 // SIMD groups (8 invocations) taking turns at every barrier, and sets up each group's state at

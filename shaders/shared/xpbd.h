@@ -219,10 +219,11 @@ SIM_INLINE uint limitRings(uint root, uint cols, uint rows) {
 /// Slots of a ring (ringParticle): two for each line of the grid's shorter side.
 SIM_INLINE uint limitSlots(uint cols, uint rows) { return 2u * min(cols, rows); }
 
-/// Rings one dispatch of the stretch limit walks (SIM_LIMIT_LOOP_BUDGET), and the rings a sheet can
-/// have from any root: its dispatches cover rings 1 to cols + rows - 2.
-SIM_INLINE uint limitRingsPerDispatch(uint cols, uint rows) {
-  uint per_ring = 1u + (limitSlots(cols, rows) + uint(SIM_WG_LIMIT) - 1u) / uint(SIM_WG_LIMIT);
+/// Rings one dispatch of the stretch limit walks with a workgroup of `invocations`
+/// (SIM_LIMIT_LOOP_BUDGET), and the rings a sheet can have from any root: its dispatches cover
+/// rings 1 to cols + rows - 2.
+SIM_INLINE uint limitRingsPerDispatch(uint cols, uint rows, uint invocations) {
+  uint per_ring = 1u + (limitSlots(cols, rows) + invocations - 1u) / invocations;
   return max(1u, SIM_LIMIT_LOOP_BUDGET / per_ring);
 }
 SIM_INLINE uint limitMostRings(uint cols, uint rows) { return cols + rows - 2u; }

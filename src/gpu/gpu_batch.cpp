@@ -87,7 +87,7 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
   // The fused tick's shape on this kind of device (see FusedShape in gpu_solver.h); a device with
   // too little shared memory for it runs every sheet's per-colour passes, as a sheet alone does.
   const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
-  const FusedShape shape = resolveFusedShape(ctx_, fused);
+  const FusedShape shape = resolveFusedShape(ctx_, fused, true);
   substeps_per_dispatch_ = shape.substeps_per_dispatch;
   fused_max_cell_spacings_ = shape.max_cell_spacings;
   sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;

@@ -272,7 +272,7 @@ PassTimes GpuSolver::passTimes() const {
 
 Arithmetic GpuSolver::arithmetic() const { return arithmeticOf(float_rules_, math_); }
 
-FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested) {
+FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested, bool fleet) {
   const bool cpu_device = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   FusedShape shape;
   const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
@@ -280,6 +280,7 @@ FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested) {
       std::min({uint32_t(SIM_WG_FUSED_MAX), limits.maxComputeWorkGroupInvocations, limits.maxComputeWorkGroupSize[0]});
   shape.workgroup = std::min<uint32_t>(requested.workgroup ? requested.workgroup
                                        : cpu_device        ? SIM_WG_FUSED_CPU
+                                       : fleet             ? SIM_WG_FUSED_FLEET
                                                            : SIM_WG_FUSED,
                                        most);
   shape.substeps_per_dispatch = requested.substeps_per_dispatch ? requested.substeps_per_dispatch

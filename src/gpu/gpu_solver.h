@@ -20,7 +20,7 @@ namespace tender::gpu {
 /// Shape of the fused small-sheet tick; 0 picks the device's value. On a CPU device (lavapipe):
 /// SIM_WG_FUSED_CPU invocations, SIM_FUSED_SUBSTEPS_CPU substeps per dispatch, and only with hash
 /// cells of at most SIM_FUSED_CPU_MAX_CELL_SPACINGS grid spacings; on a GPU: SIM_WG_FUSED
-/// invocations, the whole tick in one dispatch, any cell.
+/// invocations (SIM_WG_FUSED_FLEET in a fleet), the whole tick in one dispatch, any cell.
 struct FusedShape {
   uint32_t workgroup = 0;             ///< invocations of the workgroup, at most SIM_WG_FUSED_MAX
   uint32_t substeps_per_dispatch = 0; ///< substeps each dispatch runs
@@ -34,8 +34,9 @@ struct FusedShape {
   int contact = 0;
 };
 
-/// The fused tick's shape on this device: what `requested` sets, the device's kind's values for the rest.
-FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested = {});
+/// The fused tick's shape on this device, for a sheet alone or a `fleet`'s sheets: what `requested`
+/// sets, the device's kind's values for the rest.
+FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested = {}, bool fleet = false);
 
 /// True when the device has the shared memory the fused tick keeps its positions in.
 bool fusedTickSupported(const VulkanContext& ctx);

@@ -1,5 +1,6 @@
 #include "gpu/sim_pipeline.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -131,6 +132,13 @@ bool isContactKernel(const PipelineSpec& spec) { return std::string_view(spec.ke
 
 } // namespace
 
+uint32_t limitWorkgroup(const VulkanContext& ctx) {
+  const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
+  if (ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) return SIM_WG_LIMIT;
+  return std::min(
+      {uint32_t(SIM_WG_LIMIT_GPU), limits.maxComputeWorkGroupInvocations, limits.maxComputeWorkGroupSize[0]});
+}
+
 SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
                                bool batched, PipelineSet& owned) {
   using namespace shaderio;
@@ -138,9 +146,12 @@ SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, cons
   for (const PipelineSpec& spec : kPasses) {
     if ((batched && !spec.batched) || isContactKernel(spec)) continue;
     const std::string key = batched ? std::string(spec.key) + ".batch" : std::string(spec.key);
+    // The stretch limit's workgroup is the device's (specialization constant 0)
+    const std::optional<uint32_t> size =
+        spec.member == &SimPipelines::limit ? std::optional<uint32_t>(limitWorkgroup(ctx)) : std::nullopt;
     pipes.*spec.member =
         makeComputePipeline(ctx, key, layout, rules, math, batched ? uint32_t(sizeof(BatchPassPush)) : spec.push_size,
-                            spec.per_invocation, std::nullopt, false, owned);
+                            spec.per_invocation, size, size.has_value(), owned);
   }
   return pipes;
 }

@@ -66,6 +66,10 @@ ComputePipeline makeComputePipeline(VulkanContext& ctx, std::string_view key, Vk
                                     uint32_t per_invocation, std::optional<uint32_t> spec0, bool spec0_is_size,
                                     PipelineSet& owned);
 
+/// Invocations of the stretch limit's workgroup (limit.comp) on this device: SIM_WG_LIMIT on a CPU
+/// device, SIM_WG_LIMIT_GPU (or the device's most) on a GPU.
+uint32_t limitWorkgroup(const VulkanContext& ctx);
+
 /// The passes of the per-colour path (every SimPipelines member but tick_fused and pick) on
 /// `layout`: a sheet's own, or a fleet's (`batched`: the SIM_BATCH_PASS builds, "<key>.batch",
 /// whose push constants are BatchPassPush; no normals pass). The contact's kernels (contact_*)

@@ -168,7 +168,8 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
     break;
   case Elements::RINGS: {
     // One workgroup walks each run of rings, a barrier after it
-    const uint32_t per = limitRingsPerDispatch(topo.cols, topo.rows), most = limitMostRings(topo.cols, topo.rows);
+    const uint32_t per = limitRingsPerDispatch(topo.cols, topo.rows, p.workgroup),
+                   most = limitMostRings(topo.cols, topo.rows);
     for (uint32_t first = 1; first <= most; first += per) {
       record(sink, p, d.grid, 1, SimPush{first, per, s, 0}, s, d.gate);
       if (first + per <= most) sink.barrier();

@@ -431,14 +431,17 @@ TEST(Stretch, TheRingsVisitEveryParticleOnceAfterItsParents) {
         }
       for (uint32_t i = 0; i < cols * rows; ++i) EXPECT_EQ(seen[i], i == root ? 0 : 1) << i;
     }
-  // A large sheet's rings take several dispatches, each within lavapipe's loop count
-  for (const glm::uvec2 size : {glm::uvec2(32, 48), glm::uvec2(512, 768), glm::uvec2(4096, 4096)}) {
-    const uint32_t per = shaderio::limitRingsPerDispatch(size.x, size.y);
-    const uint32_t slots_per_invocation = (shaderio::limitSlots(size.x, size.y) + SIM_WG_LIMIT - 1) / SIM_WG_LIMIT;
-    EXPECT_LE(per * (1 + slots_per_invocation), SIM_LIMIT_LOOP_BUDGET);
-    EXPECT_GE(per, 1u);
-  }
-  EXPECT_GT(shaderio::limitMostRings(4096, 4096), shaderio::limitRingsPerDispatch(4096, 4096));
+  // A large sheet's rings take several dispatches, each within lavapipe's loop count; a GPU's
+  // workgroup walks a 1024-wide sheet's rings in one round of its invocations each
+  for (const glm::uvec2 size : {glm::uvec2(32, 48), glm::uvec2(512, 768), glm::uvec2(4096, 4096)})
+    for (const uint32_t invocations : {uint32_t(SIM_WG_LIMIT), uint32_t(SIM_WG_LIMIT_GPU)}) {
+      const uint32_t per = shaderio::limitRingsPerDispatch(size.x, size.y, invocations);
+      const uint32_t slots_per_invocation = (shaderio::limitSlots(size.x, size.y) + invocations - 1) / invocations;
+      EXPECT_LE(per * (1 + slots_per_invocation), SIM_LIMIT_LOOP_BUDGET);
+      EXPECT_GE(per, 1u);
+    }
+  EXPECT_GT(shaderio::limitMostRings(4096, 4096), shaderio::limitRingsPerDispatch(4096, 4096, SIM_WG_LIMIT));
+  EXPECT_EQ(shaderio::limitSlots(512, 768), uint32_t(SIM_WG_LIMIT_GPU));
 }
 
 TEST(Stretch, AHeldSheetYankedTearsAndALyingOneIsLeftAlone) {
