@@ -75,6 +75,10 @@ struct SimUniforms {
   // The stretch limit (limitParticle in sim_bodies.h): x the longest a structural edge may be after
   // the projection (stretch_limit x spacing; 0: off), y its rest length (the spacing)
   vec4 limit;
+  // The Verlet step: x the damping of the first substep, which also rescales the velocity its
+  // previous position carries from the last tick's substeps to this tick's (damping x dt / the
+  // last tick's dt: a tick may run more substeps than the last, Simulation::tickParams); yzw unused
+  vec4 verlet;
 
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
   vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet

@@ -471,6 +471,10 @@ SIM_INLINE vec3 meanAir(vec3 sum, uint count) {
   return vec3(simDiv(sum.x, c), simDiv(sum.y, c), simDiv(sum.z, c));
 }
 
+/// The Verlet damping of substep s (SimUniforms::damping and verlet): the first substep's rescales
+/// the velocity the last tick left to this tick's substep as well.
+SIM_INLINE float substepDamping(float damping, vec4 verlet, uint s) { return s == 0u ? verlet.x : damping; }
+
 /// The wind a particle integrates with: the substep's, plus the air on it (from the air pass) when
 /// SIM_FLAG_AIR is set.
 SIM_INLINE vec4 windWithAir(vec4 wind, vec4 air_on_particle, uint flags) {

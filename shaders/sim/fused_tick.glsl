@@ -153,7 +153,8 @@ void main() {
     for (uint i = lid; i < n; i += kInvocations) {
       VerletState st = integrateParticle(i, s_pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index,
                                          u.grab_target[s], u.grab_prev[s], u.hand, u.hand_motion, u.flags, u.gravity,
-                                         windWithAir(u.wind[s], delta[i], u.flags), u.wind_twist[s], u.damping, dt2);
+                                         windWithAir(u.wind[s], delta[i], u.flags), u.wind_twist[s],
+                                         substepDamping(u.damping, u.verlet, s), dt2);
       s_pos[i] = st.position;
       prev[i] = st.previous;
     }

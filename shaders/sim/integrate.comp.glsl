@@ -18,7 +18,7 @@ void main() {
   VerletState st =
       integrateParticle(i, pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index, u.grab_target[s], u.grab_prev[s],
                         u.hand, u.hand_motion, u.flags, u.gravity, windWithAir(u.wind[s], delta[i], u.flags),
-                        u.wind_twist[s], u.damping, u.dt * u.dt);
+                        u.wind_twist[s], substepDamping(u.damping, u.verlet, s), u.dt * u.dt);
   pos[i] = st.position;
   prev[i] = st.previous;
 }

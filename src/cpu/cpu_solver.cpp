@@ -102,9 +102,10 @@ void CpuSolver::integrate(const SimUniforms& u, uint32_t s) {
     const vec4* rest = rest_.data();
     const vec2* uv = uv_.data();
     for (uint32_t i = begin; i < end; ++i) {
-      const VerletState st = integrateParticle(i, pos[i], prev[i], rest[i], uv[i].x, i == u.grab_index, target,
-                                               grab_prev, u.hand, u.hand_motion, u.flags, u.gravity,
-                                               air ? windWithAir(wind, air_[i], u.flags) : wind, twist, u.damping, dt2);
+      const VerletState st =
+          integrateParticle(i, pos[i], prev[i], rest[i], uv[i].x, i == u.grab_index, target, grab_prev, u.hand,
+                            u.hand_motion, u.flags, u.gravity, air ? windWithAir(wind, air_[i], u.flags) : wind, twist,
+                            substepDamping(u.damping, u.verlet, s), dt2);
       pos[i] = st.position;
       prev[i] = st.previous;
     }

@@ -46,11 +46,14 @@ private:
   std::vector<std::pair<VkPipeline, std::string>> names_;
 };
 
-/// Pipelines with distinct (never dispatched) handles.
+/// Pipelines with distinct (never dispatched) handles, each of a CPU device's workgroup (the
+/// stretch limit's dispatches follow it).
 SimPipelines fakePipelines() {
   SimPipelines pipes;
   uintptr_t handle = 1;
-#define FAKE(name, push, per_invocation, batched) pipes.name.pipeline = reinterpret_cast<VkPipeline>(handle++);
+#define FAKE(name, push, per_invocation, batched)                                                                      \
+  pipes.name.pipeline = reinterpret_cast<VkPipeline>(handle++);                                                        \
+  pipes.name.workgroup = SIM_WG_LIMIT;
   SIM_KERNELS(FAKE)
 #undef FAKE
   return pipes;
