@@ -197,6 +197,12 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   u.color_count = topo_.colorCount();
   u.dt = p.substepDt();
   u.damping = p.damping;
+  // The first substep takes the velocity the last tick's substeps left over to this tick's (the
+  // substeps key changed between them)
+  const float last_dt = last_uniforms_.dt;
+  u.verlet = glm::vec4(last_dt > 0.0f && last_dt != u.dt ? float(double(p.damping) * double(u.dt) / double(last_dt))
+                                                         : p.damping,
+                       0.0f, 0.0f, 0.0f);
   u.gravity = p.gravity;
   u.floor_y = p.floor_y;
   u.restitution = p.restitution;

@@ -161,10 +161,13 @@ TEST_F(Parity, FullPhysicsCrumple60Ticks) {
 
 TEST_F(Parity, PaperInTheAir) {
   // The air on each triangle (its own pass, or the first step of the fused tick) through a throw
-  // that tears: the same bits on both GPU paths and the CPU.
+  // that tears, its substeps changed in flight (the first substep after a change rescales the
+  // velocity, SimUniforms::verlet): the same bits on both GPU paths and the CPU.
   SimParams p = preset("paper", {"tear_factor=1.6"});
   for (bool fused : {true, false}) {
-    auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 1036\n1 move 0.2 0.6 0.1\n8 release\n", 60, fused);
+    auto [cpu, gpu] = runBoth(
+        ctx(), p, "0 grab particle 1036\n1 move 0.2 0.6 0.1\n8 release\n20 set substeps 12\n40 set substeps 6\n", 60,
+        fused);
     std::printf("paper, 60 ticks, %s: %zu torn\n", fused ? "fused tick" : "per-colour passes", tornIds(cpu).size());
     EXPECT_GT(tornIds(cpu).size(), 0u);
     EXPECT_TRUE(sameState(cpu, gpu));
