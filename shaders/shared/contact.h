@@ -252,6 +252,36 @@ SIM_INLINE bool trianglesCross(vec3 a0, vec3 a1, vec3 a2, vec3 b0, vec3 b1, vec3
          segmentCrossesTriangle(b1, b2, a0, a1, a2) || segmentCrossesTriangle(b2, b0, a0, a1, a2);
 }
 
+/// Edge p-q (corners kp, kq of a crossing pair's six: 0-2 the first triangle's, 3-5 the second's)
+/// against triangle t0, t1, t2 (corners kt to kt + 2): when the edge passes through it, corner k's
+/// share of drawing the edge's end nearer the triangle's plane back through it, to `gap` beyond:
+/// the end moves half of that along the plane's normal, the triangle's corners the other half the
+/// other way. Zero for every other corner.
+SIM_INLINE vec3 untangleEdge(vec3 p, vec3 q, vec3 t0, vec3 t1, vec3 t2, float gap, uint kp, uint kq, uint kt, uint k) {
+  bool at_edge = k == kp || k == kq, at_triangle = k >= kt && k < kt + 3u;
+  if (!(at_edge || at_triangle) || !segmentCrossesTriangle(p, q, t0, t1, t2)) return vec3(0.0f);
+  vec3 n = cross3(t1 - t0, t2 - t0);
+  float n2 = dot3(n, n), sp = dot3(n, p - t0), sq = dot3(n, q - t0);
+  // The nearer end, by its signed distance times |n|
+  bool p_nearer = abs(sp) <= abs(sq);
+  float side = p_nearer ? sp : sq;
+  if ((at_edge && k != (p_nearer ? kp : kq)) || !(n2 > 0.0f)) return vec3(0.0f);
+  float len = simSqrt(n2), half_way = 0.5f * (simDiv(abs(side), len) + gap);
+  vec3 along = n * simDiv(side > 0.0f ? half_way : -half_way, len); // from the plane towards the end
+  return at_edge ? -along : along;
+}
+
+/// Corner k's push (0-2: a's, 3-5: b's) that untangles two crossing triangles: every edge of one
+/// that passes through the other is drawn back through it at its nearer end (untangleEdge), to
+/// `gap` beyond. Where a grab forced the sheet through itself, the particles of crossing triangles
+/// are free of their bounds, and these pushes (with the contact's, cut to contactPushWithin) part
+/// the layers again.
+SIM_INLINE vec3 untanglePush(vec3 a0, vec3 a1, vec3 a2, vec3 b0, vec3 b1, vec3 b2, float gap, uint k) {
+  return untangleEdge(a0, a1, b0, b1, b2, gap, 0u, 1u, 3u, k) + untangleEdge(a1, a2, b0, b1, b2, gap, 1u, 2u, 3u, k) +
+         untangleEdge(a2, a0, b0, b1, b2, gap, 2u, 0u, 3u, k) + untangleEdge(b0, b1, a0, a1, a2, gap, 3u, 4u, 0u, k) +
+         untangleEdge(b1, b2, a0, a1, a2, gap, 4u, 5u, 0u, k) + untangleEdge(b2, b0, a0, a1, a2, gap, 5u, 3u, 0u, k);
+}
+
 /// A pair's push on one particle in fixed point (`scale`: SimUniforms::contact.w units per unit of
 /// length), clamped to +-SIM_CONTACT_FIXED_MAX: integers sum to the same bits in any order, so a
 /// particle's pushes need no fixed order (atomic adds on the GPU).

@@ -233,18 +233,26 @@ void listPair(uint list, float d2, uint other) {
 }
 
 // Live triangle slot t against slot o: when they share no particle and cross, both triangles'
-// particles go free this substep
+// particles go free this substep, and take their pushes that untangle the pair (untanglePush)
 void visitCrossing(uint t, uint o) {
   uvec4 a = triangles[t], b = triangles[o];
   if (a.x == b.x || a.x == b.y || a.x == b.z || a.y == b.x || a.y == b.y || a.y == b.z || a.z == b.x || a.z == b.y ||
       a.z == b.z)
     return;
-  if (!trianglesCross(vec3(SIM_POSITION(a.x)), vec3(SIM_POSITION(a.y)), vec3(SIM_POSITION(a.z)),
-                      vec3(SIM_POSITION(b.x)), vec3(SIM_POSITION(b.y)), vec3(SIM_POSITION(b.z))))
-    return;
-  for (uint j = 0u; j < 3u; ++j) {
-    atomicOr(contact_particles[a[j]].state.y, 1u);
-    atomicOr(contact_particles[b[j]].state.y, 1u);
+  vec3 x[6] = {vec3(SIM_POSITION(a.x)), vec3(SIM_POSITION(a.y)), vec3(SIM_POSITION(a.z)),
+               vec3(SIM_POSITION(b.x)), vec3(SIM_POSITION(b.y)), vec3(SIM_POSITION(b.z))};
+  if (!trianglesCross(x[0], x[1], x[2], x[3], x[4], x[5])) return;
+  for (uint k = 0u; k < 6u; ++k) {
+    uint i = k < 3u ? a[k] : b[k - 3u];
+    atomicOr(contact_particles[i].state.y, 1u);
+    vec3 push = untanglePush(x[0], x[1], x[2], x[3], x[4], x[5], u.contact.z, k);
+    if (push == vec3(0.0f)) continue;
+    ivec3 f = contactFixed(push, u.contact.w);
+    // Two's complement: unsigned sums have the bits of the signed ones
+    atomicAdd(contact_particles[i].sum.x, uint(f.x));
+    atomicAdd(contact_particles[i].sum.y, uint(f.y));
+    atomicAdd(contact_particles[i].sum.z, uint(f.z));
+    atomicAdd(contact_particles[i].sum.w, 1u);
   }
   atomicOr(contact_words[CONTACT_TANGLED], 1u);
 }

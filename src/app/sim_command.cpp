@@ -163,7 +163,7 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   solver.computeNormals();
   SimState state;
   solver.readback(state);
-  SheetStats st = computeStats(state, common.params.substepDt());
+  SheetStats st = computeStats(state, sim.lastSubstepDt());
   judgeIntersections(st, state);
   double median = 0.0, slowest = 0.0;
   nlohmann::json j = runStatsJson(st, solver, {common.params.preset, o.ticks, sim.physicsTicks(), std::move(ms)},

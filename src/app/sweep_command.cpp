@@ -114,7 +114,7 @@ private:
     solver.computeNormals();
     SimState state;
     solver.readback(state);
-    const SheetStats st = computeStats(state, sim.params().substepDt());
+    const SheetStats st = computeStats(state, sim.lastSubstepDt());
     const nlohmann::json stats =
         runStatsJson(st, solver, {sim.params().preset, plan_.ticks, sim.physicsTicks(), std::move(ms)}, gpu);
     Json line, batch;

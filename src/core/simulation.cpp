@@ -184,8 +184,21 @@ void Simulation::reset() {
   reset_frame_ = SIM_RESET_FRAMES;
 }
 
+SimParams Simulation::tickParams() const {
+  SimParams p = params_;
+  const float bound = SIM_CONTACT_FRACTION * p.contactRadius();
+  if (!(bound > 0.0f) || grab_index_ == SIM_NONE || reset_frame_ > 0) return p;
+  const double most = double(kHandBoundShare) * bound, reach = glm::length(grab_to_ - grab_from_);
+  const uint32_t needed = uint32_t(std::min(std::ceil(reach / most), double(SIM_MAX_SUBSTEPS)));
+  if (needed <= p.substeps) return p;
+  // The damping is a factor a substep: the tick's whole stays the sheet's
+  p.damping = float(std::pow(double(p.damping), double(p.substeps) / double(needed)));
+  p.substeps = needed;
+  return p;
+}
+
 shaderio::SimUniforms Simulation::makeUniforms() const {
-  const SimParams& p = params_;
+  const SimParams p = tickParams();
   shaderio::SimUniforms u{};
   u.particle_count = topo_.particleCount();
   u.cols = topo_.cols;

@@ -23,6 +23,12 @@ WindSample windAt(WindKind kind, double t, float amplitude);
 /// takes a particle's velocity relative to the hand.
 constexpr float kHandPullSeconds = 0.25f, kHandGripSeconds = 0.1f;
 
+/// With contact on, the most a grab's target moves in a substep, as a share of the contact's
+/// bound on a free particle's step (SIM_CONTACT_FRACTION x the contact radius): a faster hand
+/// ticks in more substeps (Simulation::tickParams), so that the particles around the grab, whose
+/// steps the bound caps, keep up with it instead of letting it stretch the sheet.
+constexpr float kHandBoundShare = 0.4f;
+
 class Simulation {
 public:
   /// Builds the sheet and uploads it to the solver (params must be valid).
@@ -95,8 +101,15 @@ public:
   uint64_t physicsTicks() const { return physics_ticks_; }
   /// Uniforms of the next physics tick (for tests and tools).
   shaderio::SimUniforms makeUniforms() const;
+  /// The parameters the next physics tick runs with: the sheet's, but with contact on and a grab
+  /// moving more than kHandBoundShare of the contact's bound a substep, more substeps (up to
+  /// SIM_MAX_SUBSTEPS) and the damping that keeps the tick's.
+  SimParams tickParams() const;
   /// Uniforms the solver ran its last tick (or reset frame) with.
   const shaderio::SimUniforms& lastUniforms() const { return last_uniforms_; }
+  /// The substep of the last physics tick (its substeps may be more than the sheet's: tickParams),
+  /// in seconds: a particle's velocity is (pos - prev) / this.
+  float lastSubstepDt() const { return last_uniforms_.dt > 0.0f ? last_uniforms_.dt : params_.substepDt(); }
 
 private:
   void grabAt(uint32_t i, glm::vec3 position);

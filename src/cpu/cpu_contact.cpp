@@ -144,11 +144,11 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   const bool fresh = lists_ && list_radius_ == radius && based &&
                      !listsOutgrown(orderedCorner(all.travel_lo), orderedCorner(all.travel_hi), radius);
   if (!fresh) buildLists(pos, triangles, count, radius);
+  sums_.assign(n, glm::ivec4(0));
   findCrossings(pos, triangles, count, s == 0 && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u, u.contact_check.y,
-                u.contact_check.z);
+                u.contact_check.z, thickness, scale);
   const uint32_t none = std::bit_cast<uint32_t>(r2);
   nearest2_.assign(n, lists_ ? none : 0u); // positions gone wrong (no lists): nothing moves
-  sums_.assign(n, glm::ivec4(0));
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
   auto vf = [](vec3 p, vec3 a, vec3 b, vec3 c) { return pointTriangle(p, a, b, c); };
   auto ee = [](vec3 a, vec3 b, vec3 c, vec3 d) { return segmentSegment(a, b, c, d); };
@@ -187,7 +187,7 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
 }
 
 void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
-                               bool all, uint32_t grab_now, uint32_t grab_last) {
+                               bool all, uint32_t grab_now, uint32_t grab_last, float gap, float scale) {
   // Where the sheet already crosses itself (the user forced it through: the grab is not bounded;
   // or it started so), no bound can undo it and bounds would hold it there: the particles of the
   // triangles that cross another go free until it untangles. Only what moved unbounded can have
@@ -223,9 +223,18 @@ void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vec
     if (a.x == b.x || a.x == b.y || a.x == b.z || a.y == b.x || a.y == b.y || a.y == b.z || a.z == b.x || a.z == b.y ||
         a.z == b.z)
       return;
-    if (trianglesCross(at(a.x), at(a.y), at(a.z), at(b.x), at(b.y), at(b.z))) {
-      std::atomic_ref<uint8_t>(crossing_[t]).store(1, std::memory_order_relaxed);
-      std::atomic_ref<uint8_t>(crossing_[o]).store(1, std::memory_order_relaxed);
+    const vec3 x[6] = {at(a.x), at(a.y), at(a.z), at(b.x), at(b.y), at(b.z)};
+    if (!trianglesCross(x[0], x[1], x[2], x[3], x[4], x[5])) return;
+    std::atomic_ref<uint8_t>(crossing_[t]).store(1, std::memory_order_relaxed);
+    std::atomic_ref<uint8_t>(crossing_[o]).store(1, std::memory_order_relaxed);
+    // The pushes that untangle the pair, summed in fixed point with the contact's
+    for (uint32_t k = 0; k < 6; ++k) {
+      const vec3 push = untanglePush(x[0], x[1], x[2], x[3], x[4], x[5], gap, k);
+      if (push == vec3(0.0f)) continue;
+      const glm::ivec3 f = contactFixed(push, scale);
+      int32_t* sum = &sums_[k < 3 ? a[k] : b[k - 3]].x;
+      for (uint32_t c = 0; c < 3; ++c) std::atomic_ref<int32_t>(sum[c]).fetch_add(f[c], std::memory_order_relaxed);
+      std::atomic_ref<int32_t>(sum[3]).fetch_add(1, std::memory_order_relaxed);
     }
   };
   const uint32_t checked = uint32_t(checked_.size());

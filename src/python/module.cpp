@@ -106,7 +106,7 @@ public:
 
   py::array_t<float> velocities() {
     SimState s = state();
-    const float dt = sim_->params().substepDt();
+    const float dt = sim_->lastSubstepDt();
     py::array_t<float> a({py::ssize_t(s.pos.size()), py::ssize_t(3)});
     auto m = a.mutable_unchecked<2>();
     for (size_t i = 0; i < s.pos.size(); ++i) {
@@ -123,7 +123,7 @@ public:
 
   py::object stats() {
     SimState s = state();
-    SheetStats st = computeStats(s, sim_->params().substepDt());
+    SheetStats st = computeStats(s, sim_->lastSubstepDt());
     judgeIntersections(st, s);
     nlohmann::json j =
         runStatsJson(st, *backend_.solver, {sim_->params().preset, sim_->frameCount(), sim_->physicsTicks(), ms_},
@@ -282,7 +282,7 @@ public:
     py::array_t<float> a({py::ssize_t(b), py::ssize_t(n), py::ssize_t(3)});
     auto m = a.mutable_unchecked<3>();
     for (size_t i = 0; i < b; ++i) {
-      const float dt = fleet_->sim(uint32_t(i)).params().substepDt();
+      const float dt = fleet_->sim(uint32_t(i)).lastSubstepDt();
       for (size_t j = 0; j < n; ++j) {
         const glm::vec3 p(pos[i * n + j]), q(prev[i * n + j]);
         const glm::vec3 v = velocities ? (p - q) / dt : p;
@@ -300,7 +300,7 @@ public:
     }
     Simulation& sim = at(*sheet);
     SimState s = state(uint32_t(*sheet));
-    SheetStats st = computeStats(s, sim.params().substepDt());
+    SheetStats st = computeStats(s, sim.lastSubstepDt());
     judgeIntersections(st, s);
     nlohmann::json j = runStatsJson(st, sim.solver(), {sim.params().preset, sim.frameCount(), sim.physicsTicks(), ms_},
                                     batch_->name() == "gpu");
