@@ -77,7 +77,8 @@ struct SimUniforms {
   vec4 limit;
   // The Verlet step: x the damping of the first substep, which also rescales the velocity its
   // previous position carries from the last tick's substeps to this tick's (damping x dt / the
-  // last tick's dt, when the substeps key changed between them); yzw unused
+  // last tick's dt, when the substeps key changed between them or the hand's pace asks for more,
+  // Simulation::tickParams); yzw unused
   vec4 verlet;
 
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep

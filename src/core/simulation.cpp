@@ -211,7 +211,7 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   u.dt = p.substepDt();
   u.damping = p.damping;
   // The first substep takes the velocity the last tick's substeps left over to this tick's (the
-  // substeps key changed between them)
+  // substeps key changed between them, or the hand's pace asks for more: tickParams)
   const float last_dt = last_uniforms_.dt;
   u.verlet = glm::vec4(last_dt > 0.0f && last_dt != u.dt ? float(double(p.damping) * double(u.dt) / double(last_dt))
                                                          : p.damping,
