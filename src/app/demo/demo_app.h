@@ -107,6 +107,10 @@ private:
   /// on a HUD window belongs to the HUD alone (the flag of the previous frame can be stale: the
   /// cursor may have reached the button in the same event batch as the click).
   void resolveMouse();
+  /// Applies the wheel steps not yet applied while grabbing (off the HUD) as the hand's squeeze: in
+  /// resolveMouse, and before a key or the release that came after them in the same frame, so
+  /// the events apply in the order they came.
+  void squeezeByWheel();
 
   static void onMouseButton(GLFWwindow* w, int button, int action, int mods);
   static void onCursor(GLFWwindow* w, double x, double y);

@@ -51,12 +51,17 @@ void DemoApp::onMouseButton(GLFWwindow* w, int button, int action, int) {
   }
 }
 
+void DemoApp::squeezeByWheel() {
+  // The wheel while grabbing closes the hand (away from you) or opens it, a quarter per step.
+  if (input_.scroll == 0.0 || !input_.grabbing || ImGui::GetIO().WantCaptureMouse) return;
+  squeeze(sim_->closure() + kClosurePerWheelStep * float(input_.scroll));
+  input_.scroll = 0.0;
+}
+
 void DemoApp::resolveMouse() {
   const bool on_hud = ImGui::GetIO().WantCaptureMouse;
-  if (!on_hud && input_.scroll != 0.0 && input_.grabbing) {
-    // The wheel while grabbing closes the hand (away from you) or opens it, a quarter per step.
-    squeeze(sim_->closure() + kClosurePerWheelStep * float(input_.scroll));
-  } else if (!on_hud && input_.scroll != 0.0) {
+  squeezeByWheel();
+  if (!on_hud && input_.scroll != 0.0 && !input_.grabbing) {
     camera_.zoom(float(input_.scroll));
     follow_.stop();
   }
@@ -95,6 +100,7 @@ void DemoApp::beginDrag(int button, double x, double y) {
 void DemoApp::endDrag(int button) {
   Input& in = input_;
   if (button == GLFW_MOUSE_BUTTON_LEFT && in.grabbing) {
+    squeezeByWheel(); // wheel steps of this frame came before the release
     applyPendingMove();
     ScriptEvent e;
     e.kind = EventKind::Release;
@@ -150,7 +156,9 @@ void DemoApp::onKey(GLFWwindow* w, int key, int, int action, int) {
     break;
   case GLFW_KEY_H:
     // The hand around the grab: closed into a ball, or open again
-    if (app.input_.grabbing) app.squeeze(app.sim_->closure() < 1.0f ? 1.0f : 0.0f);
+    if (!app.input_.grabbing) return;
+    app.squeezeByWheel(); // wheel steps of this frame came before the key
+    app.squeeze(app.sim_->closure() < 1.0f ? 1.0f : 0.0f);
     return;
   case GLFW_KEY_I:
     app.show_fps_ = !app.show_fps_;
