@@ -199,6 +199,16 @@ bool contactFree(uint i) { return (contact_particles[i].state.y & 1u) != 0u; }
 
 // A pair closer than the contact radius lowers its four particles' bounds; one closer than the
 // thickness pushes them apart (contactPush, in fixed point)
+// Adds a push to particle i's sum in fixed point (contactFixed) and counts it
+void addPush(uint i, vec3 push) {
+  ivec3 f = contactFixed(push, u.contact.w);
+  // Two's complement: unsigned sums have the bits of the signed ones
+  atomicAdd(contact_particles[i].sum.x, uint(f.x));
+  atomicAdd(contact_particles[i].sum.y, uint(f.y));
+  atomicAdd(contact_particles[i].sum.z, uint(f.z));
+  atomicAdd(contact_particles[i].sum.w, 1u);
+}
+
 void contactPair(uvec4 q, ContactPair c) {
   float r = u.contact.x, thickness = u.contact.z;
   if (!(c.d2 < r * r)) return;
@@ -210,12 +220,7 @@ void contactPair(uvec4 q, ContactPair c) {
   vec4 x0 = SIM_POSITION(q.x), x1 = SIM_POSITION(q.y), x2 = SIM_POSITION(q.z), x3 = SIM_POSITION(q.w);
   for (uint j = 0u; j < 4u; ++j) {
     uint i = j == 0u ? q.x : (j == 1u ? q.y : (j == 2u ? q.z : q.w));
-    ivec3 f = contactFixed(contactPush(x0, x1, x2, x3, c, thickness, j), u.contact.w);
-    // Two's complement: unsigned sums have the bits of the signed ones
-    atomicAdd(contact_particles[i].sum.x, uint(f.x));
-    atomicAdd(contact_particles[i].sum.y, uint(f.y));
-    atomicAdd(contact_particles[i].sum.z, uint(f.z));
-    atomicAdd(contact_particles[i].sum.w, 1u);
+    addPush(i, contactPush(x0, x1, x2, x3, c, thickness, j));
   }
 }
 
@@ -246,13 +251,7 @@ void visitCrossing(uint t, uint o) {
     uint i = k < 3u ? a[k] : b[k - 3u];
     atomicOr(contact_particles[i].state.y, 1u);
     vec3 push = untanglePush(x[0], x[1], x[2], x[3], x[4], x[5], u.contact.z, k);
-    if (push == vec3(0.0f)) continue;
-    ivec3 f = contactFixed(push, u.contact.w);
-    // Two's complement: unsigned sums have the bits of the signed ones
-    atomicAdd(contact_particles[i].sum.x, uint(f.x));
-    atomicAdd(contact_particles[i].sum.y, uint(f.y));
-    atomicAdd(contact_particles[i].sum.z, uint(f.z));
-    atomicAdd(contact_particles[i].sum.w, 1u);
+    if (push != vec3(0.0f)) addPush(i, push);
   }
   atomicOr(contact_words[CONTACT_TANGLED], 1u);
 }

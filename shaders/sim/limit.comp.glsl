@@ -2,7 +2,7 @@
 // The stretch limit of a substep: one workgroup a sheet walks rings p.first to p.first + p.count - 1
 // around its root (limitRoot), a barrier after each, so every particle is placed after its parents
 // (limitParticle); a large sheet's rings take several dispatches (limitRingsPerDispatch).
-// Workgroup size: specialization constant 0, the device's (limitWorkgroup in gpu_solver.h)
+// Workgroup size: specialization constant 0, the device's (limitWorkgroup in sim_pipeline.h)
 #define SIM_LOCAL_SIZE SIM_WG_LIMIT
 #define SIM_LOCAL_SIZE_SPECIALIZED
 // Invocations read the particles other invocations placed in the ring before

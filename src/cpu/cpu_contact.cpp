@@ -166,12 +166,7 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
         for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], c.d2);
         if (!(c.d2 < thickness * thickness)) continue;
         const glm::vec4 x[4] = {pos[q.x], pos[q.y], pos[q.z], pos[q.w]};
-        for (uint32_t j = 0; j < 4; ++j) {
-          const glm::ivec3 f = contactFixed(contactPush(x[0], x[1], x[2], x[3], c, thickness, j), scale);
-          int32_t* sum = &sums_[q[j]].x;
-          for (uint32_t a = 0; a < 3; ++a) std::atomic_ref<int32_t>(sum[a]).fetch_add(f[a], std::memory_order_relaxed);
-          std::atomic_ref<int32_t>(sum[3]).fetch_add(1, std::memory_order_relaxed);
-        }
+        for (uint32_t j = 0; j < 4; ++j) addPush(q[j], contactPush(x[0], x[1], x[2], x[3], c, thickness, j), scale);
       }
     });
   };
@@ -184,6 +179,13 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
     push[i] = glm::vec4(contactPushWithin(contactAverage(sums_[i], scale), std::bit_cast<float>(nearest2_[i])), 0.0f);
   }
   contacts_ = contacts;
+}
+
+void CpuContact::addPush(uint32_t i, vec3 push, float scale) {
+  const glm::ivec3 f = contactFixed(push, scale);
+  int32_t* sum = &sums_[i].x;
+  for (uint32_t c = 0; c < 3; ++c) std::atomic_ref<int32_t>(sum[c]).fetch_add(f[c], std::memory_order_relaxed);
+  std::atomic_ref<int32_t>(sum[3]).fetch_add(1, std::memory_order_relaxed);
 }
 
 void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
@@ -230,11 +232,7 @@ void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vec
     // The pushes that untangle the pair, summed in fixed point with the contact's
     for (uint32_t k = 0; k < 6; ++k) {
       const vec3 push = untanglePush(x[0], x[1], x[2], x[3], x[4], x[5], gap, k);
-      if (push == vec3(0.0f)) continue;
-      const glm::ivec3 f = contactFixed(push, scale);
-      int32_t* sum = &sums_[k < 3 ? a[k] : b[k - 3]].x;
-      for (uint32_t c = 0; c < 3; ++c) std::atomic_ref<int32_t>(sum[c]).fetch_add(f[c], std::memory_order_relaxed);
-      std::atomic_ref<int32_t>(sum[3]).fetch_add(1, std::memory_order_relaxed);
+      if (push != vec3(0.0f)) addPush(k < 3 ? a[k] : b[k - 3], push, scale);
     }
   };
   const uint32_t checked = uint32_t(checked_.size());

@@ -55,6 +55,9 @@ private:
 
   /// Box tests below which the crossing check tests its triangles against every triangle
   static constexpr uint64_t kBruteForceTests = 1u << 20;
+  /// Adds a push to particle i's sum in fixed point (contactFixed, `scale` units a unit of length)
+  /// and counts it; from any thread (the integer sums give the same bits in any order).
+  void addPush(uint32_t i, glm::vec3 push, float scale);
   /// Sets free_ to the particles of the triangles that cross another, among the pairs with one of
   /// the triangles crossingChecked names (contact.h), and adds each crossing pair's untanglePush to
   /// the sums (`gap`: how far beyond, `scale`: their fixed point); the last call's free_ is was_free_.
