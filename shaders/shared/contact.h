@@ -15,12 +15,13 @@
 // reaches f. Two edges likewise. A triangle can only come to cross another by a particle passing
 // a triangle or an edge passing an edge, so a sheet that starts a substep without crossing itself
 // ends it without. Pairs farther apart than r are not searched: they move at most 2 fraction r < r
-// towards each other. Particles held by a pin or the grab are moved by the user, not bounded.
+// towards each other. The grab is bounded too (contactBounded): it follows the hand no faster than
+// its bound; a pinned particle does not move.
 // The bound holds in a frame that moves with the sheet: a pair's distance falls by at most the
 // largest difference of its particles' displacements, so a translation t common to every particle
 // can be taken out of each step first: no particle ends farther than b(v) from its start + t
 // (contactFrame picks t from how the sheet moved in the last substep: the motion every particle
-// shares, none while one rests). A sheet falling or flying as a whole is not held back, and with
+// shares, none while one rests, a pinned one included). A sheet falling or flying as a whole is not held back, and with
 // every start + t above the floor the floor stays out of the way.
 // Floats round: stepBound takes a margin m, far above the rounding, off d, so pairs close in on
 // m and stop there. The push that parts pairs closer than the thickness moves a particle on top of
@@ -187,7 +188,7 @@ SIM_INLINE uint orderedBits(float f) {
 SIM_INLINE float orderedFloat(uint o) { return uintBitsToFloat((o & 0x80000000u) != 0u ? o & 0x7FFFFFFFu : ~o); }
 
 /// The translation taken out of every step of the substep before the bound (the frame in the proof
-/// above), from the bounded particles' steps in the last substep (componentwise lowest `lo` and
+/// above), from every particle's step in the last substep (componentwise lowest `lo` and
 /// highest `hi`) and the lowest start of one above the floor, `lowest` (>= 0): the point of the box
 /// [lo, hi] nearest to no step, raised so that no start + it goes below the floor. Each component
 /// lies between 0 and every particle's last step, and a step cut to its bound ends between the frame
@@ -210,7 +211,15 @@ SIM_INLINE vec3 boundedStep(vec3 x0, vec3 x, float bound) {
   return x0 + d * simDiv(bound, simSqrt(l2));
 }
 
-/// A free particle's substep with contact (st: where it ends after the floor and its previous
+/// True when a particle's substep is cut to its bound (contactStep): a free particle (inverse mass
+/// `w` > 0) and the grabbed one while the user places it (`grab_w`: its grab_target.w, 1 held, 2
+/// tossed). The grab follows the hand as fast as its bound lets it and no faster, so no hand can
+/// carry the sheet through itself; a pinned particle does not move.
+SIM_INLINE bool contactBounded(float w, bool is_grabbed, float grab_w) {
+  return w > 0.0f || (is_grabbed && grab_w > 0.5f);
+}
+
+/// A particle's substep with contact (st: where it ends after the floor and its previous
 /// position; x0: where it started; push: contactPushWithin; frame: contactFrame): the step less the
 /// frame is cut to `bound` (boundedStep from x0 + frame), then the push moves it without speeding it
 /// up. A step cut short keeps the particle's speed at most, along the step it made: the contact
@@ -273,9 +282,9 @@ SIM_INLINE vec3 untangleEdge(vec3 p, vec3 q, vec3 t0, vec3 t1, vec3 t2, float ga
 
 /// Corner k's push (0-2: a's, 3-5: b's) that untangles two crossing triangles: every edge of one
 /// that passes through the other is drawn back through it at its nearer end (untangleEdge), to
-/// `gap` beyond. Where a grab forced the sheet through itself, the particles of crossing triangles
-/// are free of their bounds, and these pushes (with the contact's, cut to contactPushWithin) part
-/// the layers again.
+/// `gap` beyond. Where the sheet crosses itself (contact turned on in a tangled sheet), the
+/// particles of crossing triangles are free of their bounds, and these pushes (with the contact's,
+/// cut to contactPushWithin) part the layers again.
 SIM_INLINE vec3 untanglePush(vec3 a0, vec3 a1, vec3 a2, vec3 b0, vec3 b1, vec3 b2, float gap, uint k) {
   return untangleEdge(a0, a1, b0, b1, b2, gap, 0u, 1u, 3u, k) + untangleEdge(a1, a2, b0, b1, b2, gap, 1u, 2u, 3u, k) +
          untangleEdge(a2, a0, b0, b1, b2, gap, 2u, 0u, 3u, k) + untangleEdge(b0, b1, a0, a1, a2, gap, 3u, 4u, 0u, k) +
@@ -294,13 +303,10 @@ SIM_INLINE vec3 contactAverage(ivec4 sum, float scale) {
   return sum.w > 0 ? vec3(sum.x, sum.y, sum.z) * simDiv(1.0f, scale * float(sum.w)) : vec3(0.0f);
 }
 
-/// True when triangle t (particles tri) is looked at for crossing the sheet this substep: every
-/// triangle when the check is `all`, else those that hold a particle that moved unbounded (one
-/// the grab holds or held last tick, `grab_now` and `grab_last`, or one let free in the last
-/// substep, `was_free`). Only unbounded motion can carry a triangle through another.
-SIM_INLINE bool crossingChecked(bool all, uvec3 tri, uint grab_now, uint grab_last, bool was_free) {
-  return all || was_free || tri.x == grab_now || tri.y == grab_now || tri.z == grab_now || tri.x == grab_last ||
-         tri.y == grab_last || tri.z == grab_last;
-}
+/// True when a triangle is looked at for crossing the sheet this substep: every triangle when the
+/// check is `all`, else those that hold a particle let free in the last substep (`was_free`). Only
+/// unbounded motion can carry a triangle through another, and every particle that moves is bounded
+/// (contactBounded) but those of triangles that already cross.
+SIM_INLINE bool crossingChecked(bool all, bool was_free) { return all || was_free; }
 
 #endif

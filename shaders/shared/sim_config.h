@@ -255,16 +255,13 @@
 // The GPU's contact grid: words of its header in SIM_BIND_CONTACT_GRID (x the bits of the longest
 // live edge's squared length, y 1 when a triangle crosses another, z the particles in contact, w 1
 // when the pair lists are built this substep, then 1 when the grid is built this substep and 1 when a
-// list overflowed in this substep's build, 1 when the grab's triangles are named for the crossing
-// check instead of the grid; from word 8 what contact_clear gathers: contactFrame's lo and hi as
-// orderedBits and the bits of `lowest`, the box of the particles' travel since the lists were
-// built as orderedBits, the grab's triangles named, their count then them, and the frame that
-// contact_bound works out from what was gathered), and
+// list overflowed in this substep's build; from word 8 what contact_clear gathers: contactFrame's
+// lo and hi as orderedBits and the bits of `lowest`, the box of the particles' travel since the
+// lists were built as orderedBits, and the frame that contact_bound works out from what was
+// gathered), and
 // the cells a box spans at most (cells as wide as the longest edge and the contact diameter, with
 // room to spare for rounding: two a side)
-#define SIM_CONTACT_HEADER 44u
-// The grab's triangles contact_clear names for contact_cross at most (more: the grid is built)
-#define SIM_CONTACT_NAMED_TRIANGLES 16u
+#define SIM_CONTACT_HEADER 24u
 #define SIM_CONTACT_CELLS_PER_BOX 8u
 #define SIM_CONTACT_CELL_ROOM 1.01f
 

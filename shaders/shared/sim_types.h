@@ -63,9 +63,9 @@ struct SimUniforms {
   // to the nearest primitive a particle may move in a substep (below 1/2), z the thickness (closer
   // pairs are pushed apart), w the fixed-point units of a push per unit of length (contactFixed)
   vec4 contact;
-  // Which triangles are checked for crossing the sheet (crossingChecked): x SIM_CONTACT_CHECK_*, y
-  // the particle the grab holds this tick, z the one it held the last tick (or SIM_NONE); w the GPU's
-  // pairs a contact query keeps in its list (at most SIM_CONTACT_LIST_CAPACITY)
+  // Which triangles are checked for crossing the sheet (crossingChecked): x SIM_CONTACT_CHECK_*; y
+  // and z unused (0); w the GPU's pairs a contact query keeps in its list (at most
+  // SIM_CONTACT_LIST_CAPACITY)
   uvec4 contact_check;
   // The GPU's contact grid (the solver fills it in): x the hash mask of each half, y the scratch offset of its
   // bucket counts (then starts), z of its bucket fills, w the sheet's edges (SIM_BIND_CONTACT_LISTS);

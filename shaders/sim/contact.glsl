@@ -27,13 +27,8 @@
 #define CONTACT_REBUILD 3u
 #define CONTACT_GRID 4u
 #define CONTACT_OVERFLOW 5u
-// 1 when the crossing check looks at the grab's triangles alone and the grid is not built for it:
-// contact_clear names them (their count, then them) and contact_cross looks at every triangle
-#define CONTACT_FEW 6u
-#define CONTACT_NAMED_COUNT 21u
-#define CONTACT_NAMED 22u
-// contactFrame's inputs, gathered by contact_clear: the bounded particles' last steps, lowest (3
-// words) and highest (3 words) as orderedBits, and the bits of their lowest start above the floor
+// contactFrame's inputs, gathered by contact_clear: every particle's last step, lowest (3 words)
+// and highest (3 words) as orderedBits, and the bits of their lowest start above the floor
 #define CONTACT_FRAME_LO 8u
 #define CONTACT_FRAME_HI 11u
 #define CONTACT_LOWEST 14u
@@ -42,7 +37,7 @@
 #define CONTACT_TRAVEL_LO 15u
 #define CONTACT_TRAVEL_HI 18u
 // The substep's frame (3 words, float bits): contact_bound works it out once for the floor's steps
-#define CONTACT_FRAME 38u
+#define CONTACT_FRAME 21u
 // Words of the lists' header (SIM_CONTACT_LIST_HEADER): the triangle count + 1 they were built for
 // (0: none stand), the bits of the radius, the builds so far
 #define LIST_KEY 0u
@@ -277,9 +272,8 @@ uvec2 bucketRange(ivec3 cell, bool edge) {
 // none stand, the triangles or the radius changed, the audit checks every triangle, or (`passes`:
 // the contact_* passes, not the fused tick) contact_emit did not name the queries of the last build
 // (the particles' travel outgrew them: contactTravelled after contact_clear), and the grid when they are, when a
-// list overflowed at the last build, or when crossingChecked may name many triangles: the audit or
-// a particle free in the last substep (a triangle crossed); the grab's triangles alone (now or the
-// last tick) are looked at without it (CONTACT_FEW)
+// list overflowed at the last build, or when crossingChecked names triangles: the audit or a
+// particle free in the last substep (a triangle crossed)
 void contactBegin(uint s, bool passes) {
   bool crossed = contact_words[CONTACT_TANGLED] != 0u;
   for (uint w = 0u; w < SIM_CONTACT_HEADER; ++w) contact_words[w] = 0u;
@@ -293,12 +287,8 @@ void contactBegin(uint s, bool passes) {
                contact_lists[listHeader() + LIST_RADIUS] == floatBitsToUint(u.contact.x) && !audit;
   // The passes walk the queries contact_emit named: lists the fused tick built are built again
   if (passes) stand = stand && contact_lists[listHeader() + LIST_NAMED] == contact_lists[listHeader() + LIST_BUILDS];
-  bool grab = u.contact_check.y != SIM_NONE || u.contact_check.z != SIM_NONE;
   if (!stand) contact_words[CONTACT_REBUILD] = 1u;
-  if (!stand || audit || crossed || contact_lists[listHeader() + LIST_SEARCH] != 0u)
-    contact_words[CONTACT_GRID] = 1u;
-  else if (grab)
-    contact_words[CONTACT_FEW] = 1u; // the grab's few triangles, against every triangle
+  if (!stand || audit || crossed || contact_lists[listHeader() + LIST_SEARCH] != 0u) contact_words[CONTACT_GRID] = 1u;
 }
 
 // Lowest (w = 0) or highest (w = 1) of a box contact_clear gathered at word w0 (orderedBits)
@@ -329,21 +319,19 @@ uint contactSlots() { return max(u.particle_count, contactEdgeCount()); }
 uint contactBucketSlots() { return 2u * (u.contact_grid.x + 1u) + 1u; }
 
 // contact_clear: particle k's start of the substep, its travel since the lists were built into the
-// box contactTravelled looks at, and when it is bounded its last step and height above the floor
-// into the frame's inputs; edge k's squared length raises the longest
+// box contactTravelled looks at, and its last step and height above the floor into the frame's
+// inputs; edge k's squared length raises the longest
 void contactClear(uint k) {
   if (k < u.particle_count) {
     float r = u.contact.x;
     vec4 x = SIM_POSITION(k);
-    if (x.w > 0.0f && k != u.contact_check.y) {
-      vec3 step = vec3(x) - vec3(prev[k]);
-      for (uint c = 0u; c < 3u; ++c) {
-        atomicMin(contact_words[CONTACT_FRAME_LO + c], orderedBits(step[c]));
-        atomicMax(contact_words[CONTACT_FRAME_HI + c], orderedBits(step[c]));
-      }
-      float height = x.y - u.floor_y;
-      atomicMin(contact_words[CONTACT_LOWEST], floatBitsToUint(height > 0.0f ? height : 0.0f));
+    vec3 step = vec3(x) - vec3(prev[k]);
+    for (uint c = 0u; c < 3u; ++c) {
+      atomicMin(contact_words[CONTACT_FRAME_LO + c], orderedBits(step[c]));
+      atomicMax(contact_words[CONTACT_FRAME_HI + c], orderedBits(step[c]));
     }
+    float height = x.y - u.floor_y;
+    atomicMin(contact_words[CONTACT_LOWEST], floatBitsToUint(height > 0.0f ? height : 0.0f));
     contact_particles[k].start = SIM_POSITION(k);
     // Free in the last substep: bit 1 (crossingChecked looks at its triangles again)
     contact_particles[k].state = uvec4(floatBitsToUint(r * r), (contact_particles[k].state.y & 1u) << 1, 0u, 0u);
@@ -353,15 +341,6 @@ void contactClear(uint k) {
       atomicMin(contact_words[CONTACT_TRAVEL_LO + c], orderedBits(d[c]));
       atomicMax(contact_words[CONTACT_TRAVEL_HI + c], orderedBits(d[c]));
     }
-  }
-  // The grab's triangles, named for contact_cross (a sheet's triangles are fewer than its edges)
-  if (contact_words[CONTACT_FEW] != 0u && k < counters.triangle_count &&
-      crossingChecked(false, triangles[k].xyz, u.contact_check.y, u.contact_check.z, false)) {
-    uint slot = atomicAdd(contact_words[CONTACT_NAMED_COUNT], 1u);
-    if (slot < SIM_CONTACT_NAMED_TRIANGLES)
-      contact_words[CONTACT_NAMED + slot] = k;
-    else
-      atomicOr(contact_words[CONTACT_GRID], 1u); // too many: the grid after all
   }
   if (k < contactEdgeCount() && contactEdgeLive(k)) {
     uvec2 edge = contactEdge(k).xy;
@@ -383,10 +362,9 @@ void contactArm() {
         built ? hash_args[SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES + k] : uvec4(0u, 1u, 1u, 0u);
   // contact_walk: the queries with pairs at the last build, unless the lists are built now
   hash_args[SIM_CONTACT_WALK_ARGS] = listsRebuilt() ? uvec4(0u, 1u, 1u, 0u) : hash_args[SIM_CONTACT_WALK_ARGS + 1u];
-  // contact_cross: every triangle when the grid is built or the grab's triangles are named
-  bool cross = built || contact_words[CONTACT_FEW] != 0u;
+  // contact_cross: every triangle when the grid is built
   hash_args[SIM_CONTACT_CROSS_ARGS] =
-      cross ? uvec4(groupGrid((u.triangle_count + SIM_WG_PARTICLES - 1u) / SIM_WG_PARTICLES), 1u, 0u)
+      built ? uvec4(groupGrid((u.triangle_count + SIM_WG_PARTICLES - 1u) / SIM_WG_PARTICLES), 1u, 0u)
             : uvec4(0u, 1u, 1u, 0u);
 }
 
@@ -400,30 +378,15 @@ void contactGridClear(uint k) {
 
 // contact_cross: live triangle slot t in substep s. With the grid built: when crossingChecked names
 // t, against every triangle whose box meets its box (once: in the cell of the low corner of the
-// boxes' overlap, which both boxes span). With the grab's triangles named instead (CONTACT_FEW):
-// t against each of them whose box meets its box. The same pairs either way; the particles of two
-// that cross go free.
+// boxes' overlap, which both boxes span); the particles of two that cross go free.
 void contactCross(uint t, uint s) {
   if (t >= counters.triangle_count || contactGoneWrong()) return;
   vec3 lo, hi;
-  if (!gridBuilt()) {
-    if (contact_words[CONTACT_FEW] == 0u) return;
-    contactBox(t, lo, hi);
-    // Those whose boxes meet first, then those weighed: a CPU device runs the costly test once a
-    // meeting pair, not once a named triangle
-    uint named = min(contact_words[CONTACT_NAMED_COUNT], SIM_CONTACT_NAMED_TRIANGLES), meet = 0u;
-    for (uint j = 0u; j < named; ++j) {
-      vec3 clo, chi;
-      contactBox(contact_words[CONTACT_NAMED + j], clo, chi);
-      if (boxesMeet(clo, chi, lo, hi)) meet |= 1u << j;
-    }
-    for (; meet != 0u; meet &= meet - 1u) visitCrossing(contact_words[CONTACT_NAMED + uint(findLSB(meet))], t);
-    return;
-  }
+  if (!gridBuilt()) return;
   uvec4 tri = triangles[t];
   uint was = contact_particles[tri.x].state.y | contact_particles[tri.y].state.y | contact_particles[tri.z].state.y;
   bool all = s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u;
-  if (!crossingChecked(all, tri.xyz, u.contact_check.y, u.contact_check.z, (was & 2u) != 0u)) return;
+  if (!crossingChecked(all, (was & 2u) != 0u)) return;
   loadBox(t, lo, hi);
   float inv = contactInvCell();
   ivec3 a = cellOf(lo, inv), b = min(cellOf(hi, inv), a + ivec3(4)), cell = a;
@@ -605,7 +568,7 @@ void contactBound(uint i) {
   }
   if (i == 0u) {
     // The substep's frame, once (contactFrameNow)
-    bool none = contact_words[CONTACT_FRAME_LO] > contact_words[CONTACT_FRAME_HI]; // no particle bounded
+    bool none = contact_words[CONTACT_FRAME_LO] > contact_words[CONTACT_FRAME_HI]; // no particles
     vec3 t = none ? vec3(0.0f)
                   : contactFrame(gatheredCorner(CONTACT_FRAME_LO), gatheredCorner(CONTACT_FRAME_HI),
                                  uintBitsToFloat(contact_words[CONTACT_LOWEST]));

@@ -12,9 +12,7 @@ void main() {
   uint i = threadIndex();
   if (i >= p.count) return;
   VerletState st = floorContact(pos[i], prev[i], u.floor_y, u.restitution, u.friction);
-  // The grab puts its particle where the user says: not bounded
-  bool placed = u.grab_target[p.substep].w > 0.5f && i == u.grab_index;
-  if (u.contact.x > 0.0f && st.position.w > 0.0f && !placed)
+  if (u.contact.x > 0.0f && contactBounded(st.position.w, i == u.grab_index, u.grab_target[p.substep].w))
     st = contactStep(st, vec3(contact_particles[i].start), vec3(contact_particles[i].push),
                      contact_particles[i].start.w, contactFrameNow());
   pos[i] = st.position;

@@ -256,8 +256,7 @@ void main() {
     for (uint i = lid; i < n; i += kInvocations) {
       VerletState st = floorContact(s_pos[i], prev[i], u.floor_y, u.restitution, u.friction);
 #ifdef SIM_FUSED_CONTACT
-      bool placed = u.grab_target[s].w > 0.5f && i == u.grab_index; // the grab is not bounded
-      if (u.contact.x > 0.0f && st.position.w > 0.0f && !placed)
+      if (u.contact.x > 0.0f && contactBounded(st.position.w, i == u.grab_index, u.grab_target[s].w))
         st = contactStep(st, vec3(contact_particles[i].start), vec3(contact_particles[i].push),
                          contact_particles[i].start.w, contactFrameNow());
 #endif

@@ -69,7 +69,7 @@ void Simulation::rebuild(const SimParams& p) {
   solver_.upload(topo_);
   wind_ = params_.wind;
   pins_ = params_.pins != PinMode::None;
-  grab_index_ = release_index_ = contact_grab_last_ = SIM_NONE;
+  grab_index_ = release_index_ = SIM_NONE;
   contact_on_last_ = false;
   reset_frame_ = 0;
   physics_ticks_ = 0;
@@ -176,7 +176,7 @@ void Simulation::squeeze(float closure) {
 }
 
 void Simulation::reset() {
-  grab_index_ = release_index_ = contact_grab_last_ = SIM_NONE;
+  grab_index_ = release_index_ = SIM_NONE;
   contact_on_last_ = false;
   closure_ = 0.0f;
   pins_ = params_.pins != PinMode::None; // the start: pinned as the preset is
@@ -275,10 +275,9 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   }
   // Every triangle is checked for crossing the sheet in the first substep of a tick when contact
   // starts (a new sheet, a reset, the key turned on) and once every SIM_CONTACT_AUDIT_TICKS ticks;
-  // otherwise those the grab moves and those already crossing (crossingChecked in contact.h)
+  // otherwise those already crossing (crossingChecked in contact.h)
   const bool audit = !contact_on_last_ || physics_ticks_ % SIM_CONTACT_AUDIT_TICKS == 0;
-  if (u.contact.x > 0.0f)
-    u.contact_check = glm::uvec4(audit ? SIM_CONTACT_CHECK_ALL : 0u, u.grab_index, contact_grab_last_, 0u);
+  if (u.contact.x > 0.0f) u.contact_check = glm::uvec4(audit ? SIM_CONTACT_CHECK_ALL : 0u, 0u, 0u, 0u);
   return u;
 }
 
@@ -286,7 +285,6 @@ void Simulation::runPhysicsTick() {
   last_uniforms_ = makeUniforms();
   solver_.tick(last_uniforms_);
   ++physics_ticks_;
-  contact_grab_last_ = last_uniforms_.grab_index;
   contact_on_last_ = last_uniforms_.contact.x > 0.0f;
   release_index_ = SIM_NONE;
   if (grab_index_ != SIM_NONE) {

@@ -131,9 +131,8 @@ private:
   glm::vec3 release_velocity_{0.0f};
   uint32_t reset_frame_ = 0; ///< frames left in the animated reset
   uint64_t frame_ = 0, physics_ticks_ = 0;
-  // Contact (SimUniforms::contact_check): the particle the grab held at the last physics tick, and
-  // whether that tick had contact on (off: the next one checks every triangle for crossing)
-  uint32_t contact_grab_last_ = SIM_NONE;
+  // Contact (SimUniforms::contact_check): whether the last physics tick had contact on (off: the
+  // next one checks every triangle for crossing)
   bool contact_on_last_ = false;
   uint32_t grabs_ = 0;
   double accumulator_ = 0.0;

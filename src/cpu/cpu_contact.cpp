@@ -92,8 +92,8 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   bound.resize(n);
   push.resize(n);
   // What the GPU's contact_clear gathers, in orderedBits (the same bits in any order): the frame's
-  // inputs (the bounded particles' last steps, lowest and highest, and their lowest start above the
-  // floor) and the box of every particle's travel since the lists were built
+  // inputs (every particle's last step, lowest and highest, and their lowest start above the floor)
+  // and the box of every particle's travel since the lists were built
   struct Gathered {
     glm::uvec3 lo{~0u}, hi{0u}, travel_lo{~0u}, travel_hi{0u};
     uint32_t lowest = std::bit_cast<uint32_t>(INFINITY);
@@ -104,17 +104,14 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
     Gathered g;
     for (uint32_t i = begin; i < end; ++i) {
       const vec3 step = vec3(pos[i]) - vec3(prev[i]), d = based ? vec3(pos[i]) - vec3(base_[i]) : vec3(0.0f);
-      const bool bounded = pos[i].w > 0.0f && i != u.contact_check.y;
       for (int c = 0; c < 3; ++c) {
-        if (bounded) {
-          g.lo[c] = std::min(g.lo[c], orderedBits(step[c]));
-          g.hi[c] = std::max(g.hi[c], orderedBits(step[c]));
-        }
+        g.lo[c] = std::min(g.lo[c], orderedBits(step[c]));
+        g.hi[c] = std::max(g.hi[c], orderedBits(step[c]));
         g.travel_lo[c] = std::min(g.travel_lo[c], orderedBits(d[c]));
         g.travel_hi[c] = std::max(g.travel_hi[c], orderedBits(d[c]));
       }
       const float height = pos[i].y - u.floor_y;
-      if (bounded) g.lowest = std::min(g.lowest, std::bit_cast<uint32_t>(height > 0.0f ? height : 0.0f));
+      g.lowest = std::min(g.lowest, std::bit_cast<uint32_t>(height > 0.0f ? height : 0.0f));
     }
     const std::lock_guard<std::mutex> lock(merge);
     all.lo = glm::min(all.lo, g.lo);
@@ -145,8 +142,7 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
                      !listsOutgrown(orderedCorner(all.travel_lo), orderedCorner(all.travel_hi), radius);
   if (!fresh) buildLists(pos, triangles, count, radius);
   sums_.assign(n, glm::ivec4(0));
-  findCrossings(pos, triangles, count, s == 0 && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u, u.contact_check.y,
-                u.contact_check.z, thickness, scale);
+  findCrossings(pos, triangles, count, s == 0 && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u, thickness, scale);
   const uint32_t none = std::bit_cast<uint32_t>(r2);
   nearest2_.assign(n, lists_ ? none : 0u); // positions gone wrong (no lists): nothing moves
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
@@ -189,11 +185,11 @@ void CpuContact::addPush(uint32_t i, vec3 push, float scale) {
 }
 
 void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
-                               bool all, uint32_t grab_now, uint32_t grab_last, float gap, float scale) {
-  // Where the sheet already crosses itself (the user forced it through: the grab is not bounded;
-  // or it started so), no bound can undo it and bounds would hold it there: the particles of the
-  // triangles that cross another go free until it untangles. Only what moved unbounded can have
-  // crossed the sheet: the triangles crossingChecked names are tested against every triangle
+                               bool all, float gap, float scale) {
+  // Where the sheet already crosses itself (contact turned on in a sheet that crossed itself, or
+  // a state that started so), no bound can undo it and bounds would hold it there: the particles
+  // of the triangles that cross another go free until it untangles. Only what moved unbounded can
+  // have crossed the sheet: the triangles crossingChecked names are tested against every triangle
   // whose box meets theirs.
   const uint32_t n = uint32_t(pos.size());
   was_free_.swap(free_);
@@ -204,9 +200,7 @@ void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vec
   if (!lists_) return; // positions gone wrong: nothing is looked for (nothing moves)
   for (uint32_t t = 0; t < count; ++t) {
     const uvec4 tri = triangles[t];
-    if (crossingChecked(all, uvec3(tri), grab_now, grab_last,
-                        (was_free_[tri.x] | was_free_[tri.y] | was_free_[tri.z]) != 0))
-      checked_.push_back(t);
+    if (crossingChecked(all, (was_free_[tri.x] | was_free_[tri.y] | was_free_[tri.z]) != 0)) checked_.push_back(t);
   }
   if (checked_.empty()) return;
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
@@ -247,7 +241,7 @@ void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vec
       }
     });
   } else {
-    // A few (the grab's): against every triangle
+    // A few: against every triangle
     for (uint32_t t : checked_)
       for (uint32_t o = 0; o < count; ++o) {
         const vec3 lo = lo_[t], hi = hi_[t], elo = lo_[o], ehi = hi_[o];

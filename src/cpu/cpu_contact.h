@@ -62,7 +62,7 @@ private:
   /// the triangles crossingChecked names (contact.h), and adds each crossing pair's untanglePush to
   /// the sums (`gap`: how far beyond, `scale`: their fixed point); the last call's free_ is was_free_.
   void findCrossings(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
-                     bool all, uint32_t grab_now, uint32_t grab_last, float gap, float scale);
+                     bool all, float gap, float scale);
   /// Lists the particle-triangle and edge-edge pairs closer than contactReach at `pos`.
   void buildLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                   float radius);

@@ -196,14 +196,13 @@ void CpuSolver::repelPass(const SimUniforms& u) {
 
 void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
   const bool contact = u.contact.x > 0.0f;
-  const bool placed = u.grab_target[s].w > 0.5f; // the grabbed particle goes where the user puts it
   const vec3 frame = contact ? contact_.frame() : vec3(0.0f);
   pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
     vec4* pos = pos_.data();
     vec4* prev = prev_.data();
     for (uint32_t i = begin; i < end; ++i) {
       VerletState st = floorContact(pos[i], prev[i], u.floor_y, u.restitution, u.friction);
-      if (contact && st.position.w > 0.0f && !(placed && i == u.grab_index))
+      if (contact && contactBounded(st.position.w, i == u.grab_index, u.grab_target[s].w))
         st = contactStep(st, vec3(start_[i]), vec3(push_[i]), bound_[i], frame);
       pos[i] = st.position;
       prev[i] = st.previous;

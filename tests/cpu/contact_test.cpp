@@ -126,8 +126,10 @@ SimParams flatCrumple(bool contact, std::vector<std::string> sets = {}) {
   return p;
 }
 
-/// The most intersecting pairs of triangles seen every `every` ticks of `ticks` ticks of `text`.
-uint64_t mostPairs(const SimParams& p, const std::string& text, int ticks, int every, uint32_t threads = 2) {
+/// The most intersecting pairs of triangles seen every `every` ticks of `ticks` ticks of `text`
+/// (and in `torn`, when given, the constraints torn at the end).
+uint64_t mostPairs(const SimParams& p, const std::string& text, int ticks, int every, uint32_t threads = 2,
+                   uint32_t* torn = nullptr) {
   CpuOptions o;
   o.threads = threads;
   CpuSolver solver(o);
@@ -137,32 +139,33 @@ uint64_t mostPairs(const SimParams& p, const std::string& text, int ticks, int e
   for (int t = 0; t < ticks; t += every) {
     const SimState s = run(sim, every);
     most = std::max(most, intersectingPairs(s.pos, s.triangles, s.triangle_count).pairs);
+    if (torn) *torn = tornCount(s);
   }
   return most;
 }
 
 /// Where the hand of the fast crumple is at tick t (1 to 39): the middle of the flat sheet is
 /// snatched up (a third of the sheet's length in a twelfth of a second) as the hand closes, then
-/// swung round in circles.
-vec3 fastCrumpleHand(const SimParams& p, const SimState& flat, int t) {
+/// swung round in circles; `pace` times as fast (the path of tick t x pace at tick t).
+vec3 fastCrumpleHand(const SimParams& p, const SimState& flat, int t, float pace = 1.0f) {
   const vec3 m(flat.pos[(p.rows / 2) * p.cols + p.cols / 2]);
-  const float length = float(p.rows - 1) * p.spacing;
-  if (t <= 5) return vec3(m.x, m.y + length * 0.07f * float(t), m.z);
-  const float a = 0.35f * float(t - 6);
+  const float length = float(p.rows - 1) * p.spacing, at = float(t) * pace;
+  if (at <= 5.0f) return vec3(m.x, m.y + length * 0.07f * at, m.z);
+  const float a = 0.35f * (at - 6.0f);
   return vec3(m.x + 0.14f * length * std::cos(a), m.y + length * (0.35f - 0.09f * std::sin(a)),
               m.z + 0.14f * length * std::sin(a));
 }
 
 /// A crumple at a hand's speed (fastCrumpleHand), let go at tick 40.
-std::string fastCrumple(const SimParams& p, const SimState& flat) {
+std::string fastCrumple(const SimParams& p, const SimState& flat, float pace = 1.0f) {
   std::string text = "0 grab particle " + std::to_string((p.rows / 2) * p.cols + p.cols / 2) + "\n";
   char line[160];
   for (int t = 1; t < 40; ++t) {
-    const vec3 q = fastCrumpleHand(p, flat, t);
+    const vec3 q = fastCrumpleHand(p, flat, t, pace);
     std::snprintf(line, sizeof(line), "%d move %.6f %.6f %.6f\n", t, q.x, q.y, q.z);
     text += line;
-    if (t <= 5) {
-      std::snprintf(line, sizeof(line), "%d squeeze %.6f\n", t, 0.2f * float(t));
+    if (float(t) * pace <= 5.0f) {
+      std::snprintf(line, sizeof(line), "%d squeeze %.6f\n", t, std::min(0.2f * float(t) * pace, 1.0f));
       text += line;
     }
   }
@@ -177,18 +180,32 @@ SimState flatState() {
 }
 
 /// Expects the script `text` to pass the flat sheet through itself with the particle repulsion
-/// alone (the scene is a real test) and never with contact, judged every 5 ticks.
-void expectContactHolds(const char* scene, const std::string& text, int ticks) {
+/// alone (the scene is a real test) and never with contact, judged every 5 ticks. Returns the
+/// constraints torn at the end with contact.
+uint32_t expectContactHolds(const char* scene, const std::string& text, int ticks) {
+  uint32_t torn = 0;
   const uint64_t without = mostPairs(flatCrumple(false), text, ticks, 5);
-  const uint64_t with = mostPairs(flatCrumple(true), text, ticks, 5);
-  std::printf("%s: %llu intersecting pairs at most without contact, %llu with\n", scene, (unsigned long long)without,
-              (unsigned long long)with);
+  const uint64_t with = mostPairs(flatCrumple(true), text, ticks, 5, 2, &torn);
+  std::printf("%s: %llu intersecting pairs at most without contact, %llu with (%u torn)\n", scene,
+              (unsigned long long)without, (unsigned long long)with, torn);
   EXPECT_GT(without, 0u) << scene;
   EXPECT_EQ(with, 0u) << scene;
+  return torn;
 }
 
 TEST(Contact, AFastCrumpleNeverPassesTheSheetThroughItself) {
   expectContactHolds("fast crumple", fastCrumple(flatCrumple(true), flatState()), 80);
+}
+
+TEST(Contact, NoHandIsFastEnoughToPassTheSheetThroughItself) {
+  // The fast crumple with the hand twice as fast (73 units/s, the crumple sheet's length 34 times a
+  // second), judged every tick: the grab is bounded like every particle (contactBounded), so it
+  // falls behind such a hand instead of carrying its triangles through the layers it meets
+  const SimParams p = flatCrumple(true);
+  const std::string text = fastCrumple(p, flatState(), 2.0f);
+  const uint64_t with = mostPairs(p, text, 60, 1);
+  std::printf("fast crumple at twice the pace: %llu intersecting pairs at most\n", (unsigned long long)with);
+  EXPECT_EQ(with, 0u);
 }
 
 /// The fastest particle but the held one in the fast crumple of `p`, while the hand moves (ticks
@@ -245,7 +262,6 @@ TEST(Contact, AFastCrumpleLeftOnTheFloorStaysApartAndComesToRest) {
               (unsigned long long)most, tornCount(s), double(speed), double(with.moving), double(without.moving),
               double(with.let_go), double(without.let_go), double(hand));
   EXPECT_EQ(most, 0u);
-  EXPECT_GT(tornCount(s), 0u);
   EXPECT_LE(with.moving, without.moving);
   EXPECT_LE(with.let_go, hand);
   EXPECT_LT(speed, 0.5f);
@@ -319,7 +335,8 @@ TEST(Contact, AFastFoldAndAYankNeverPassTheSheetThroughItself) {
     text += line;
   }
   text += "41 release\n";
-  expectContactHolds("fold and yank", text, 90);
+  // Torn triangles stop colliding at once: the layers still never cross
+  EXPECT_GT(expectContactHolds("fold and yank", text, 90), 0u);
 }
 
 TEST(Contact, TheHandCrumplesItIntoABallWithoutPassingItThroughItself) {
