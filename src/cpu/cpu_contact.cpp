@@ -31,11 +31,12 @@ void lower(uint32_t& slot, float d2) {
   }
 }
 
-/// Calls f(entry) once for each entry of `grid` whose box overlaps the box [lo, hi]: in the cell
-/// that holds the lowest corner of the two boxes' overlap (both boxes are in that cell).
+/// Calls f(entry) once for each entry of `grid` from `first` on whose box overlaps the box [lo,
+/// hi]: in the cell that holds the lowest corner of the two boxes' overlap (both boxes are in that
+/// cell).
 template <typename Grid, typename F>
 void visitBox(const Grid& grid, const std::vector<vec3>& lows, const std::vector<vec3>& highs, vec3 lo, vec3 hi,
-              float inv_cell, F&& f) {
+              float inv_cell, uint32_t first, F&& f) {
   const ivec3 a = cellOf(lo, inv_cell), b = cellOf(hi, inv_cell);
   for (int z = a.z; z <= b.z; ++z)
     for (int y = a.y; y <= b.y; ++y)
@@ -44,6 +45,7 @@ void visitBox(const Grid& grid, const std::vector<vec3>& lows, const std::vector
         const uint32_t h = hashCell(cell, grid.mask);
         for (uint32_t k = grid.start[h]; k < grid.start[h + 1]; ++k) {
           const uint32_t e = grid.entry[k];
+          if (e < first) continue;
           const vec3 elo = lows[e], ehi = highs[e];
           if (!(lo.x <= ehi.x && elo.x <= hi.x && lo.y <= ehi.y && elo.y <= hi.y && lo.z <= ehi.z && elo.z <= hi.z))
             continue;
@@ -237,7 +239,7 @@ void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vec
     pool_.parallelFor(checked, kGrainCollide, [&](uint32_t begin, uint32_t end) {
       for (uint32_t k = begin; k < end; ++k) {
         const uint32_t t = checked_[k];
-        visitBox(grid_, lo_, hi_, lo_[t], hi_[t], inv_cell, [&](uint32_t o) { test(t, o); });
+        visitBox(grid_, lo_, hi_, lo_[t], hi_[t], inv_cell, 0, [&](uint32_t o) { test(t, o); });
       }
     });
   } else {
@@ -292,7 +294,7 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
     std::vector<uvec4> found;
     for (uint32_t v = begin; v < end; ++v) {
       const vec3 p = at(v), plo = p - vec3(reach), phi = p + vec3(reach);
-      visitBox(grid_, lo_, hi_, plo, phi, inv_cell, [&](uint32_t t) {
+      visitBox(grid_, lo_, hi_, plo, phi, inv_cell, 0, [&](uint32_t t) {
         const uvec4 tri = triangles[t];
         if (v == tri.x || v == tri.y || v == tri.z) return;
         if (pointTriangleDistance2(p, at(tri.x), at(tri.y), at(tri.z)) < reach2)
@@ -316,8 +318,7 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
     for (uint32_t k = begin; k < end; ++k) {
       const uvec2 e = edges_[k];
       const vec3 elo = lo_[k] - vec3(reach), ehi = hi_[k] + vec3(reach);
-      visitBox(grid_, lo_, hi_, elo, ehi, inv_cell, [&](uint32_t j) {
-        if (j <= k) return;
+      visitBox(grid_, lo_, hi_, elo, ehi, inv_cell, k + 1, [&](uint32_t j) {
         const uvec2 f = edges_[j];
         if (f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
         if (segmentDistance2(at(e.x), at(e.y), at(f.x), at(f.y)) < reach2) found.push_back(uvec4(e, f));
