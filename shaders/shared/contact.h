@@ -21,8 +21,8 @@
 // largest difference of its particles' displacements, so a translation t common to every particle
 // can be taken out of each step first: no particle ends farther than b(v) from its start + t
 // (contactFrame picks t from how the sheet moved in the last substep: the motion every particle
-// shares, none while one rests, a pinned one included). A sheet falling or flying as a whole is not held back, and with
-// every start + t above the floor the floor stays out of the way.
+// shares, none while one rests, a pinned one included). A sheet falling or flying as a whole is not
+// held back, and with every start + t above the floor the floor stays out of the way.
 // Floats round: stepBound takes a margin m, far above the rounding, off d, so pairs close in on
 // m and stop there. The push that parts pairs closer than the thickness moves a particle on top of
 // its bound, by at most SIM_CONTACT_PUSH_FRACTION x d(v) (contactPushWithin): with
