@@ -25,8 +25,8 @@ constexpr float kHandPullSeconds = 0.25f, kHandGripSeconds = 0.1f;
 
 /// With contact on, the most a grab's target moves in a substep, as a share of the contact's
 /// bound on a free particle's step (SIM_CONTACT_FRACTION x the contact radius): a faster hand
-/// ticks in more substeps (Simulation::tickParams), so that the particles around the grab, whose
-/// steps the bound caps, keep up with it instead of letting it stretch the sheet.
+/// ticks in more substeps (Simulation::tickParams), so that the grab and the particles around it,
+/// whose steps the bound caps (contactBounded), keep up with the hand instead of falling behind.
 constexpr float kHandBoundShare = 0.4f;
 
 class Simulation {
