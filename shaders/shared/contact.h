@@ -25,8 +25,14 @@
 // held back, and with every start + t above the floor the floor stays out of the way.
 // Floats round: stepBound takes a margin m, far above the rounding, off d, so pairs close in on
 // m and stop there. The push that parts pairs closer than the thickness moves a particle on top of
-// its bound, by at most SIM_CONTACT_PUSH_FRACTION x d(v) (contactPushWithin): with
-// fraction (d - m) + 0.1 d on either side, a pair d apart keeps d - 2 (0.5 d - 0.4 m) = 0.8 m.
+// its bound, by at most SIM_CONTACT_PUSH_FRACTION x (d(v) - m/2) (contactPushWithin). A particle's
+// push is the mean of all its pairs' pushes, so it may carry the particle towards a primitive other
+// than the one a pair parts it from; the push's own margin keeps that from closing a pair substep
+// after substep: with 0.4 (d - m) + 0.1 (d - m/2) on either side a pair d >= m apart keeps 0.9 m,
+// one between m/2 and m moves 0.1 (d - m/2) a side at most and keeps 0.8 d + 0.1 m >= m/2, and
+// one closer than m/2 (only a sheet that starts so) does not move. No pair ends a substep closer
+// than the least of its distance at the start and m/2. (A push cut to 0.1 d alone let a pair
+// pressed below m close by a fifth each substep, towards touching.)
 #ifndef SIM_CONTACT_H
 #define SIM_CONTACT_H
 #include "exact_math.h"
@@ -155,10 +161,12 @@ SIM_INLINE float stepBound(float nearest2, float radius, float fraction) {
 }
 
 /// A particle's push (contactAverage) cut to SIM_CONTACT_PUSH_FRACTION of the distance to its
-/// nearest primitive, sqrt(nearest2): it moves the particle on top of its bound (contactStep), and
-/// with the bounds' fraction below 1/2 leaves every pair 0.8 x the margin apart at least.
-SIM_INLINE vec3 contactPushWithin(vec3 push, float nearest2) {
-  float most = SIM_CONTACT_PUSH_FRACTION * simSqrt(nearest2), l2 = dot3(push, push);
+/// nearest primitive, sqrt(nearest2), less half the margin of contact radius `radius`: it moves the
+/// particle on top of its bound (contactStep), and with the bounds' fraction below 1/2 no pair
+/// ends a substep closer than the least of its distance at the start and half the margin.
+SIM_INLINE vec3 contactPushWithin(vec3 push, float nearest2, float radius) {
+  float most = SIM_CONTACT_PUSH_FRACTION * max(simSqrt(nearest2) - 0.5f * SIM_CONTACT_MARGIN * radius, 0.0f);
+  float l2 = dot3(push, push);
   return l2 > most * most ? push * simDiv(most, simSqrt(l2)) : push;
 }
 

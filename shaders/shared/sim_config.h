@@ -230,8 +230,9 @@
 // The least distance of two primitives, per unit of contact radius: far above the rounding of the
 // positions, so that the bound of a step (stepBound in contact.h) holds in floats
 #define SIM_CONTACT_MARGIN 1e-3f
-// The part of the distance to its nearest primitive the push may move a particle on top of its
-// bound (contactPushWithin): two sides moving 0.4 (d - m) + 0.1 d each keep 0.8 m between them
+// The part of the distance to its nearest primitive, less half the margin, the push may move a
+// particle on top of its bound (contactPushWithin): two sides moving 0.4 (d - m) + 0.1 (d - m/2)
+// each keep 0.9 m between them, and no pair closes below m/2
 #define SIM_CONTACT_PUSH_FRACTION 0.1f
 // The thickness of the contact, per unit of contact radius: closer pairs are pushed apart
 #define SIM_CONTACT_THICKNESS 0.5f

@@ -580,8 +580,9 @@ void contactBound(uint i) {
   if (nearest < floatBitsToUint(r * r)) atomicAdd(contact_words[CONTACT_COUNT], 1u);
   contact_particles[i].start.w =
       contactFree(i) ? uintBitsToFloat(0x7F800000u) : stepBound(uintBitsToFloat(nearest), r, u.contact.y);
-  contact_particles[i].push = vec4(
-      contactPushWithin(contactAverage(ivec4(contact_particles[i].sum), u.contact.w), uintBitsToFloat(nearest)), 0.0f);
+  contact_particles[i].push =
+      vec4(contactPushWithin(contactAverage(ivec4(contact_particles[i].sum), u.contact.w), uintBitsToFloat(nearest), r),
+           0.0f);
 }
 
 #endif

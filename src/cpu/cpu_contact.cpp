@@ -174,7 +174,8 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   for (uint32_t i = 0; i < n; ++i) {
     contacts += nearest2_[i] < none ? 1u : 0u;
     bound[i] = free_[i] ? INFINITY : stepBound(std::bit_cast<float>(nearest2_[i]), radius, u.contact.y);
-    push[i] = glm::vec4(contactPushWithin(contactAverage(sums_[i], scale), std::bit_cast<float>(nearest2_[i])), 0.0f);
+    push[i] =
+        glm::vec4(contactPushWithin(contactAverage(sums_[i], scale), std::bit_cast<float>(nearest2_[i]), radius), 0.0f);
   }
   contacts_ = contacts;
 }
