@@ -22,13 +22,7 @@ import os
 import sys
 
 import tender
-
-
-def number(text):
-    try:
-        return float(text)
-    except ValueError:
-        return text
+from stretch import number  # bench/stretch.py, beside this script
 
 
 class Scene:
