@@ -105,7 +105,7 @@ TEST(ContactDistance, ABoundedStepGoesNoFartherThanItsBound) {
     EXPECT_GT(glm::dot(y - x0, x - x0), 0.0f);
   }
   // The bound is the fraction of the distance less the margin; within the margin, nothing: a pair
-  // pressed together stops, and its push, at most a tenth of the distance, parts it
+  // pressed together stops, and its push, at most a tenth of the distance less half the margin, parts it
   EXPECT_NEAR(shaderio::stepBound(0.25f, 1.0f, 0.4f), 0.4f * (0.5f - SIM_CONTACT_MARGIN), 1e-7f);
   EXPECT_EQ(shaderio::stepBound(1e-8f, 1.0f, 0.4f), 0.0f);
   // The push: a tenth of the distance less half the margin (1e-3 - 5e-5 for a radius of 0.1)
