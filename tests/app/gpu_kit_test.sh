@@ -44,7 +44,8 @@ scrubbed=(env -i PATH=/usr/bin:/bin HOME="$tmp" VK_DRIVER_FILES="$DRIVER")
 
 # gpu-check --quick from the copy, in a scrubbed environment.
 start=$(date +%s)
-"${scrubbed[@]}" "$kit/gpu-check" --quick --out "$tmp/report" >"$tmp/check.out" 2>&1
+# Two shards: the tests' logs are gathered from two processes (one on a 2-core machine otherwise).
+"${scrubbed[@]}" "$kit/gpu-check" --quick --shards 2 --out "$tmp/report" >"$tmp/check.out" 2>&1
 rc=$?
 echo "gpu-check --quick: exit $rc in $(($(date +%s) - start)) s"
 report=$tmp/report/report.md
@@ -62,6 +63,10 @@ if [ -f "$report" ]; then
     grep -q "^| $check | .* | pass | " "$report" || fail "report.md: check $check did not pass or is missing"
   done
   grep -q '^\*\*PASS\*\*' "$report" || fail "report.md does not say PASS"
+  # The shards' counts add up to the whole binary's.
+  render_count=$("${scrubbed[@]}" "$kit/bin/tender_render_tests" --gtest_list_tests | grep -c '^  ')
+  grep -q "^| render-tests | .* | $render_count tests, $render_count passed (2 processes) |" "$report" ||
+    fail "report.md: render-tests did not count $render_count tests from 2 processes"
   grep -q '^| dispatch cost | [0-9.]* us per empty dispatch' "$report" || fail "report.md has no dispatch cost"
   grep -q '^| 128x192 | 24576 | gpu-percolor | [0-9]' "$report" || fail "report.md has no benchmark table"
   [ -s "$tmp/report/bench.json" ] && [ -s "$tmp/report/bench.csv" ] || fail "no bench.json or bench.csv"
@@ -95,6 +100,8 @@ expect_usage --quick
 expect_usage --out
 expect_usage --bogus --out "$tmp/x"
 expect_usage --out /proc/version/x
+expect_usage --shards 0 --out "$tmp/x"
+expect_usage --shards many --out "$tmp/x"
 "$SRC/tools/gpu-bundle" >/dev/null 2>"$tmp/e"
 [ $? -eq 2 ] || fail "gpu-bundle without OUT_DIR should exit 2"
 "$SRC/tools/gpu-bundle" --build-dir "$tmp/nope" "$tmp/k2" >/dev/null 2>"$tmp/e"
