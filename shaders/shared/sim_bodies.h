@@ -92,6 +92,20 @@ SIM_INLINE bool edgeCut(uint a, uint b) {
   return !held && (t.x != SIM_NONE || t.y != SIM_NONE);
 }
 
+/// The shorten stage on constraint c, in the colour order of the projection (no two of a colour
+/// share a particle): a structural edge longer than the stretch limit is shortened to it from both
+/// ends (shortenEdge), unless it is stretched to its tear length (shouldTear), which it is left to.
+/// Runs only while limitShortens.
+SIM_INLINE void shortenConstraint(Constraint c) {
+  if ((c.kind_id & SIM_KIND_MASK) != SIM_KIND_STRUCTURAL) return;
+  vec4 limit = u.limit;
+  vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b);
+  if (shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return;
+  PairDelta d = shortenEdge(pa, pb, limit.x);
+  SIM_POSITION(c.a) = pa + vec4(d.da, 0.0f);
+  SIM_POSITION(c.b) = pb + vec4(d.db, 0.0f);
+}
+
 /// The stretch limit on particle i, in its ring of the limit from `root` (after the projection,
 /// ring after ring, so its parents have their places): a free particle farther than u.limit.x from
 /// a parent it is still joined to moves to the nearest point within that reach of its parents

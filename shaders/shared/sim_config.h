@@ -140,6 +140,9 @@
 #define SIM_GATE_CREASE 7u
 // SIM_GATE_LIMIT: the sheet has a stretch limit (limit)
 #define SIM_GATE_LIMIT 8u
+// SIM_GATE_SHORTEN: the sheet's limit shortens edges (limitShortens) and it has iteration
+// BatchArgs.gate_arg (shorten)
+#define SIM_GATE_SHORTEN 9u
 // Sheets per hardware thread that one dispatch of a fleet takes on a CPU device, which runs a
 // substep per dispatch: each thread keeps its sheet's arrays (under 1 MiB for 32 x 48) in its
 // cache through every substep before the next sheets start (lavapipe, 2 threads, 64 sheets of

@@ -48,6 +48,7 @@
   X(candidates_finish, SIM, 1, 1)                                                                                      \
   X(repel, SIM, 1, 1)                                                                                                  \
   X(project, SIM, 1, 1)                                                                                                \
+  X(shorten, SIM, 1, 1)                                                                                                \
   X(limit, SIM, 1, 1)                                                                                                  \
   X(crease, SIM, 1, 1)                                                                                                 \
   X(floor, SIM, 1, 1)                                                                                                  \
@@ -70,11 +71,12 @@
   X(integrate, 0u, ONCE, ALWAYS)                                                                                       \
   X(collide, 1u, ONCE, COLLISION)                                                                                      \
   X(project, 2u, COLOUR, ALWAYS)                                                                                       \
-  X(limit, 3u, ONCE, ALWAYS)                                                                                           \
-  X(crease, 4u, ONCE, ALWAYS)                                                                                          \
-  X(floor, 5u, ONCE, ALWAYS)                                                                                           \
-  X(tear, 6u, ONCE, ALWAYS)
-#define SIM_STAGE_COUNT 7u
+  X(shorten, 3u, COLOUR, ALWAYS)                                                                                       \
+  X(limit, 4u, ONCE, ALWAYS)                                                                                           \
+  X(crease, 5u, ONCE, ALWAYS)                                                                                          \
+  X(floor, 6u, ONCE, ALWAYS)                                                                                           \
+  X(tear, 7u, ONCE, ALWAYS)
+#define SIM_STAGE_COUNT 8u
 
 // The dispatches of each stage, in the order the per-colour path records them (a barrier after
 // each). The fused tick and the CPU run the same bodies in the same order.
@@ -101,7 +103,7 @@
 //             Compaction (the tear compaction's arguments): gpu::Grid
 //   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)
 //   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases), LIMIT
-//             (the sheet has a stretch limit),
+//             (the sheet has a stretch limit), SHORTEN (the limit shortens edges: limitShortens),
 //             CONSTRAINTS (the sheet has constraints) or CONTACT (contact is on: a sheet alone,
 //             or a fleet's sheet recorded on its own)
 //   category  its timestamp category (gpu::PassCategory k<category>)
@@ -132,6 +134,7 @@
   X(collide, candidates_finish, ONE, Threads, COLLISION, ALWAYS, Collide)                                              \
   X(collide, repel, PARTICLES, Threads, COLLISION, ALWAYS, Collide)                                                    \
   X(project, project, COLOUR, Threads, ITERATION, ALWAYS, Project)                                                     \
+  X(shorten, shorten, COLOUR, Threads, SHORTEN, SHORTEN, Project)                                                      \
   X(limit, limit, RINGS, Threads, LIMIT, LIMIT, Project)                                                               \
   X(crease, crease, HINGES, Threads, CREASE, CREASE, Project)                                                          \
   X(floor, floor, PARTICLES, Threads, TICK, ALWAYS, Floor)                                                             \

@@ -255,6 +255,37 @@ SIM_INLINE uvec2 limitParents(uint i, uint root, uint cols) {
   return uvec2(in_row, in_col);
 }
 
+/// True when the stretch limit first shortens the sheet's edges from both ends (the shorten stage)
+/// before its rings: nothing holds the sheet (no grab, no pins). The rings alone draw the sheet
+/// after their root, one-sidedly, and with no hand or pin to root them at, the free middle they
+/// root at keeps a crumpled ball moving: 1.8 to 3.5 units/s 8 s after a fast crumple
+/// (bench/README.md, "Why contact is not yet on").
+SIM_INLINE bool limitShortens(float reach, uint grab_index, uint flags) {
+  return reach > 0.0f && grab_index == SIM_NONE && (flags & SIM_FLAG_PINS) == 0u;
+}
+
+/// True when the shorten stage visits a colour whose first constraint is `kind_id`: hinges have
+/// colours of their own, and a hinge's colour holds no edge.
+SIM_INLINE bool shortensColour(uint kind_id) { return (kind_id & SIM_KIND_MASK) != SIM_KIND_HINGE; }
+
+/// An edge from pa to pb longer than `reach` shortened to it from both ends alike (an end that
+/// does not move, w = 0, leaves the whole to the other): a step, which the previous positions do
+/// not follow, so the speed it takes out of the stretch is gone.
+SIM_INLINE PairDelta shortenEdge(vec4 pa, vec4 pb, float reach) {
+  PairDelta r;
+  r.da = vec3(0.0f);
+  r.db = vec3(0.0f);
+  float wa = pa.w > 0.0f ? 1.0f : 0.0f, wb = pb.w > 0.0f ? 1.0f : 0.0f;
+  vec3 d = vec3(pb) - vec3(pa);
+  float len2 = dot3(d, d);
+  if (!(wa + wb > 0.0f) || !(len2 > reach * reach)) return r;
+  float len = simSqrt(len2);
+  vec3 c = d * simDiv(len - reach, len * (wa + wb));
+  r.da = c * wa;
+  r.db = -(c * wb);
+  return r;
+}
+
 /// True when c lies within `reach` of a.
 SIM_INLINE bool withinReach(vec3 c, vec3 a, float reach) {
   vec3 d = c - a;

@@ -133,6 +133,7 @@ void main() {
   uint per_substep = passesPerSubstep(u.iterations, u.color_count, collision);
   uint integrate_pass = stageFirstPass(SIM_STAGE_integrate, u.iterations, u.color_count, collision);
   uint project_pass = stageFirstPass(SIM_STAGE_project, u.iterations, u.color_count, collision);
+  uint shorten_pass = stageFirstPass(SIM_STAGE_shorten, u.iterations, u.color_count, collision);
   uint limit_pass = stageFirstPass(SIM_STAGE_limit, u.iterations, u.color_count, collision);
   uint crease_pass = stageFirstPass(SIM_STAGE_crease, u.iterations, u.color_count, collision);
   uint collide_pass = stageFirstPass(SIM_STAGE_collide, u.iterations, u.color_count, collision);
@@ -231,7 +232,22 @@ void main() {
           return;
         }
       }
-    // 4. The stretch limit (as limit.comp): ring after ring from the root
+    // 4. The shorten stage (as shorten.comp) while nothing holds the sheet: Gauss-Seidel over the
+    // colours with edges, a barrier after each
+    bool shortens = limitShortens(u.limit.x, u.grab_index, u.flags);
+    for (uint it = 0u; it < u.iterations; ++it)
+      for (uint c = 0u; c < u.color_count; ++c) {
+        uvec2 range = color_range[c];
+        if (shortens && range.y > 0u && shortensColour(constraints[range.x].kind_id)) {
+          for (uint t = lid; t < range.y; t += kInvocations) shortenConstraint(constraints[range.x + t]);
+          sync();
+        }
+        if (stopsAfter(first_pass + shorten_pass + it * u.color_count + c)) {
+          storePositions(n);
+          return;
+        }
+      }
+    // 5. The stretch limit (as limit.comp): ring after ring from the root
     if (u.limit.x > 0.0f) {
       uint root = limitRoot(u.grab_index, u.cols, u.rows), rings = limitRings(root, u.cols, u.rows);
       for (uint k = 1u; k <= rings; ++k) {
@@ -243,7 +259,7 @@ void main() {
       storePositions(n);
       return;
     }
-    // 5. The creases (as crease.comp)
+    // 6. The creases (as crease.comp)
     if (creasing(u.hinge.y, u.crease.y)) {
       for (uint k = lid; k < u.hinge.y; k += kInvocations) creaseHinge(k);
       sync();
@@ -252,7 +268,7 @@ void main() {
       storePositions(n);
       return;
     }
-    // 6. The floor (as floor.comp)
+    // 7. The floor (as floor.comp)
     for (uint i = lid; i < n; i += kInvocations) {
       VerletState st = floorContact(s_pos[i], prev[i], u.floor_y, u.restitution, u.friction);
 #ifdef SIM_FUSED_CONTACT
@@ -268,7 +284,7 @@ void main() {
       storePositions(n);
       return;
     }
-    // 7. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
+    // 8. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
     // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
     // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
     // substep it tore in removed it), and kinds that cannot tear skip the position loads.

@@ -265,6 +265,8 @@ bool batchGateTakes() {
     return creasing(u.hinge.y, u.crease.y);
   case SIM_GATE_LIMIT:
     return u.limit.x > 0.0f;
+  case SIM_GATE_SHORTEN:
+    return limitShortens(u.limit.x, u.grab_index, u.flags) && batch.gate_arg < u.iterations;
   default:
     return true;
   }

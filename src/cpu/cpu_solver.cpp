@@ -159,6 +159,32 @@ void CpuSolver::projectColors(const SimUniforms& u, uint32_t first, uint32_t cou
     });
 }
 
+void CpuSolver::shortenColors(const SimUniforms& u, uint32_t first, uint32_t count) {
+  const uint32_t colors = uint32_t(colors_.size());
+  if (colors == 0 || !limitShortens(u.limit.x, u.grab_index, u.flags)) return;
+  SheetElements e = elements(u);
+  uint32_t largest = 0;
+  for (const ColorRange& range : colors_) largest = std::max(largest, range.count);
+  const uint32_t chunks = pool_->chunksFor(largest, grain_(kGrainConstraints));
+  std::vector<uint32_t>& passes = project_passes_;
+  passes.clear();
+  for (uint32_t pass = first; pass < first + count; ++pass) {
+    const ColorRange& range = colors_[pass % colors];
+    if (range.count > 0 && shortensColour(con_kind_[range.first])) passes.push_back(pass);
+  }
+  const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
+  const float* rest = con_rest_.data();
+  const uint32_t total = uint32_t(passes.size());
+  for (uint32_t done = 0; done < total; done += WorkerPool::kMaxPhases)
+    pool_->runPhases(std::min(WorkerPool::kMaxPhases, total - done), chunks, [&](uint32_t phase, uint32_t chunk) {
+      const ColorRange& range = colors_[passes[done + phase] % colors];
+      const uint32_t end = range.first + WorkerPool::chunkBound(range.count, chunks, chunk + 1);
+      for (uint32_t k = range.first + WorkerPool::chunkBound(range.count, chunks, chunk); k < end; ++k)
+        if (kind[k] == SIM_KIND_STRUCTURAL)
+          e.shortenConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]});
+    });
+}
+
 void CpuSolver::creasePass(const SimUniforms& u) {
   if (!creasing(u.hinge.y, u.crease.y)) return;
   SheetElements e = elements(u);
@@ -354,6 +380,9 @@ void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint3
     break;
   case PassKind::project:
     projectColors(u, first, count); // Gauss-Seidel over the colours
+    break;
+  case PassKind::shorten:
+    shortenColors(u, first, count); // while nothing holds the sheet, over-long edges shortened
     break;
   case PassKind::limit:
     limitPass(u); // no structural edge longer than the limit

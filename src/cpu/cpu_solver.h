@@ -87,6 +87,9 @@ public:
   /// Colour passes [first, first + count) of the Gauss-Seidel sweep (pass k: colour k % colours of
   /// iteration k / colours).
   void projectColors(const shaderio::SimUniforms& u, uint32_t first, uint32_t count);
+  /// Colour passes [first, first + count) of the shorten stage (shortenConstraint over each
+  /// colour with edges, as projectColors numbers them), while limitShortens.
+  void shortenColors(const shaderio::SimUniforms& u, uint32_t first, uint32_t count);
   /// The creases of the substep (creaseHinge), when the sheet creases.
   void creasePass(const shaderio::SimUniforms& u);
   /// The stretch limit: the rings around its root one after the other (limitParticle).

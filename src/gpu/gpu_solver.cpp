@@ -169,7 +169,8 @@ void GpuSolver::tick(const SimUniforms& u) {
                 (u.flags & SIM_FLAG_AIR) != 0u,
                 creasing(u.hinge.y, u.crease.y),
                 contact,
-                u.limit.x > 0.0f};
+                u.limit.x > 0.0f,
+                limitShortens(u.limit.x, u.grab_index, u.flags)};
   stop_after_ = SIM_NONE;
   if (flight.recorded != key) recordTick(flight, index, key);
   ctx_.submit(flight.tick, flight.fence);

@@ -145,6 +145,7 @@ private:
     bool crease = false;      ///< the crease pass runs after the projection (creasing)
     bool contact = false;     ///< the contact passes run (SimUniforms::contact)
     bool limit = false;       ///< the stretch limit runs after the projection (SimUniforms::limit)
+    bool shorten = false;     ///< the limit shortens edges first (limitShortens)
     bool operator==(const RecordKey&) const = default;
   };
   struct InFlight {

@@ -90,7 +90,7 @@ enum class Elements : uint8_t {
   CONTACT_CELLS
 };
 /// When a sheet records a dispatch (SIM_DISPATCHES' needs column).
-enum class Needs : uint8_t { ALWAYS, AIR, CREASE, LIMIT, CONSTRAINTS, CONTACT };
+enum class Needs : uint8_t { ALWAYS, AIR, CREASE, LIMIT, SHORTEN, CONSTRAINTS, CONTACT };
 
 /// One row of SIM_DISPATCHES.
 struct Dispatch {
@@ -151,9 +151,12 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
   case Elements::COLOUR: {
     // Pass k: colour k % colours of iteration k / colours; an empty colour, or one that does not
     // project in this iteration (projectsInIteration), records nothing
+    // (the shorten stage: a colour with no edge records nothing, shortensColour)
     const uint32_t c = k % topo.colorCount(), iteration = k / topo.colorCount();
     const ColorRange& range = topo.colors[c];
-    if (range.count == 0 || !projectsInIteration(topo.constraints[range.first].kind_id, iteration)) return;
+    if (range.count == 0) return;
+    const uint32_t kind = topo.constraints[range.first].kind_id;
+    if (d.stage == SIM_STAGE_shorten ? !shortensColour(kind) : !projectsInIteration(kind, iteration)) return;
     record(sink, p, d.grid, range.count, SimPush{iteration, range.count, s, c}, s, d.gate, iteration);
     break;
   }
@@ -253,7 +256,7 @@ bool recordSubstep(PassSink& sink, const SimPipelines& pipes, const SheetTopolog
         if (d.stage != stage) continue;
         const bool needed = d.needs == Needs::ALWAYS || (d.needs == Needs::AIR && plan.air) ||
                             (d.needs == Needs::CREASE && plan.crease && topo.hingeCount() > 0) ||
-                            (d.needs == Needs::LIMIT && plan.limit) ||
+                            (d.needs == Needs::LIMIT && plan.limit) || (d.needs == Needs::SHORTEN && plan.shorten) ||
                             (d.needs == Needs::CONSTRAINTS && has_constraints) ||
                             (d.needs == Needs::CONTACT && plan.contact);
         if (needed) recordDispatch(sink, pipes, topo, sizes, d, s, k);

@@ -107,6 +107,7 @@ struct SubstepPlan {
   bool crease = false;      ///< the crease pass runs (creasing in xpbd.h)
   bool contact = false;     ///< the contact passes run (SimUniforms::contact)
   bool limit = false;       ///< the stretch limit runs (SimUniforms::limit)
+  bool shorten = false;     ///< the limit shortens edges first (limitShortens)
 };
 
 /// Timestamps a substep of the per-colour path records (one where each category ends).

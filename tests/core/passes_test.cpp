@@ -20,20 +20,23 @@ shaderio::SimUniforms uniforms(uint32_t substeps, uint32_t iterations, uint32_t 
 
 TEST(Passes, OrderOfOneSubstep) {
   const shaderio::SimUniforms u = uniforms(3, 2, 5, true);
-  ASSERT_EQ(passesPerTick(u), 3u * (1u + 10u + 1u + 1u + 1u + 1u + 1u));
+  ASSERT_EQ(passesPerTick(u), 3u * (1u + 10u + 10u + 1u + 1u + 1u + 1u + 1u));
   EXPECT_EQ(passAt(u, 0), (PassPoint{0, PassKind::integrate}));
   EXPECT_EQ(passAt(u, 1), (PassPoint{0, PassKind::collide}));
   EXPECT_EQ(passAt(u, 2), (PassPoint{0, PassKind::project, 0, 0}));
   EXPECT_EQ(passAt(u, 8), (PassPoint{0, PassKind::project, 1, 1}));
   EXPECT_EQ(passAt(u, 11), (PassPoint{0, PassKind::project, 1, 4}));
-  EXPECT_EQ(passAt(u, 12), (PassPoint{0, PassKind::limit}));
-  EXPECT_EQ(passAt(u, 13), (PassPoint{0, PassKind::crease}));
-  EXPECT_EQ(passAt(u, 14), (PassPoint{0, PassKind::floor}));
-  EXPECT_EQ(passAt(u, 15), (PassPoint{0, PassKind::tear}));
-  EXPECT_EQ(passAt(u, 16), (PassPoint{1, PassKind::integrate}));
-  EXPECT_EQ(describePass(passAt(u, 24)), "substep 1, project (iteration 1, colour 1)");
-  EXPECT_EQ(describePass(passAt(u, 28)), "substep 1, limit");
-  EXPECT_EQ(describePass(passAt(u, 29)), "substep 1, crease");
+  EXPECT_EQ(passAt(u, 12), (PassPoint{0, PassKind::shorten, 0, 0}));
+  EXPECT_EQ(passAt(u, 21), (PassPoint{0, PassKind::shorten, 1, 4}));
+  EXPECT_EQ(passAt(u, 22), (PassPoint{0, PassKind::limit}));
+  EXPECT_EQ(passAt(u, 23), (PassPoint{0, PassKind::crease}));
+  EXPECT_EQ(passAt(u, 24), (PassPoint{0, PassKind::floor}));
+  EXPECT_EQ(passAt(u, 25), (PassPoint{0, PassKind::tear}));
+  EXPECT_EQ(passAt(u, 26), (PassPoint{1, PassKind::integrate}));
+  EXPECT_EQ(describePass(passAt(u, 34)), "substep 1, project (iteration 1, colour 1)");
+  EXPECT_EQ(describePass(passAt(u, 46)), "substep 1, shorten (iteration 1, colour 3)");
+  EXPECT_EQ(describePass(passAt(u, 48)), "substep 1, limit");
+  EXPECT_EQ(describePass(passAt(u, 49)), "substep 1, crease");
 }
 
 TEST(Passes, IndexIsTheInverseOfPassAt) {
@@ -43,11 +46,12 @@ TEST(Passes, IndexIsTheInverseOfPassAt) {
       for (uint32_t k = 0; k < n; ++k) EXPECT_EQ(passIndex(u, passAt(u, k)), k);
     }
   shaderio::SimUniforms u = uniforms(2, 2, 3, false);
-  EXPECT_EQ(passesPerTick(u), 2u * 11u);
+  EXPECT_EQ(passesPerTick(u), 2u * 17u);
   EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::collide}));
   EXPECT_FALSE(passIndex(u, PassPoint{2, PassKind::floor}));
   EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::project, 2, 0}));
   EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::project, 0, 3}));
+  EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::shorten, 2, 0}));
   u.reset_active = 1;
   EXPECT_EQ(passesPerTick(u), 1u);
   EXPECT_EQ(passAt(u, 0).kind, PassKind::reset);

@@ -106,6 +106,7 @@ TEST_P(GpuBatchPasses, AFlushRunsFusedAndPerColourSheetsTogether) {
   expectFleetMatchesAlone(batch, alone, sheets, 12);
   const bool cpu_device = ctx().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   Simulation sim(sheets[5].params, alone);
+  sim.setScript(sheets[5].script); // held by its grab, as in the fleet's last flush
   sim.tick();
   EXPECT_EQ(alone.usesFusedPath(sim.lastUniforms()), !cpu_device);
   if (cpu_device)

@@ -83,8 +83,53 @@ TEST_F(StoppedTick, EveryPassMatchesTheCpuFusedAndPerColour) {
   EXPECT_FALSE(percolor.usesFusedPath());
   // The cuts really stop: positions change from pass to pass (in each substep the crease, here
   // without hinges, the floor, with nothing below it, and the tear move none but the last tear pass,
-  // which tears; the collide moves what it repels), and the collide passes had repulsion to compare.
-  EXPECT_GE(distinct.size(), size_t(passes) - 7u);
+  // which tears; the shorten stage, with the sheet held, moves nothing (the next test); the collide
+  // moves what it repels), and the collide passes had repulsion to compare.
+  uint32_t shorten_passes = 0;
+  for (uint32_t k = 0; k < passes; ++k) shorten_passes += passAt(u, k).kind == PassKind::shorten;
+  EXPECT_GT(shorten_passes, 0u);
+  EXPECT_GE(distinct.size(), size_t(passes) - 7u - shorten_passes);
   EXPECT_GT(torn_at_end, torn_before_last);
   EXPECT_TRUE(deltas_compared) << "no collide pass of the tick had a repulsion";
+}
+
+// The shorten stage, which runs while nothing holds the sheet: a pinless sheet yanked and let go,
+// cut after each pass of the shorten stage (and the projection's last before it) in the tick after
+// the release, gives the CPU's bits on both GPU paths, and the stage moves the sheet.
+TEST_F(StoppedTick, EveryShortenPassMatchesTheCpuFusedAndPerColour) {
+  const SimParams p =
+      preset("tender", {"wind=off", "pins=none", "substeps=2", "iterations=2", "stretch_limit=1.01", "tear_factor=0"});
+  const char* text = "0 grab particle 1535\n1 move 7 -4 6\n6 release\n";
+  const uint64_t tick = 7;
+  CpuSolver probe;
+  Simulation sim(p, probe);
+  sim.setScript(script(text));
+  for (uint64_t t = 0; t <= tick; ++t) sim.tick();
+  const shaderio::SimUniforms u = sim.lastUniforms();
+  ASSERT_EQ(u.grab_index, SIM_NONE);
+  ASSERT_TRUE(shaderio::limitShortens(u.limit.x, u.grab_index, u.flags));
+  gpu::GpuSolver fused(ctx()), percolor(ctx());
+  percolor.setFusedPath(false);
+  CpuSolver cpu;
+  uint32_t cuts = 0, moved = 0;
+  uint64_t last = 0;
+  for (uint32_t k = 0; k < passesPerTick(u); ++k) {
+    const PassPoint at = passAt(u, k), next = passAt(u, k + 1 < passesPerTick(u) ? k + 1 : k);
+    if (at.kind != PassKind::shorten && next.kind != PassKind::shorten) continue;
+    const Cut ref = runCut(cpu, p, text, tick, k);
+    const uint64_t hash = hashPositions(ref.state.pos);
+    if (at.kind == PassKind::shorten) {
+      ++cuts;
+      moved += hash != last;
+    }
+    last = hash;
+    for (gpu::GpuSolver* g : {&fused, &percolor}) {
+      const Cut got = runCut(*g, p, text, tick, k);
+      EXPECT_TRUE(sameState(ref.state, got.state))
+          << (g == &fused ? "fused" : "per-colour") << ", after pass " << k << ": " << describePass(ref.pass);
+    }
+  }
+  EXPECT_TRUE(fused.usesFusedPath());
+  EXPECT_EQ(cuts, 2u * 2u * sim.topology().colorCount());
+  EXPECT_GE(moved, cuts / 4) << "the shorten stage moved the sheet in " << moved << " of its " << cuts << " passes";
 }

@@ -85,7 +85,7 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   const SimPipelines pipes = fakePipelines();
   RecordingSink sink(pipes);
   uint32_t pass = 0;
-  const SubstepPlan plan{2, true, true, SIM_NONE, true, true, true};
+  const SubstepPlan plan{2, true, true, SIM_NONE, true, true, true, true};
   EXPECT_FALSE(recordSubstep(sink, pipes, topo, sizes, plan, 0, pass));
   EXPECT_EQ(pass, shaderio::passesPerSubstep(2, topo.colorCount(), true));
   EXPECT_EQ(sink.barriers_due, 0u); // every pass is followed by a barrier
@@ -112,18 +112,29 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
         expected.push_back("project");
         iterations.push_back(it);
       }
+  // The shorten stage: in each iteration every colour but the hinges'
+  std::vector<uint32_t> shorten_iterations;
+  for (uint32_t it = 0; it < 2; ++it)
+    for (const ColorRange& range : topo.colors)
+      if (range.count > 0 && constraintKind(topo.constraints[range.first]) != SIM_KIND_HINGE) {
+        expected.push_back("shorten");
+        shorten_iterations.push_back(it);
+      }
   expected.push_back("limit");
   expected.push_back("crease");
   for (const char* k : {"floor", "tear_mark", "tear_unsupported", "tear_flags", "scan", "tear_compact"})
     expected.push_back(k);
   EXPECT_EQ(kernels(sink.passes), expected);
-  for (size_t k = 0, project = 0; k < sink.passes.size(); ++k)
+  for (size_t k = 0, project = 0, shorten = 0; k < sink.passes.size(); ++k)
     if (sink.passes[k].kernel == "project") {
       EXPECT_EQ(sink.passes[k].gate, SIM_GATE_ITERATION);
       EXPECT_EQ(sink.passes[k].gate_arg, iterations[project++]);
+    } else if (sink.passes[k].kernel == "shorten") {
+      EXPECT_EQ(sink.passes[k].gate, SIM_GATE_SHORTEN);
+      EXPECT_EQ(sink.passes[k].gate_arg, shorten_iterations[shorten++]);
     }
   EXPECT_EQ(sink.marks, (std::vector<PassCategory>{kContact, kIntegrate, kHash, kCollide, kProject, kProject, kProject,
-                                                   kFloor, kTear}));
+                                                   kProject, kFloor, kTear}));
   EXPECT_EQ(marksPerSubstep(), sink.marks.size());
 }
 
@@ -144,6 +155,8 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
       return "integrate";
     case PassKind::project:
       return "project";
+    case PassKind::shorten:
+      return "shorten";
     case PassKind::limit:
       return "limit";
     case PassKind::crease:
@@ -162,11 +175,20 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
   for (uint32_t stop = 0; stop < passesPerTick(u); ++stop) {
     RecordingSink sink(pipes);
     uint32_t pass = 0;
-    EXPECT_TRUE(recordSubstep(sink, pipes, topo, sizes, SubstepPlan{1, true, false, stop, true, false, true}, 0, pass))
+    EXPECT_TRUE(
+        recordSubstep(sink, pipes, topo, sizes, SubstepPlan{1, true, false, stop, true, false, true, true}, 0, pass))
         << stop;
     EXPECT_EQ(pass, stop + 1);
     const PassPoint at = passAt(u, stop);
     ASSERT_FALSE(sink.passes.empty());
+    if (at.kind == PassKind::shorten) { // a hinge's colour records nothing; every other colour one pass
+      size_t shortens = 0, edge_colours = 0;
+      for (const Recorded& r : sink.passes) shortens += r.kernel == "shorten";
+      for (uint32_t c = 0; c <= at.color; ++c)
+        edge_colours += constraintKind(topo.constraints[topo.colors[c].first]) != SIM_KIND_HINGE;
+      EXPECT_EQ(shortens, edge_colours) << describePass(at);
+      if (constraintKind(topo.constraints[topo.colors[at.color].first]) == SIM_KIND_HINGE) continue;
+    }
     EXPECT_EQ(sink.passes.back().kernel, lastOf(at.kind)) << describePass(at);
     if (at.kind == PassKind::project) {
       size_t projects = 0;
