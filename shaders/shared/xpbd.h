@@ -264,9 +264,10 @@ SIM_INLINE bool limitShortens(float reach, uint grab_index, uint flags) {
   return reach > 0.0f && grab_index == SIM_NONE && (flags & SIM_FLAG_PINS) == 0u;
 }
 
-/// True when the shorten stage visits a colour whose first constraint is `kind_id`: hinges have
-/// colours of their own, and a hinge's colour holds no edge.
-SIM_INLINE bool shortensColour(uint kind_id) { return (kind_id & SIM_KIND_MASK) != SIM_KIND_HINGE; }
+/// True when the shorten stage visits a colour whose first constraint is `kind_id`: a colour holds
+/// its structural edges first (buildSheet makes them first; the colouring's sort and the compaction
+/// keep the order), so one that starts with another kind (a shear's, a hinge's) holds no edge.
+SIM_INLINE bool shortensColour(uint kind_id) { return (kind_id & SIM_KIND_MASK) == SIM_KIND_STRUCTURAL; }
 
 /// An edge from pa to pb longer than `reach` shortened to it from both ends alike (an end that
 /// does not move, w = 0, leaves the whole to the other): a step, which the previous positions do

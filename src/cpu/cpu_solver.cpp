@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/host_queries.h"
 #include "denormal_mode.h"
@@ -26,10 +27,16 @@ void CpuSolver::splitConstraints() {
   const size_t m = constraints_.size();
   std::vector<uint32_t> order(m);
   for (uint32_t k = 0; k < m; ++k) order[k] = k;
-  auto first = [&](uint32_t k) { return std::min(constraints_[k].a, constraints_[k].b); };
+  // Within a colour (whose constraints share no particle, so any order gives the same bits): the
+  // structural edges first, as the sheet has them (shortenColors visits that run alone), each run
+  // by its first particle, for locality
+  auto key = [&](uint32_t k) {
+    return std::pair(constraintKind(constraints_[k]) != SIM_KIND_STRUCTURAL,
+                     std::min(constraints_[k].a, constraints_[k].b));
+  };
   for (const ColorRange& range : colors_)
     std::stable_sort(order.begin() + range.first, order.begin() + range.first + range.count,
-                     [&](uint32_t x, uint32_t y) { return first(x) < first(y); });
+                     [&](uint32_t x, uint32_t y) { return key(x) < key(y); });
   con_a_.resize(m);
   con_b_.resize(m);
   con_kind_.resize(m);
@@ -163,25 +170,37 @@ void CpuSolver::shortenColors(const SimUniforms& u, uint32_t first, uint32_t cou
   const uint32_t colors = uint32_t(colors_.size());
   if (colors == 0 || !limitShortens(u.limit.x, u.grab_index, u.flags)) return;
   SheetElements e = elements(u);
-  uint32_t largest = 0;
-  for (const ColorRange& range : colors_) largest = std::max(largest, range.count);
-  const uint32_t chunks = pool_->chunksFor(largest, grain_(kGrainConstraints));
-  std::vector<uint32_t>& passes = project_passes_;
-  passes.clear();
-  for (uint32_t pass = first; pass < first + count; ++pass) {
-    const ColorRange& range = colors_[pass % colors];
-    if (range.count > 0 && shortensColour(con_kind_[range.first])) passes.push_back(pass);
-  }
+  // A colour holds its edges first (splitConstraints sorts them there; the compaction keeps the
+  // order), so the stage visits that run of each colour alone.
   const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
   const float* rest = con_rest_.data();
+  std::vector<uint32_t>& passes = project_passes_;
+  std::vector<uint32_t>& edges = shorten_edges_;
+  passes.clear();
+  edges.assign(colors, 0);
+  uint32_t largest = 0;
+  for (uint32_t c = 0; c < colors; ++c) {
+    const uint32_t* at = kind + colors_[c].first;
+    edges[c] = uint32_t(
+        std::partition_point(at, at + colors_[c].count, [](uint32_t k) { return k == SIM_KIND_STRUCTURAL; }) - at);
+    largest = std::max(largest, edges[c]);
+  }
+  for (uint32_t pass = first; pass < first + count; ++pass) {
+    const ColorRange& range = colors_[pass % colors];
+    if (range.count > 0 && shortensColour(kind[range.first]) && edges[pass % colors] > 0) passes.push_back(pass);
+  }
+  const uint32_t chunks = pool_->chunksFor(largest, grain_(kGrainConstraints));
+  const bool tears = tearingOn(u.tear_factor) && (u.tear_kinds & (1u << SIM_KIND_STRUCTURAL)) != 0u;
   const uint32_t total = uint32_t(passes.size());
   for (uint32_t done = 0; done < total; done += WorkerPool::kMaxPhases)
     pool_->runPhases(std::min(WorkerPool::kMaxPhases, total - done), chunks, [&](uint32_t phase, uint32_t chunk) {
-      const ColorRange& range = colors_[passes[done + phase] % colors];
-      const uint32_t end = range.first + WorkerPool::chunkBound(range.count, chunks, chunk + 1);
-      for (uint32_t k = range.first + WorkerPool::chunkBound(range.count, chunks, chunk); k < end; ++k)
-        if (kind[k] == SIM_KIND_STRUCTURAL)
-          e.shortenConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]});
+      const uint32_t c = passes[done + phase] % colors, start = colors_[c].first;
+      const uint32_t end = start + WorkerPool::chunkBound(edges[c], chunks, chunk + 1);
+      uint32_t k = start + WorkerPool::chunkBound(edges[c], chunks, chunk);
+      if (simd_)
+        k = simd::shorten(reinterpret_cast<float*>(pos_.data()), ca, cb, rest, kind, u.limit.x, u.tear_factor, tears, k,
+                          end);
+      for (; k < end; ++k) e.shortenConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]});
     });
 }
 

@@ -151,6 +151,7 @@ private:
   std::vector<shaderio::Constraint> constraints_;
   std::vector<ColorRange> colors_;
   std::vector<uint32_t> project_passes_; ///< projectColors' passes that project (scratch)
+  std::vector<uint32_t> shorten_edges_;  ///< shortenColors' edges at the head of each colour (scratch)
   // constraints_ split into one array per field, each colour ordered by first particle
   std::vector<uint32_t> con_a_, con_b_, con_kind_, con_id_;
   std::vector<uint32_t> con_hinge_; ///< per slot of a hinge: its hinge

@@ -88,6 +88,66 @@ uint32_t projectColor(float* pos, const uint32_t* a, const uint32_t* b, const fl
   return k;
 }
 
+uint32_t shortenColor(float* pos, const uint32_t* a, const uint32_t* b, const float* rest, const uint32_t* kind,
+                      const ShortenLimit& limit, uint32_t begin, uint32_t end) {
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), sign = _mm256_set1_ps(-0.0f);
+  const __m256 reach = _mm256_set1_ps(limit.reach), reach2 = _mm256_set1_ps(limit.reach * limit.reach);
+  const __m256 tear_factor = _mm256_set1_ps(limit.tear_factor);
+  uint32_t k = begin;
+  for (; k + 8 <= end; k += 8) {
+    // Lane l of the low half is constraint k + l, of the high half k + 4 + l (as projectColor).
+    float* pa[8];
+    float* pb[8];
+    for (uint32_t l = 0; l < 8; ++l) {
+      pa[l] = pos + 4 * size_t(a[k + l]);
+      pb[l] = pos + 4 * size_t(b[k + l]);
+    }
+    const __m256 ra0 = loadRows(pa[0], pa[4]), ra1 = loadRows(pa[1], pa[5]);
+    const __m256 ra2 = loadRows(pa[2], pa[6]), ra3 = loadRows(pa[3], pa[7]);
+    const __m256 rb0 = loadRows(pb[0], pb[4]), rb1 = loadRows(pb[1], pb[5]);
+    const __m256 rb2 = loadRows(pb[2], pb[6]), rb3 = loadRows(pb[3], pb[7]);
+    __m256 ax = ra0, ay = ra1, az = ra2, aw = ra3;
+    transpose(ax, ay, az, aw);
+    __m256 bx = rb0, by = rb1, bz = rb2, bw = rb3;
+    transpose(bx, by, bz, bw);
+    // shortenEdge: w 1 or 0 by pos.w > 0; d = b - a, len2 = (x*x + y*y) + z*z, len = sqrt(len2)
+    const __m256 wa = _mm256_and_ps(_mm256_cmp_ps(aw, zero, _CMP_GT_OQ), one);
+    const __m256 wb = _mm256_and_ps(_mm256_cmp_ps(bw, zero, _CMP_GT_OQ), one);
+    const __m256 wsum = _mm256_add_ps(wa, wb);
+    const __m256 dx = _mm256_sub_ps(bx, ax), dy = _mm256_sub_ps(by, ay), dz = _mm256_sub_ps(bz, az);
+    const __m256 len2 =
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
+    const __m256 len = _mm256_sqrt_ps(len2);
+    // c = d * ((len - reach) / (len * wsum)), da = c * wa, db = -(c * wb)
+    const __m256 q = _mm256_div_ps(_mm256_sub_ps(len, reach), _mm256_mul_ps(len, wsum));
+    const __m256 cx = _mm256_mul_ps(dx, q), cy = _mm256_mul_ps(dy, q), cz = _mm256_mul_ps(dz, q);
+    // Moved: a structural edge (kind 0), wsum > 0, len2 > reach^2, not stretched to its tear length
+    // (shouldTear: len > rest x tear_factor where structural edges tear)
+    const __m256 structural = _mm256_cmp_ps(
+        _mm256_cvtepi32_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(kind + k))), zero, _CMP_EQ_OQ);
+    __m256 ok = _mm256_and_ps(
+        structural, _mm256_and_ps(_mm256_cmp_ps(wsum, zero, _CMP_GT_OQ), _mm256_cmp_ps(len2, reach2, _CMP_GT_OQ)));
+    if (limit.tears)
+      ok = _mm256_andnot_ps(_mm256_cmp_ps(len, _mm256_mul_ps(_mm256_loadu_ps(rest + k), tear_factor), _CMP_GT_OQ), ok);
+    __m256 dax = _mm256_and_ps(_mm256_mul_ps(cx, wa), ok), day = _mm256_and_ps(_mm256_mul_ps(cy, wa), ok);
+    __m256 daz = _mm256_and_ps(_mm256_mul_ps(cz, wa), ok), daw = zero;
+    __m256 dbx = _mm256_and_ps(_mm256_xor_ps(_mm256_mul_ps(cx, wb), sign), ok);
+    __m256 dby = _mm256_and_ps(_mm256_xor_ps(_mm256_mul_ps(cy, wb), sign), ok);
+    __m256 dbz = _mm256_and_ps(_mm256_xor_ps(_mm256_mul_ps(cz, wb), sign), ok), dbw = zero;
+    transpose(dax, day, daz, daw);
+    transpose(dbx, dby, dbz, dbw);
+    storeRows(pa[0], pa[4], _mm256_add_ps(ra0, dax));
+    storeRows(pa[1], pa[5], _mm256_add_ps(ra1, day));
+    storeRows(pa[2], pa[6], _mm256_add_ps(ra2, daz));
+    storeRows(pa[3], pa[7], _mm256_add_ps(ra3, daw));
+    storeRows(pb[0], pb[4], _mm256_add_ps(rb0, dbx));
+    storeRows(pb[1], pb[5], _mm256_add_ps(rb1, dby));
+    storeRows(pb[2], pb[6], _mm256_add_ps(rb2, dbz));
+    storeRows(pb[3], pb[7], _mm256_add_ps(rb3, dbw));
+  }
+  return k;
+}
+
 namespace {
 
 using V = __m256;

@@ -15,6 +15,19 @@ bool available();
 uint32_t projectColor(float* pos, const uint32_t* a, const uint32_t* b, const float* rest, const uint32_t* kind,
                       const float stiffness[4], uint32_t begin, uint32_t end);
 
+/// The stretch limit as the shorten stage reads it (shortenConstraint).
+struct ShortenLimit {
+  float reach;       ///< the longest an edge may be (SimUniforms::limit.x)
+  float tear_factor; ///< SimUniforms::tear_factor
+  bool tears;        ///< structural edges tear (tearingOn and SimUniforms::tear_kinds)
+};
+
+/// The shorten stage on the constraints [begin, end) of one colour, eight at a time, with the
+/// exact operations of shortenConstraint (shouldTear, shortenEdge): only the structural ones move.
+/// Returns the first constraint it did not do (the caller finishes the last end - returned < 8).
+uint32_t shortenColor(float* pos, const uint32_t* a, const uint32_t* b, const float* rest, const uint32_t* kind,
+                      const ShortenLimit& limit, uint32_t begin, uint32_t end);
+
 /// One colour of hinges: what the arrays of a hinge slot hold.
 struct HingeSlots {
   const uint32_t* corners; ///< 4 per hinge: the edge's ends and its opposite corners (gridHinge)

@@ -37,6 +37,16 @@ uint32_t project8([[maybe_unused]] float* pos, [[maybe_unused]] const uint32_t* 
   return begin;
 }
 
+uint32_t shorten([[maybe_unused]] float* pos, [[maybe_unused]] const uint32_t* a, [[maybe_unused]] const uint32_t* b,
+                 [[maybe_unused]] const float* rest, [[maybe_unused]] const uint32_t* kind,
+                 [[maybe_unused]] float reach, [[maybe_unused]] float tear_factor, [[maybe_unused]] bool tears,
+                 uint32_t begin, [[maybe_unused]] uint32_t end) {
+#if defined(TENDER_CPU_AVX)
+  if (hasAvx()) return avx::shortenColor(pos, a, b, rest, kind, {reach, tear_factor, tears}, begin, end);
+#endif
+  return begin;
+}
+
 uint32_t projectHinges([[maybe_unused]] float* pos, [[maybe_unused]] float* state,
                        [[maybe_unused]] const uint32_t* corners, [[maybe_unused]] const uint32_t* hinge,
                        [[maybe_unused]] uint32_t first_diagonal, [[maybe_unused]] float alpha, uint32_t begin,

@@ -38,6 +38,12 @@ uint32_t project8(float* pos, const uint32_t* a, const uint32_t* b, const float*
 uint32_t project(float* pos, const uint32_t* a, const uint32_t* b, const float* rest, const uint32_t* kind,
                  const float stiffness[4], uint32_t begin, uint32_t end);
 
+/// The shorten stage on constraints [begin, end) of one colour eight at a time with AVX, with the
+/// operations of shortenConstraint (the limit's reach, the tear factor, whether structural edges
+/// tear). Returns the first constraint it did not do (`begin` without AVX); the caller does the rest.
+uint32_t shorten(float* pos, const uint32_t* a, const uint32_t* b, const float* rest, const uint32_t* kind, float reach,
+                 float tear_factor, bool tears, uint32_t begin, uint32_t end);
+
 /// Projects the hinges of slots [begin, end) of one colour eight at a time with AVX, with the
 /// operations of projectHinge: `corners` holds each hinge's gridHinge (4 words), `hinge` each slot's hinge,
 /// hinges from `first_diagonal` on are diagonals, `alpha` is an edge hinge's compliance over dt^2.

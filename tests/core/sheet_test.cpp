@@ -69,6 +69,30 @@ TEST(Coloring, NoSharedParticleWithinColor) {
   }
 }
 
+TEST(Coloring, AColourHoldsItsEdgesFirst) {
+  // The shorten stage of the CPU visits the run of structural edges at the head of each colour
+  // (CpuSolver::shortenColors): every kind of sheet keeps them there (the compaction keeps the order)
+  for (const char* preset : {"tender", "crumple", "paper"})
+    for (const char* extra : {"", "tri_bend", "shear"}) {
+      SimParams p = *presetParams(preset);
+      if (std::string(extra) == "tri_bend") p.tri_bend = true, p.bend = true;
+      if (std::string(extra) == "shear") p.shear = true, p.dihedral = false;
+      const SheetTopology t = buildSheet(p);
+      uint32_t edges = 0;
+      for (const ColorRange& range : t.colors) {
+        bool past = false;
+        for (uint32_t k = range.first; k < range.first + range.count; ++k) {
+          const bool edge = constraintKind(t.constraints[k]) == SIM_KIND_STRUCTURAL;
+          EXPECT_FALSE(edge && past) << preset << " " << extra << ": an edge after another kind in colour at "
+                                     << range.first;
+          past = past || !edge;
+          edges += edge;
+        }
+      }
+      EXPECT_EQ(edges, t.kind_counts[SIM_KIND_STRUCTURAL]) << preset << " " << extra;
+    }
+}
+
 TEST(Coloring, GridNeedsTwelveColours) {
   // An interior particle has 12 constraints, so 12 colours is optimal; greedy reaches it.
   EXPECT_EQ(buildSheet(*presetParams("tender")).colorCount(), 12u);

@@ -199,6 +199,39 @@ TEST(SimdKernels, AvxProjectionMatchesSolveDistance) {
   expectKernelMatchesReference(simd::project, 4); // AVX, then SSE on what it leaves
 }
 
+// The reference of the shorten stage on constraints [begin, end), as shortenConstraint does it.
+void shortenScalar(Constraints& c, float reach, float tear_factor, uint32_t begin, uint32_t end) {
+  for (uint32_t k = begin; k < end; ++k) {
+    const vec4 pa = c.pos[c.a[k]], pb = c.pos[c.b[k]];
+    if (c.kind[k] != SIM_KIND_STRUCTURAL || shouldTear(pa, pb, c.rest[k], SIM_KIND_STRUCTURAL, tear_factor, 0xFu))
+      continue;
+    const PairDelta d = shortenEdge(pa, pb, reach);
+    c.pos[c.a[k]] = pa + vec4(d.da, 0.0f);
+    c.pos[c.b[k]] = pb + vec4(d.db, 0.0f);
+  }
+}
+
+TEST(SimdKernels, AvxShortenMatchesShortenConstraint) {
+  if (!simd::hasAvx()) GTEST_SKIP() << "no AVX kernel in this build or on this CPU";
+  uint32_t seed = 200, moved = 0;
+  for (const float reach : {1.0f, 0.05f, 1e-30f})
+    for (const float tear_factor : {0.0f, 2.5f})
+      for (uint32_t begin : {0u, 3u}) {
+        const Constraints start = randomConstraints(4099, seed++);
+        const uint32_t end = uint32_t(start.a.size());
+        Constraints fast = start, slow = start;
+        const uint32_t done = simd::shorten(&fast.pos[0].x, fast.a.data(), fast.b.data(), fast.rest.data(),
+                                            fast.kind.data(), reach, tear_factor, tear_factor > 0.0f, begin, end);
+        EXPECT_LT(end - done, 8u);
+        shortenScalar(fast, reach, tear_factor, done, end);
+        shortenScalar(slow, reach, tear_factor, begin, end);
+        ASSERT_EQ(0, std::memcmp(fast.pos.data(), slow.pos.data(), fast.pos.size() * sizeof(vec4)))
+            << "reach " << reach << ", tear factor " << tear_factor << ", begin " << begin;
+        for (size_t i = 0; i < start.pos.size(); ++i) moved += start.pos[i] != slow.pos[i];
+      }
+  EXPECT_GT(moved, 5000u); // the edges really move (a quarter are structural)
+}
+
 TEST(SimdKernels, TearTestMatchesShouldTear) {
   if (!simd::kBuilt) GTEST_SKIP() << "no SSE kernels in this build";
   uint32_t tearing = 0, seed = 100;
@@ -283,4 +316,21 @@ TEST(SimdSimulation, CrumpleTossIsIdenticalWithoutSimd) {
   test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 30, kSimdOne));
   test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 30, kSimdTwo));
   test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 30, kScalarTwo));
+}
+
+TEST(SimdSimulation, TheShortenStageIsIdenticalWithoutSimd) {
+  // Sheets no pin holds, so the shorten stage runs once the grab lets go: a crumple sheet tossed,
+  // and a tender sheet with the limit yanked hard enough to tear (edges at their tear length are
+  // left to tear) and let go
+  const std::string toss = "0 grab particle 100\n1 move 1 2 3\n10 release\n";
+  const std::vector<std::string> crumple = {"cols=37", "rows=53", "pins=none"};
+  const SimState reference = test::runCpu("crumple", crumple, toss, 30, kScalarOne);
+  test::expectIdentical(reference, test::runCpu("crumple", crumple, toss, 30, kSimdOne));
+  test::expectIdentical(reference, test::runCpu("crumple", crumple, toss, 30, kSimdTwo));
+  const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n12 release\n";
+  const std::vector<std::string> tender = {"pins=none", "stretch_limit=1.01", "tear_factor=1.5"};
+  const SimState torn = test::runCpu("tender", tender, yank, 30, kScalarOne);
+  EXPECT_GT(test::tornCount(torn), 0u);
+  test::expectIdentical(torn, test::runCpu("tender", tender, yank, 30, kSimdOne));
+  test::expectIdentical(torn, test::runCpu("tender", tender, yank, 30, kSimdTwo));
 }
