@@ -26,6 +26,45 @@ inline void storeRows(float* p0, float* p1, __m256 v) {
   _mm_storeu_ps(p1, _mm256_extractf128_ps(v, 1));
 }
 
+// The ends of eight constraints k to k + 7 of a colour (no two share a particle): lane l of the low
+// half is constraint k + l, of the high half k + 4 + l. Holds the rows as loaded and, transposed,
+// their components.
+struct Ends {
+  float* pa[8];
+  float* pb[8];
+  __m256 ra[4], rb[4];
+  __m256 ax, ay, az, aw, bx, by, bz, bw;
+};
+
+inline Ends loadEnds(float* pos, const uint32_t* a, const uint32_t* b, uint32_t k) {
+  Ends e;
+  for (uint32_t l = 0; l < 8; ++l) {
+    e.pa[l] = pos + 4 * size_t(a[k + l]);
+    e.pb[l] = pos + 4 * size_t(b[k + l]);
+  }
+  for (uint32_t r = 0; r < 4; ++r) {
+    e.ra[r] = loadRows(e.pa[r], e.pa[r + 4]);
+    e.rb[r] = loadRows(e.pb[r], e.pb[r + 4]);
+  }
+  e.ax = e.ra[0], e.ay = e.ra[1], e.az = e.ra[2], e.aw = e.ra[3];
+  transpose(e.ax, e.ay, e.az, e.aw);
+  e.bx = e.rb[0], e.by = e.rb[1], e.bz = e.rb[2], e.bw = e.rb[3];
+  transpose(e.bx, e.by, e.bz, e.bw);
+  return e;
+}
+
+// Adds the corrections (components, w 0) to the ends: back to rows, then p += correction.
+inline void storeEnds(const Ends& e, __m256 dax, __m256 day, __m256 daz, __m256 dbx, __m256 dby, __m256 dbz) {
+  __m256 daw = _mm256_setzero_ps(), dbw = _mm256_setzero_ps();
+  transpose(dax, day, daz, daw);
+  transpose(dbx, dby, dbz, dbw);
+  const __m256 da[4] = {dax, day, daz, daw}, db[4] = {dbx, dby, dbz, dbw};
+  for (uint32_t r = 0; r < 4; ++r) {
+    storeRows(e.pa[r], e.pa[r + 4], _mm256_add_ps(e.ra[r], da[r]));
+    storeRows(e.pb[r], e.pb[r + 4], _mm256_add_ps(e.rb[r], db[r]));
+  }
+}
+
 } // namespace
 
 bool available() {
@@ -43,21 +82,8 @@ uint32_t projectColor(float* pos, const uint32_t* a, const uint32_t* b, const fl
                                       stiffness[1], stiffness[2], stiffness[3]);
   uint32_t k = begin;
   for (; k + 8 <= end; k += 8) {
-    // Lane l of the low half is constraint k + l, of the high half k + 4 + l.
-    float* pa[8];
-    float* pb[8];
-    for (uint32_t l = 0; l < 8; ++l) {
-      pa[l] = pos + 4 * size_t(a[k + l]);
-      pb[l] = pos + 4 * size_t(b[k + l]);
-    }
-    const __m256 ra0 = loadRows(pa[0], pa[4]), ra1 = loadRows(pa[1], pa[5]);
-    const __m256 ra2 = loadRows(pa[2], pa[6]), ra3 = loadRows(pa[3], pa[7]);
-    const __m256 rb0 = loadRows(pb[0], pb[4]), rb1 = loadRows(pb[1], pb[5]);
-    const __m256 rb2 = loadRows(pb[2], pb[6]), rb3 = loadRows(pb[3], pb[7]);
-    __m256 ax = ra0, ay = ra1, az = ra2, aw = ra3;
-    transpose(ax, ay, az, aw);
-    __m256 bx = rb0, by = rb1, bz = rb2, bw = rb3;
-    transpose(bx, by, bz, bw);
+    const Ends e = loadEnds(pos, a, b, k);
+    const __m256 &ax = e.ax, &ay = e.ay, &az = e.az, &aw = e.aw, &bx = e.bx, &by = e.by, &bz = e.bz, &bw = e.bw;
     // d = b - a; len = sqrt(dot(d, d)) with dot = (x*x + y*y) + z*z
     const __m256 dx = _mm256_sub_ps(bx, ax), dy = _mm256_sub_ps(by, ay), dz = _mm256_sub_ps(bz, az);
     const __m256 len = _mm256_sqrt_ps(
@@ -69,21 +95,9 @@ uint32_t projectColor(float* pos, const uint32_t* a, const uint32_t* b, const fl
     const __m256 s = _mm256_div_ps(_mm256_mul_ps(st, _mm256_sub_ps(len, r)), _mm256_mul_ps(len, wsum));
     const __m256 ok = _mm256_and_ps(_mm256_cmp_ps(wsum, zero, _CMP_GT_OQ), _mm256_cmp_ps(len, tiny, _CMP_GT_OQ));
     const __m256 ta = _mm256_mul_ps(s, aw), tb = _mm256_mul_ps(_mm256_xor_ps(s, sign), bw);
-    __m256 dax = _mm256_and_ps(_mm256_mul_ps(dx, ta), ok), day = _mm256_and_ps(_mm256_mul_ps(dy, ta), ok);
-    __m256 daz = _mm256_and_ps(_mm256_mul_ps(dz, ta), ok), daw = zero;
-    __m256 dbx = _mm256_and_ps(_mm256_mul_ps(dx, tb), ok), dby = _mm256_and_ps(_mm256_mul_ps(dy, tb), ok);
-    __m256 dbz = _mm256_and_ps(_mm256_mul_ps(dz, tb), ok), dbw = zero;
-    // Back to rows (w correction 0), then p += correction.
-    transpose(dax, day, daz, daw);
-    transpose(dbx, dby, dbz, dbw);
-    storeRows(pa[0], pa[4], _mm256_add_ps(ra0, dax));
-    storeRows(pa[1], pa[5], _mm256_add_ps(ra1, day));
-    storeRows(pa[2], pa[6], _mm256_add_ps(ra2, daz));
-    storeRows(pa[3], pa[7], _mm256_add_ps(ra3, daw));
-    storeRows(pb[0], pb[4], _mm256_add_ps(rb0, dbx));
-    storeRows(pb[1], pb[5], _mm256_add_ps(rb1, dby));
-    storeRows(pb[2], pb[6], _mm256_add_ps(rb2, dbz));
-    storeRows(pb[3], pb[7], _mm256_add_ps(rb3, dbw));
+    storeEnds(e, _mm256_and_ps(_mm256_mul_ps(dx, ta), ok), _mm256_and_ps(_mm256_mul_ps(dy, ta), ok),
+              _mm256_and_ps(_mm256_mul_ps(dz, ta), ok), _mm256_and_ps(_mm256_mul_ps(dx, tb), ok),
+              _mm256_and_ps(_mm256_mul_ps(dy, tb), ok), _mm256_and_ps(_mm256_mul_ps(dz, tb), ok));
   }
   return k;
 }
@@ -95,21 +109,8 @@ uint32_t shortenColor(float* pos, const uint32_t* a, const uint32_t* b, const fl
   const __m256 tear_factor = _mm256_set1_ps(limit.tear_factor);
   uint32_t k = begin;
   for (; k + 8 <= end; k += 8) {
-    // Lane l of the low half is constraint k + l, of the high half k + 4 + l (as projectColor).
-    float* pa[8];
-    float* pb[8];
-    for (uint32_t l = 0; l < 8; ++l) {
-      pa[l] = pos + 4 * size_t(a[k + l]);
-      pb[l] = pos + 4 * size_t(b[k + l]);
-    }
-    const __m256 ra0 = loadRows(pa[0], pa[4]), ra1 = loadRows(pa[1], pa[5]);
-    const __m256 ra2 = loadRows(pa[2], pa[6]), ra3 = loadRows(pa[3], pa[7]);
-    const __m256 rb0 = loadRows(pb[0], pb[4]), rb1 = loadRows(pb[1], pb[5]);
-    const __m256 rb2 = loadRows(pb[2], pb[6]), rb3 = loadRows(pb[3], pb[7]);
-    __m256 ax = ra0, ay = ra1, az = ra2, aw = ra3;
-    transpose(ax, ay, az, aw);
-    __m256 bx = rb0, by = rb1, bz = rb2, bw = rb3;
-    transpose(bx, by, bz, bw);
+    const Ends e = loadEnds(pos, a, b, k);
+    const __m256 &ax = e.ax, &ay = e.ay, &az = e.az, &aw = e.aw, &bx = e.bx, &by = e.by, &bz = e.bz, &bw = e.bw;
     // shortenEdge: w 1 or 0 by pos.w > 0; d = b - a, len2 = (x*x + y*y) + z*z, len = sqrt(len2)
     const __m256 wa = _mm256_and_ps(_mm256_cmp_ps(aw, zero, _CMP_GT_OQ), one);
     const __m256 wb = _mm256_and_ps(_mm256_cmp_ps(bw, zero, _CMP_GT_OQ), one);
@@ -129,21 +130,10 @@ uint32_t shortenColor(float* pos, const uint32_t* a, const uint32_t* b, const fl
         structural, _mm256_and_ps(_mm256_cmp_ps(wsum, zero, _CMP_GT_OQ), _mm256_cmp_ps(len2, reach2, _CMP_GT_OQ)));
     if (limit.tears)
       ok = _mm256_andnot_ps(_mm256_cmp_ps(len, _mm256_mul_ps(_mm256_loadu_ps(rest + k), tear_factor), _CMP_GT_OQ), ok);
-    __m256 dax = _mm256_and_ps(_mm256_mul_ps(cx, wa), ok), day = _mm256_and_ps(_mm256_mul_ps(cy, wa), ok);
-    __m256 daz = _mm256_and_ps(_mm256_mul_ps(cz, wa), ok), daw = zero;
-    __m256 dbx = _mm256_and_ps(_mm256_xor_ps(_mm256_mul_ps(cx, wb), sign), ok);
-    __m256 dby = _mm256_and_ps(_mm256_xor_ps(_mm256_mul_ps(cy, wb), sign), ok);
-    __m256 dbz = _mm256_and_ps(_mm256_xor_ps(_mm256_mul_ps(cz, wb), sign), ok), dbw = zero;
-    transpose(dax, day, daz, daw);
-    transpose(dbx, dby, dbz, dbw);
-    storeRows(pa[0], pa[4], _mm256_add_ps(ra0, dax));
-    storeRows(pa[1], pa[5], _mm256_add_ps(ra1, day));
-    storeRows(pa[2], pa[6], _mm256_add_ps(ra2, daz));
-    storeRows(pa[3], pa[7], _mm256_add_ps(ra3, daw));
-    storeRows(pb[0], pb[4], _mm256_add_ps(rb0, dbx));
-    storeRows(pb[1], pb[5], _mm256_add_ps(rb1, dby));
-    storeRows(pb[2], pb[6], _mm256_add_ps(rb2, dbz));
-    storeRows(pb[3], pb[7], _mm256_add_ps(rb3, dbw));
+    storeEnds(e, _mm256_and_ps(_mm256_mul_ps(cx, wa), ok), _mm256_and_ps(_mm256_mul_ps(cy, wa), ok),
+              _mm256_and_ps(_mm256_mul_ps(cz, wa), ok), _mm256_and_ps(_mm256_xor_ps(_mm256_mul_ps(cx, wb), sign), ok),
+              _mm256_and_ps(_mm256_xor_ps(_mm256_mul_ps(cy, wb), sign), ok),
+              _mm256_and_ps(_mm256_xor_ps(_mm256_mul_ps(cz, wb), sign), ok));
   }
   return k;
 }
