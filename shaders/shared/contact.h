@@ -173,6 +173,12 @@ SIM_INLINE vec3 contactPushWithin(vec3 push, float nearest2, float radius) {
 /// The reach of the pair lists of contact radius `radius`: they hold the pairs closer than this.
 SIM_INLINE float contactReach(float radius) { return radius * (1.0f + SIM_CONTACT_SKIN); }
 
+/// The reach of the pairs a repair of the lists looks for (the pairs with a particle that travelled
+/// beyond contactTravel; CpuContact): a repaired pair's particles may have been up to two travels
+/// apart already when it was looked at, so it closes by up to four before the lists are looked at
+/// again, and 4 x SIM_CONTACT_TRAVEL < 2 skins.
+SIM_INLINE float contactRepairReach(float radius) { return radius * (1.0f + 2.0f * SIM_CONTACT_SKIN); }
+
 /// How far a particle may travel from where it was when the pair lists were built before they are
 /// built again: under half the skin, so that every pair closer than the radius is in the lists (two
 /// primitives close in by at most twice this, plus a rounding far below the rest of the skin).

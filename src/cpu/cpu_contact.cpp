@@ -142,7 +142,9 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   // they were built stays within contactTravel of one point (listsOutgrown)
   const bool fresh = lists_ && list_radius_ == radius && based &&
                      !listsOutgrown(orderedCorner(all.travel_lo), orderedCorner(all.travel_hi), radius);
-  if (!fresh) buildLists(pos, triangles, count, radius);
+  const bool repairable = repairs_ && lists_ && list_radius_ == radius && based &&
+                          length2(orderedCorner(all.travel_hi) - orderedCorner(all.travel_lo)) < 1e30f;
+  if (!fresh && !(repairable && repairLists(pos, triangles, count, radius))) buildLists(pos, triangles, count, radius);
   sums_.assign(n, glm::ivec4(0));
   findCrossings(pos, triangles, count, s == 0 && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u, thickness, scale);
   const uint32_t none = std::bit_cast<uint32_t>(r2);
@@ -267,18 +269,8 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
   vf_.clear();
   ee_.clear();
   lists_ = false;
-  // Cells as wide as the reach and the mean edge, and at least an eighth of the longest edge, so
-  // that no box spans more than a few cells
-  double sum = 0.0;
-  float longest = 0.0f;
-  for (const uvec2 e : edges_) {
-    const float l = std::sqrt(length2(at(e.y) - at(e.x)));
-    sum += double(l);
-    longest = std::max(longest, l);
-  }
-  const float mean = edge_count > 0 ? float(sum / double(edge_count)) : 0.0f;
-  const float inv_cell = 1.0f / std::max(reach + mean, (reach + longest) * 0.125f);
-  if (!(std::isfinite(inv_cell) && inv_cell > 0.0f && longest < 1e30f)) return;
+  const float inv_cell = listCell(pos, reach);
+  if (!(inv_cell > 0.0f)) return;
   const float reach2 = reach * reach;
   std::mutex merge;
   // Particles against the triangles that do not hold them: the boxes of the triangles in the grid,
@@ -340,11 +332,148 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
   ++builds_;
 }
 
+float CpuContact::listCell(const std::vector<glm::vec4>& pos, float reach) const {
+  // Cells as wide as the reach and the mean edge, and at least an eighth of the longest edge, so
+  // that no box spans more than a few cells
+  double sum = 0.0;
+  float longest = 0.0f;
+  for (const uvec2 e : edges_) {
+    const float l = std::sqrt(length2(vec3(pos[e.y]) - vec3(pos[e.x])));
+    sum += double(l);
+    longest = std::max(longest, l);
+  }
+  const float mean = edges_.empty() ? 0.0f : float(sum / double(edges_.size()));
+  const float inv_cell = 1.0f / std::max(reach + mean, (reach + longest) * 0.125f);
+  return std::isfinite(inv_cell) && inv_cell > 0.0f && longest < 1e30f ? inv_cell : 0.0f;
+}
+
+bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
+                             float radius) {
+  // Why a repair keeps every pair closer than the radius in the lists. Let d(v) be particle v's
+  // travel since its base and say a pair was looked at at time t0 (listed when closer than the
+  // reach it was looked for with). At any later time t the lists are used, every particle's d lies
+  // within T = contactTravel of one point (the travels' box is small, or a repair looked again at
+  // the pairs of every particle beyond T of `middle`), so a pair's particles i, j have
+  // |d_i(t) - d_j(t)| < 2T. A pair's distance falls by at most the largest difference of its
+  // particles' displacements since t0, |(d_i(t) - d_i(t0)) - (d_j(t) - d_j(t0))|. A pair of the
+  // whole build (t0: every d zero) has fallen by less than 2T < SKIN x radius since, so one not
+  // listed then is still beyond the radius. A pair of a repair holds a particle beyond T at t0,
+  // whose base the repair moves so that its d is `middle`: then |d_i(t0) - d_j(t0)| < 2T too, the
+  // pair falls by less than 4T, and the repair looks as far as contactRepairReach. A pair both
+  // keep stays until one of its particles goes beyond T, when a repair drops it and looks again.
+  const uint32_t n = uint32_t(pos.size()), edge_count = uint32_t(edges_.size());
+  const float travel = contactTravel(radius), reach = contactRepairReach(radius), reach2 = reach * reach;
+  // The travel most particles share: the componentwise median
+  vec3 middle;
+  points_.resize(n);
+  for (int c = 0; c < 3; ++c) {
+    travels_.resize(n);
+    for (uint32_t i = 0; i < n; ++i) travels_[i] = pos[i][c] - base_[i][c];
+    std::nth_element(travels_.begin(), travels_.begin() + n / 2, travels_.end());
+    middle[c] = travels_[n / 2];
+  }
+  if (!(length2(middle) < 1e30f)) return false;
+  moved_.assign(n, 0);
+  uint32_t moved = 0;
+  for (uint32_t i = 0; i < n; ++i)
+    if (!(length2(vec3(pos[i]) - vec3(base_[i]) - middle) < travel * travel)) {
+      moved_[i] = 1;
+      ++moved;
+    }
+  if (moved == 0 || moved > n / kRepairShare) return false;
+  const float inv_cell = listCell(pos, reach);
+  if (!(inv_cell > 0.0f)) return false;
+  auto at = [&](uint32_t i) { return vec3(pos[i]); };
+  auto touched = [&](uvec4 q) { return (moved_[q.x] | moved_[q.y] | moved_[q.z] | moved_[q.w]) != 0; };
+  vf_.erase(std::remove_if(vf_.begin(), vf_.end(), touched), vf_.end());
+  ee_.erase(std::remove_if(ee_.begin(), ee_.end(), touched), ee_.end());
+  std::mutex merge;
+  std::vector<uvec4> added_vf, added_ee;
+  // Calls look(k, found) for each of `dirty_` in parallel and gathers what they find into `added`
+  auto search = [&](std::vector<uvec4>& added, auto&& look) {
+    pool_.parallelFor(uint32_t(dirty_.size()), kGrainRepair, [&](uint32_t begin, uint32_t end) {
+      std::vector<uvec4> found;
+      for (uint32_t k = begin; k < end; ++k) look(dirty_[k], found);
+      const std::lock_guard<std::mutex> lock(merge);
+      added.insert(added.end(), found.begin(), found.end());
+    });
+  };
+  // The particles that moved against every triangle near them
+  lo_.resize(count);
+  hi_.resize(count);
+  for (uint32_t t = 0; t < count; ++t) {
+    const vec3 a = at(triangles[t].x), b = at(triangles[t].y), c = at(triangles[t].z);
+    lo_[t] = glm::min(a, glm::min(b, c));
+    hi_[t] = glm::max(a, glm::max(b, c));
+  }
+  grid_.build(lo_, hi_, inv_cell);
+  dirty_.clear();
+  for (uint32_t i = 0; i < n; ++i)
+    if (moved_[i]) dirty_.push_back(i);
+  search(added_vf, [&](uint32_t v, std::vector<uvec4>& found) {
+    const vec3 p = at(v);
+    visitBox(grid_, lo_, hi_, p - vec3(reach), p + vec3(reach), inv_cell, 0, [&](uint32_t t) {
+      const uvec4 tri = triangles[t];
+      if (v == tri.x || v == tri.y || v == tri.z) return;
+      if (pointTriangleDistance2(p, at(tri.x), at(tri.y), at(tri.z)) < reach2)
+        found.push_back(uvec4(v, tri.x, tri.y, tri.z));
+    });
+  });
+  // The triangles with a particle that moved against every other particle near them (those that
+  // moved found theirs above)
+  for (uint32_t i = 0; i < n; ++i) points_[i] = at(i);
+  points_grid_.build(points_, points_, inv_cell);
+  dirty_.clear();
+  for (uint32_t t = 0; t < count; ++t)
+    if (moved_[triangles[t].x] | moved_[triangles[t].y] | moved_[triangles[t].z]) dirty_.push_back(t);
+  search(added_vf, [&](uint32_t t, std::vector<uvec4>& found) {
+    const uvec4 tri = triangles[t];
+    const vec3 a = at(tri.x), b = at(tri.y), c = at(tri.z);
+    visitBox(points_grid_, points_, points_, lo_[t] - vec3(reach), hi_[t] + vec3(reach), inv_cell, 0, [&](uint32_t v) {
+      if (moved_[v] || v == tri.x || v == tri.y || v == tri.z) return;
+      if (pointTriangleDistance2(at(v), a, b, c) < reach2) found.push_back(uvec4(v, tri.x, tri.y, tri.z));
+    });
+  });
+  // The edges with a particle that moved against every edge near them, a pair of two such from the
+  // first of them
+  lo_.resize(edge_count);
+  hi_.resize(edge_count);
+  for (uint32_t k = 0; k < edge_count; ++k) {
+    lo_[k] = glm::min(at(edges_[k].x), at(edges_[k].y));
+    hi_[k] = glm::max(at(edges_[k].x), at(edges_[k].y));
+  }
+  grid_.build(lo_, hi_, inv_cell);
+  dirty_.clear();
+  for (uint32_t k = 0; k < edge_count; ++k)
+    if (moved_[edges_[k].x] | moved_[edges_[k].y]) dirty_.push_back(k);
+  search(added_ee, [&](uint32_t k, std::vector<uvec4>& found) {
+    const uvec2 e = edges_[k];
+    visitBox(grid_, lo_, hi_, lo_[k] - vec3(reach), hi_[k] + vec3(reach), inv_cell, 0, [&](uint32_t j) {
+      const uvec2 f = edges_[j];
+      if (j == k || f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
+      if ((moved_[f.x] | moved_[f.y]) && j < k) return;
+      if (segmentDistance2(at(e.x), at(e.y), at(f.x), at(f.y)) < reach2)
+        found.push_back(j < k ? uvec4(f, e) : uvec4(e, f));
+    });
+  });
+  // The same lists whatever the threads' order
+  std::sort(added_vf.begin(), added_vf.end(), less4);
+  std::sort(added_ee.begin(), added_ee.end(), less4);
+  vf_.insert(vf_.end(), added_vf.begin(), added_vf.end());
+  ee_.insert(ee_.end(), added_ee.begin(), added_ee.end());
+  for (uint32_t i = 0; i < n; ++i)
+    if (moved_[i]) base_[i] = glm::vec4(vec3(pos[i]) - middle, pos[i].w);
+  ++repairs_done_;
+  return true;
+}
+
 uint64_t CpuContact::memoryBytes() const {
   return capacityBytes(edges_) + capacityBytes(free_) + capacityBytes(was_free_) + capacityBytes(checked_) +
          capacityBytes(sums_) + capacityBytes(crossing_) + capacityBytes(vf_) + capacityBytes(ee_) +
          capacityBytes(base_) + capacityBytes(lo_) + capacityBytes(hi_) + capacityBytes(nearest2_) +
-         capacityBytes(grid_.start) + capacityBytes(grid_.entry) + capacityBytes(grid_.fill);
+         capacityBytes(grid_.start) + capacityBytes(grid_.entry) + capacityBytes(grid_.fill) + capacityBytes(points_) +
+         capacityBytes(moved_) + capacityBytes(dirty_) + capacityBytes(travels_) + capacityBytes(points_grid_.start) +
+         capacityBytes(points_grid_.entry) + capacityBytes(points_grid_.fill);
 }
 
 } // namespace tender

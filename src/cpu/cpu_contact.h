@@ -1,9 +1,11 @@
 #pragma once
 /// Penetration-free self-contact of the CPU solver: the step bound of every particle at the start
 /// of a substep (contact.h: the smallest of the contact radius and its distances to the triangles
-/// and edges near it, times SIM_CONTACT_FRACTION), found through a uniform grid that holds the
-/// triangles, then the edges, in every cell their boxes overlap. Each distance lowers the bounds of the particles of
-/// its pair by an atomic minimum, so the bounds are the same whatever the thread count or order.
+/// and edges near it, times SIM_CONTACT_FRACTION), from lists of the pairs near each other that a
+/// uniform grid of the triangles', then the edges', boxes finds, kept while the particles travel
+/// little and repaired where a few travelled far. Each distance lowers the bounds of the particles
+/// of its pair by an atomic minimum, so the bounds are the same whatever the thread count or order
+/// and whatever the lists hold beyond the pairs closer than the radius.
 #include <cstdint>
 #include <vector>
 
@@ -15,7 +17,9 @@ class WorkerPool;
 
 class CpuContact {
 public:
-  explicit CpuContact(WorkerPool& pool) : pool_(pool) {}
+  /// `repairs`: repair the pair lists where a few particles travelled too far instead of building
+  /// them whole (the bounds and pushes are the same bits either way).
+  CpuContact(WorkerPool& pool, bool repairs) : pool_(pool), repairs_(repairs) {}
 
   /// The step bound of each particle at `pos` (xyz; w inverse mass; `prev` where each was a
   /// substep before) in substep `s`, of the sheet made of the first `count` triangles of
@@ -30,8 +34,11 @@ public:
   glm::vec3 frame() const { return frame_; }
   /// Particles within the radius of a primitive at the last call.
   uint64_t contacts() const { return contacts_; }
-  /// The times the pair lists were built.
+  /// The times the pair lists were built whole.
   uint32_t listBuilds() const { return builds_; }
+  /// The times the pair lists were repaired: the pairs of the particles that travelled too far
+  /// looked for again (repairLists).
+  uint32_t listRepairs() const { return repairs_done_; }
   /// True when the sheet crossed itself at the last call (the particles of the crossing triangles
   /// went unbounded to untangle it).
   bool crossedItself() const { return tangles_; }
@@ -66,8 +73,21 @@ private:
   /// Lists the particle-triangle and edge-edge pairs closer than contactReach at `pos`.
   void buildLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                   float radius);
+  /// Repairs the lists when few particles travelled more than contactTravel from `middle`, the
+  /// travel most share: drops every pair with such a particle, lists those closer than
+  /// contactRepairReach anew and moves their particles' bases so that they travelled `middle`.
+  /// False (nothing changed) when too many did.
+  bool repairLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
+                   float radius);
+  /// The cells of the lists' grids for pairs within `reach` at `pos` (1 / their width), or 0 when
+  /// the positions have gone wrong.
+  float listCell(const std::vector<glm::vec4>& pos, float reach) const;
+
+  /// A repair looks for the pairs of at most 1 / kRepairShare of the particles; more build whole
+  static constexpr uint32_t kRepairShare = 8;
 
   WorkerPool& pool_;
+  bool repairs_;
   std::vector<glm::uvec4> vf_;     ///< particle, then the triangle's three: pairs within radius + skin
   std::vector<glm::ivec4> sums_;   ///< each particle's pushes in fixed point, and their count
   std::vector<glm::uvec4> ee_;     ///< two edges' particles: pairs within radius + skin
@@ -82,10 +102,15 @@ private:
   std::vector<glm::uvec2> edges_;  ///< the sheet's edges, each once (a < b)
   uint64_t edges_key_ = ~0ull;     ///< the triangle count the edges were worked out for
   std::vector<glm::vec3> lo_, hi_; ///< scratch: the boxes of the triangles, then of the edges
+  std::vector<glm::vec3> points_;  ///< scratch: the particles (a repair's grid of them)
+  std::vector<uint8_t> moved_;     ///< scratch: the particles a repair looks at
+  std::vector<float> travels_;     ///< scratch: one component of every particle's travel
+  std::vector<uint32_t> dirty_;    ///< scratch: the particles, triangles, edges a repair looks at
   std::vector<uint32_t> nearest2_; ///< the bits of each particle's smallest squared distance
-  Grid grid_;
+  Grid grid_, points_grid_;
   uint64_t contacts_ = 0;
   uint32_t builds_ = 0;
+  uint32_t repairs_done_ = 0;
   glm::vec3 frame_{0.0f};
 };
 

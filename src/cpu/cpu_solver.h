@@ -32,6 +32,9 @@ struct CpuOptions {
   /// whose particles have not travelled too far since the lists were built sums its repulsion
   /// from them instead of building the hash. The results are the same either way.
   bool candidate_lists = true;
+  /// Repair the contact's pair lists where a few particles travelled too far (CpuContact: their
+  /// pairs looked for again) instead of building them whole. The results are the same either way.
+  bool contact_repairs = true;
   /// Run the SIMD kernels (simd_kernels.h: SSE, and AVX where the CPU has it) for the projection,
   /// the tear test and the collision gather; off runs the scalar reference alone. The results are
   /// bitwise the same either way.
@@ -59,8 +62,9 @@ public:
   Arithmetic arithmetic() const override;
   uint32_t dispatchesPerTick() const override { return passes_per_tick_; }
   int64_t contacts() const override { return contact_on_ ? int64_t(contact_.contacts()) : -1; }
-  /// The times contact's pair lists were built so far.
+  /// The times contact's pair lists were built whole, and repaired, so far.
   uint32_t contactListBuilds() const { return contact_.listBuilds(); }
+  uint32_t contactListRepairs() const { return contact_.listRepairs(); }
   /// Bytes of host memory of the solver's own arrays (capacity, not size).
   uint64_t memoryBytes() const override;
   /// Worker threads in use, the caller included.

@@ -9,6 +9,7 @@ namespace tender {
 inline constexpr uint32_t kGrainParticles = 4096;   ///< integrate, floor, hash, reset: a few ns per particle
 inline constexpr uint32_t kGrainConstraints = 1024; ///< projection of one colour, tear marking: ~2 ns each
 inline constexpr uint32_t kGrainCollide = 256;      ///< collision gather: ~100 ns per particle
+inline constexpr uint32_t kGrainRepair = 32;        ///< a contact list repair's search: ~1 us per primitive
 /// Shares per worker of the collision loops: the cost of a particle varies with the crowd around it.
 inline constexpr uint32_t kCollideChunksPerWorker = 4;
 /// Below this many particles a whole substep takes tens of microseconds, and sharing its loops

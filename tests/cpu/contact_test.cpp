@@ -13,7 +13,9 @@
 #include "common/sim_helpers.h"
 #include "core/intersections.h"
 #include "core/stats.h"
+#include "cpu/cpu_contact.h"
 #include "cpu/cpu_solver.h"
+#include "cpu/worker_pool.h"
 #include "cpu_runs.h"
 #include "shaderio.h"
 
@@ -493,6 +495,55 @@ TEST(Contact, ASheetFallingAsAWholeIsNotHeldBack) {
   EXPECT_GT(speed, 4.0f * cap);
   EXPECT_LE(builds, 2u);
   EXPECT_EQ(hashPositions(free.pos), hashPositions(bounded.pos));
+}
+
+TEST(ContactLists, ARepairKeepsEveryPairCloserThanTheRadius) {
+  // Two layers of a 16 x 16 grid a radius apart, a triangle mesh of each, and at each call a few
+  // particles carried up to half a radius and the rest nudged: the bounds and pushes from lists
+  // repaired where particles travelled too far are those of lists built whole at every call
+  // (a bound is the nearest pair's, so a pair closer than the radius missing from the lists shows)
+  constexpr uint32_t kSide = 16, kLayer = kSide * kSide;
+  const float radius = 0.1f;
+  std::vector<glm::vec4> pos(2 * kLayer);
+  std::vector<glm::uvec4> triangles;
+  for (uint32_t l = 0; l < 2; ++l)
+    for (uint32_t y = 0; y < kSide; ++y)
+      for (uint32_t x = 0; x < kSide; ++x) {
+        const uint32_t i = l * kLayer + y * kSide + x;
+        pos[i] = glm::vec4(0.15f * float(x), radius * float(l), 0.15f * float(y) + 0.05f * float(l), 1.0f);
+        if (x + 1 < kSide && y + 1 < kSide) {
+          triangles.push_back(glm::uvec4(i, i + 1, i + kSide, 0));
+          triangles.push_back(glm::uvec4(i + 1, i + kSide + 1, i + kSide, 0));
+        }
+      }
+  shaderio::SimUniforms u{};
+  const float thickness = radius * SIM_CONTACT_THICKNESS;
+  u.contact = glm::vec4(radius, SIM_CONTACT_FRACTION, thickness, SIM_CONTACT_FIXED / thickness);
+  u.floor_y = -10.0f;
+  WorkerPool pool(2);
+  CpuContact whole(pool, false), repaired(pool, true);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::vector<float> bound_a, bound_b;
+  std::vector<glm::vec4> push_a, push_b;
+  uint32_t contacts = 0;
+  for (uint32_t call = 0; call < 120; ++call) {
+    const std::vector<glm::vec4> prev = pos;
+    for (glm::vec4& p : pos) {
+      const float reach = rng() % 40 == 0 ? 0.5f * radius : 0.03f * radius;
+      p += glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * reach;
+    }
+    whole.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_a, push_a);
+    repaired.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_b, push_b);
+    ASSERT_TRUE(sameBytes(bound_a, bound_b)) << "call " << call;
+    ASSERT_TRUE(sameBytes(push_a, push_b)) << "call " << call;
+    contacts += uint32_t(whole.contacts());
+  }
+  std::printf("%u particles in contact a call; lists built whole %u times, or %u times and repaired %u times\n",
+              contacts / 120u, whole.listBuilds(), repaired.listBuilds(), repaired.listRepairs());
+  EXPECT_GT(contacts / 120u, kLayer);
+  EXPECT_GT(repaired.listRepairs(), 60u);
+  EXPECT_EQ(whole.listRepairs(), 0u);
 }
 
 TEST(Contact, TheBoundsDoNotDependOnTheThreadCount) {
