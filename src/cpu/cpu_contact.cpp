@@ -209,15 +209,9 @@ void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vec
   }
   if (checked_.empty()) return;
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
-  lo_.resize(count);
-  hi_.resize(count);
+  boxTriangles(pos, triangles, count);
   float longest = 0.0f;
-  for (uint32_t t = 0; t < count; ++t) {
-    const vec3 a = at(triangles[t].x), b = at(triangles[t].y), c = at(triangles[t].z);
-    lo_[t] = glm::min(a, glm::min(b, c));
-    hi_[t] = glm::max(a, glm::max(b, c));
-    longest = std::max(longest, glm::compMax(hi_[t] - lo_[t]));
-  }
+  for (uint32_t t = 0; t < count; ++t) longest = std::max(longest, glm::compMax(hi_[t] - lo_[t]));
   crossing_.assign(count, 0);
   auto test = [&](uint32_t t, uint32_t o) {
     const uvec4 a = triangles[t], b = triangles[o];
@@ -275,13 +269,7 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
   std::mutex merge;
   // Particles against the triangles that do not hold them: the boxes of the triangles in the grid,
   // each particle's box of half-width `reach` against them
-  lo_.resize(count);
-  hi_.resize(count);
-  for (uint32_t t = 0; t < count; ++t) {
-    const vec3 a = at(triangles[t].x), b = at(triangles[t].y), c = at(triangles[t].z);
-    lo_[t] = glm::min(a, glm::min(b, c));
-    hi_[t] = glm::max(a, glm::max(b, c));
-  }
+  boxTriangles(pos, triangles, count);
   grid_.build(lo_, hi_, inv_cell);
   pool_.parallelFor(n, kGrainCollide, [&](uint32_t begin, uint32_t end) {
     std::vector<uvec4> found;
@@ -298,13 +286,7 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
     vf_.insert(vf_.end(), found.begin(), found.end());
   });
   // Edges against the edges that share no particle with them, each pair once
-  lo_.resize(edge_count);
-  hi_.resize(edge_count);
-  for (uint32_t k = 0; k < edge_count; ++k) {
-    const vec3 a = at(edges_[k].x), b = at(edges_[k].y);
-    lo_[k] = glm::min(a, b);
-    hi_[k] = glm::max(a, b);
-  }
+  boxEdges(pos);
   grid_.build(lo_, hi_, inv_cell);
   pool_.parallelFor(edge_count, kGrainCollide, [&](uint32_t begin, uint32_t end) {
     std::vector<uvec4> found;
@@ -330,6 +312,26 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
   list_radius_ = radius;
   lists_ = true;
   ++builds_;
+}
+
+void CpuContact::boxTriangles(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count) {
+  lo_.resize(count);
+  hi_.resize(count);
+  for (uint32_t t = 0; t < count; ++t) {
+    const vec3 a = vec3(pos[triangles[t].x]), b = vec3(pos[triangles[t].y]), c = vec3(pos[triangles[t].z]);
+    lo_[t] = glm::min(a, glm::min(b, c));
+    hi_[t] = glm::max(a, glm::max(b, c));
+  }
+}
+
+void CpuContact::boxEdges(const std::vector<glm::vec4>& pos) {
+  lo_.resize(edges_.size());
+  hi_.resize(edges_.size());
+  for (size_t k = 0; k < edges_.size(); ++k) {
+    const vec3 a = vec3(pos[edges_[k].x]), b = vec3(pos[edges_[k].y]);
+    lo_[k] = glm::min(a, b);
+    hi_[k] = glm::max(a, b);
+  }
 }
 
 float CpuContact::listCell(const std::vector<glm::vec4>& pos, float reach) const {
@@ -399,13 +401,7 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
     });
   };
   // The particles that moved against every triangle near them
-  lo_.resize(count);
-  hi_.resize(count);
-  for (uint32_t t = 0; t < count; ++t) {
-    const vec3 a = at(triangles[t].x), b = at(triangles[t].y), c = at(triangles[t].z);
-    lo_[t] = glm::min(a, glm::min(b, c));
-    hi_[t] = glm::max(a, glm::max(b, c));
-  }
+  boxTriangles(pos, triangles, count);
   grid_.build(lo_, hi_, inv_cell);
   dirty_.clear();
   for (uint32_t i = 0; i < n; ++i)
@@ -436,12 +432,7 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
   });
   // The edges with a particle that moved against every edge near them, a pair of two such from the
   // first of them
-  lo_.resize(edge_count);
-  hi_.resize(edge_count);
-  for (uint32_t k = 0; k < edge_count; ++k) {
-    lo_[k] = glm::min(at(edges_[k].x), at(edges_[k].y));
-    hi_[k] = glm::max(at(edges_[k].x), at(edges_[k].y));
-  }
+  boxEdges(pos);
   grid_.build(lo_, hi_, inv_cell);
   dirty_.clear();
   for (uint32_t k = 0; k < edge_count; ++k)

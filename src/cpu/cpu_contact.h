@@ -79,6 +79,9 @@ private:
   /// False (nothing changed) when too many did.
   bool repairLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                    float radius);
+  /// The boxes of the first `count` triangles at `pos`, then of the edges, into lo_ and hi_.
+  void boxTriangles(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count);
+  void boxEdges(const std::vector<glm::vec4>& pos);
   /// The cells of the lists' grids for pairs within `reach` at `pos` (1 / their width), or 0 when
   /// the positions have gone wrong.
   float listCell(const std::vector<glm::vec4>& pos, float reach) const;
