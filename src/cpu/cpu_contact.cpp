@@ -140,10 +140,11 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   const float r = radius, r2 = r * r;
   // The pair lists hold every pair that can be closer than r while the particles' travel since
   // they were built stays within contactTravel of one point (listsOutgrown)
-  const bool fresh = lists_ && list_radius_ == radius && based &&
-                     !listsOutgrown(orderedCorner(all.travel_lo), orderedCorner(all.travel_hi), radius);
-  const bool repairable = repairs_ && lists_ && list_radius_ == radius && based &&
-                          length2(orderedCorner(all.travel_hi) - orderedCorner(all.travel_lo)) < 1e30f;
+  const bool usable = lists_ && list_radius_ == radius && based;
+  const vec3 travel_lo = orderedCorner(all.travel_lo), travel_hi = orderedCorner(all.travel_hi);
+  const bool fresh = usable && !listsOutgrown(travel_lo, travel_hi, radius);
+  // or repairable around the particles that travelled beyond it (finite travels only)
+  const bool repairable = usable && repairs_ && length2(travel_hi - travel_lo) < 1e30f;
   if (!fresh && !(repairable && repairLists(pos, triangles, count, radius))) buildLists(pos, triangles, count, radius);
   sums_.assign(n, glm::ivec4(0));
   findCrossings(pos, triangles, count, s == 0 && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u, thickness, scale);
@@ -367,7 +368,6 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
   const float travel = contactTravel(radius), reach = contactRepairReach(radius), reach2 = reach * reach;
   // The travel most particles share: the componentwise median
   vec3 middle;
-  points_.resize(n);
   for (int c = 0; c < 3; ++c) {
     travels_.resize(n);
     for (uint32_t i = 0; i < n; ++i) travels_[i] = pos[i][c] - base_[i][c];
@@ -376,13 +376,13 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
   }
   if (!(length2(middle) < 1e30f)) return false;
   moved_.assign(n, 0);
-  uint32_t moved = 0;
+  dirty_.clear();
   for (uint32_t i = 0; i < n; ++i)
     if (!(length2(vec3(pos[i]) - vec3(base_[i]) - middle) < travel * travel)) {
       moved_[i] = 1;
-      ++moved;
+      dirty_.push_back(i);
     }
-  if (moved == 0 || moved > n / kRepairShare) return false;
+  if (dirty_.empty() || dirty_.size() > n / kRepairShare) return false;
   const float inv_cell = listCell(pos, reach);
   if (!(inv_cell > 0.0f)) return false;
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
@@ -403,9 +403,6 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
   // The particles that moved against every triangle near them
   boxTriangles(pos, triangles, count);
   grid_.build(lo_, hi_, inv_cell);
-  dirty_.clear();
-  for (uint32_t i = 0; i < n; ++i)
-    if (moved_[i]) dirty_.push_back(i);
   search(added_vf, [&](uint32_t v, std::vector<uvec4>& found) {
     const vec3 p = at(v);
     visitBox(grid_, lo_, hi_, p - vec3(reach), p + vec3(reach), inv_cell, 0, [&](uint32_t t) {
@@ -417,6 +414,7 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
   });
   // The triangles with a particle that moved against every other particle near them (those that
   // moved found theirs above)
+  points_.resize(n);
   for (uint32_t i = 0; i < n; ++i) points_[i] = at(i);
   points_grid_.build(points_, points_, inv_cell);
   dirty_.clear();
