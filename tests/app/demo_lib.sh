@@ -52,6 +52,22 @@ start_demo() {
   [ -n "$wid" ] || fail "no window appeared"
 }
 
+# Each thread of process $1: its name, its kernel wait channel and the CPU time it took over one
+# second (in clock ticks: a thread busy all the second takes about 100), so that a demo that does
+# not exit tells a thread waiting for ever from one still working; with gdb, the stacks too.
+stuck_threads() {
+  local t before=() i=0
+  for t in /proc/"$1"/task/*; do before+=("$(awk '{print $14 + $15}' "$t/stat" 2>/dev/null)"); done
+  sleep 1
+  for t in /proc/"$1"/task/*; do
+    echo "$(cat "$t/comm" 2>/dev/null): $(cat "$t/wchan" 2>/dev/null), $(($(awk '{print $14 + $15}' "$t/stat" 2>/dev/null || echo 0) - ${before[i]:-0})) ticks in 1 s"
+    i=$((i + 1))
+  done
+  if command -v gdb >/dev/null; then
+    gdb -batch -p "$1" -ex "thread apply all bt 12" 2>/dev/null | grep '^#\|^Thread'
+  fi
+}
+
 stop_demo() {
   # Escape again each second, in case one is lost; a demo still running after 20 s is stuck: the
   # threads' kernel wait channels say where, and it is stopped (TERM, then KILL) so that the test
@@ -64,13 +80,14 @@ stop_demo() {
   done
   if kill -0 "$demo" 2>/dev/null; then
     local where
-    where=$(for t in /proc/"$demo"/task/*; do echo "$(cat "$t/comm" 2>/dev/null): $(cat "$t/wchan" 2>/dev/null)"; done | sort | uniq -c)
+    where=$(stuck_threads "$demo")
     kill -TERM "$demo" 2>/dev/null
     for i in $(seq 50); do kill -0 "$demo" 2>/dev/null || break; sleep 0.1; done
     kill -KILL "$demo" 2>/dev/null
     wait "$demo"
     demo=
-    fail "tender-demo did not exit within 20 s of Escape; its threads were waiting in: $where"
+    fail "tender-demo did not exit within 20 s of Escape; its threads (name: wait channel, CPU time):
+$where"
   fi
   wait "$demo"
   local rc=$?
