@@ -33,7 +33,7 @@ void lower(uint32_t& slot, float d2) {
 
 /// Calls f(entry) once for each entry of `grid` from `first` on whose box overlaps the box [lo,
 /// hi]: in the cell that holds the lowest corner of the two boxes' overlap (both boxes are in that
-/// cell).
+/// cell; a bucket holds an entry once, so no entry is met twice).
 template <typename Grid, typename F>
 void visitBox(const Grid& grid, const std::vector<vec3>& lows, const std::vector<vec3>& highs, vec3 lo, vec3 hi,
               float inv_cell, uint32_t first, F&& f) {
@@ -73,17 +73,28 @@ void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3
   const uint32_t size = std::bit_ceil(std::max(2u * n, 16u));
   mask = size - 1;
   start.assign(size + 1, 0);
-  auto cells = [&](uint32_t i, auto&& f) {
+  // Calls f(h) for the bucket of each cell box i spans, each bucket once (two cells of a box may
+  // share one): `last` holds the box that last went into each bucket
+  last.assign(size, ~0u);
+  auto buckets = [&](uint32_t i, auto&& f) {
     const ivec3 a = cellOf(lo[i], inv_cell), b = cellOf(hi[i], inv_cell);
     for (int z = a.z; z <= b.z; ++z)
       for (int y = a.y; y <= b.y; ++y)
-        for (int x = a.x; x <= b.x; ++x) f(hashCell(ivec3(x, y, z), mask));
+        for (int x = a.x; x <= b.x; ++x) {
+          const uint32_t h = hashCell(ivec3(x, y, z), mask);
+          if (last[h] == i) continue;
+          last[h] = i;
+          f(h);
+        }
   };
-  for (uint32_t i = 0; i < n; ++i) cells(i, [&](uint32_t h) { ++start[h + 1]; });
+  for (uint32_t i = 0; i < n; ++i) buckets(i, [&](uint32_t h) { ++start[h + 1]; });
   for (uint32_t h = 0; h < size; ++h) start[h + 1] += start[h];
   entry.resize(start[size]);
   fill.assign(start.begin(), start.end() - 1);
-  for (uint32_t i = 0; i < n; ++i) cells(i, [&](uint32_t h) { entry[fill[h]++] = i; });
+  last.assign(size, ~0u);
+  for (uint32_t i = 0; i < n; ++i) {
+    buckets(i, [&](uint32_t h) { entry[fill[h]++] = i; });
+  }
 }
 
 void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::vec4>& prev,
@@ -303,12 +314,9 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
     const std::lock_guard<std::mutex> lock(merge);
     ee_.insert(ee_.end(), found.begin(), found.end());
   });
-  // The same lists whatever the threads' order, each pair once (a box may meet another in two
-  // cells of one bucket)
+  // The same lists whatever the threads' order (visitBox meets each pair once)
   std::sort(vf_.begin(), vf_.end(), less4);
   std::sort(ee_.begin(), ee_.end(), less4);
-  vf_.erase(std::unique(vf_.begin(), vf_.end()), vf_.end());
-  ee_.erase(std::unique(ee_.begin(), ee_.end()), ee_.end());
   base_ = pos;
   list_radius_ = radius;
   lists_ = true;
@@ -460,9 +468,10 @@ uint64_t CpuContact::memoryBytes() const {
   return capacityBytes(edges_) + capacityBytes(free_) + capacityBytes(was_free_) + capacityBytes(checked_) +
          capacityBytes(sums_) + capacityBytes(crossing_) + capacityBytes(vf_) + capacityBytes(ee_) +
          capacityBytes(base_) + capacityBytes(lo_) + capacityBytes(hi_) + capacityBytes(nearest2_) +
-         capacityBytes(grid_.start) + capacityBytes(grid_.entry) + capacityBytes(grid_.fill) + capacityBytes(points_) +
-         capacityBytes(moved_) + capacityBytes(dirty_) + capacityBytes(travels_) + capacityBytes(points_grid_.start) +
-         capacityBytes(points_grid_.entry) + capacityBytes(points_grid_.fill);
+         capacityBytes(grid_.start) + capacityBytes(grid_.entry) + capacityBytes(grid_.fill) +
+         capacityBytes(grid_.last) + capacityBytes(points_) + capacityBytes(moved_) + capacityBytes(dirty_) +
+         capacityBytes(travels_) + capacityBytes(points_grid_.start) + capacityBytes(points_grid_.entry) +
+         capacityBytes(points_grid_.fill) + capacityBytes(points_grid_.last);
 }
 
 } // namespace tender

@@ -53,9 +53,9 @@ public:
 
 private:
   /// A uniform grid of boxes hashed into a power-of-two table: a box is an entry of every cell it
-  /// overlaps; the entries of bucket h at [start[h], start[h + 1]).
+  /// overlaps, once in each bucket; the entries of bucket h at [start[h], start[h + 1]).
   struct Grid {
-    std::vector<uint32_t> start, entry, fill;
+    std::vector<uint32_t> start, entry, fill, last;
     uint32_t mask = 0;
     void build(const std::vector<glm::vec3>& lo, const std::vector<glm::vec3>& hi, float inv_cell);
   };

@@ -546,6 +546,95 @@ TEST(ContactLists, ARepairKeepsEveryPairCloserThanTheRadius) {
   EXPECT_EQ(whole.listRepairs(), 0u);
 }
 
+// Three layers of a side x side grid 0.4 radius apart (closer than the thickness: every particle
+// pushed), at each call shaken about their rest and one particle in `carried` carried up to half a
+// radius in its layer's plane (the lists repaired or built whole): the bounds and pushes are those
+// of every particle-triangle and edge-edge pair weighed once, found without a grid. A small sheet
+// has a small hash table, where two cells of one box often share a bucket.
+void expectBruteForceContact(uint32_t side, uint32_t carried, uint32_t calls) {
+  const uint32_t kSide = side, kLayer = kSide * kSide, kLayers = 3, n = kLayers * kLayer;
+  const float radius = 0.1f, thickness = radius * SIM_CONTACT_THICKNESS, r2 = radius * radius;
+  std::vector<glm::vec4> rest(n);
+  std::vector<glm::uvec4> triangles;
+  for (uint32_t l = 0; l < kLayers; ++l)
+    for (uint32_t y = 0; y < kSide; ++y)
+      for (uint32_t x = 0; x < kSide; ++x) {
+        const uint32_t i = l * kLayer + y * kSide + x;
+        rest[i] = glm::vec4(0.15f * float(x) + 0.05f * float(l), 0.4f * radius * float(l), 0.15f * float(y), 1.0f);
+        if (x + 1 < kSide && y + 1 < kSide) {
+          triangles.push_back(glm::uvec4(i, i + 1, i + kSide, 0));
+          triangles.push_back(glm::uvec4(i + 1, i + kSide + 1, i + kSide, 0));
+        }
+      }
+  std::vector<glm::uvec2> edges;
+  for (const glm::uvec4& t : triangles)
+    for (glm::uvec2 e : {glm::uvec2(t.x, t.y), glm::uvec2(t.y, t.z), glm::uvec2(t.z, t.x)})
+      edges.push_back(glm::uvec2(std::min(e.x, e.y), std::max(e.x, e.y)));
+  std::sort(edges.begin(), edges.end(), [](glm::uvec2 a, glm::uvec2 b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  shaderio::SimUniforms u{};
+  u.contact = glm::vec4(radius, SIM_CONTACT_FRACTION, thickness, SIM_CONTACT_FIXED / thickness);
+  u.floor_y = -10.0f;
+  WorkerPool pool(2);
+  CpuContact contact(pool, true);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::vector<glm::vec4> pos = rest, prev;
+  std::vector<float> bound, want_bound(n);
+  std::vector<glm::vec4> push, want_push(n);
+  for (uint32_t call = 0; call < calls; ++call) {
+    prev = pos;
+    for (uint32_t i = 0; i < n; ++i) {
+      const float carry = rng() % carried == 0 ? 0.5f * radius : 0.0f;
+      pos[i] = rest[i] + glm::vec4(unit(rng) * carry, 0.0f, unit(rng) * carry, 0.0f) +
+               glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.03f * radius;
+    }
+    contact.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound, push);
+    // Every pair once, without lists or a grid
+    std::vector<float> nearest2(n, r2);
+    std::vector<glm::ivec4> sums(n, glm::ivec4(0));
+    auto weigh = [&](glm::uvec4 q, ContactPair c) {
+      if (!(c.d2 < r2)) return;
+      for (uint32_t i : {q.x, q.y, q.z, q.w}) nearest2[i] = std::min(nearest2[i], c.d2);
+      if (!(c.d2 < thickness * thickness)) return;
+      for (uint32_t j = 0; j < 4; ++j) {
+        const glm::ivec3 f = shaderio::contactFixed(
+            shaderio::contactPush(pos[q.x], pos[q.y], pos[q.z], pos[q.w], c, thickness, j), u.contact.w);
+        sums[q[j]] += glm::ivec4(f, 1);
+      }
+    };
+    auto at = [&](uint32_t i) { return vec3(pos[i]); };
+    for (uint32_t v = 0; v < n; ++v)
+      for (const glm::uvec4& t : triangles)
+        if (v != t.x && v != t.y && v != t.z)
+          weigh(glm::uvec4(v, t.x, t.y, t.z), shaderio::pointTriangle(at(v), at(t.x), at(t.y), at(t.z)));
+    for (size_t a = 0; a < edges.size(); ++a)
+      for (size_t b = a + 1; b < edges.size(); ++b) {
+        const glm::uvec2 e = edges[a], f = edges[b];
+        if (e.x != f.x && e.x != f.y && e.y != f.x && e.y != f.y)
+          weigh(glm::uvec4(e, f), shaderio::segmentSegment(at(e.x), at(e.y), at(f.x), at(f.y)));
+      }
+    uint32_t pushed = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      want_bound[i] = shaderio::stepBound(nearest2[i], radius, u.contact.y);
+      want_push[i] = glm::vec4(
+          shaderio::contactPushWithin(shaderio::contactAverage(sums[i], u.contact.w), nearest2[i], radius), 0.0f);
+      pushed += sums[i].w > 0 ? 1u : 0u;
+    }
+    ASSERT_TRUE(sameBytes(bound, want_bound)) << side << " x " << side << ", call " << call;
+    ASSERT_TRUE(sameBytes(push, want_push)) << side << " x " << side << ", call " << call;
+    ASSERT_GT(pushed, n / 2) << side << " x " << side << ", call " << call;
+  }
+  std::printf("%u x %u x 3: lists built whole %u times, repaired %u times\n", side, side, contact.listBuilds(),
+              contact.listRepairs());
+  EXPECT_GT(contact.listRepairs(), calls / 3);
+}
+
+TEST(ContactLists, TheBoundsAndPushesAreThoseOfABruteForceSearch) {
+  expectBruteForceContact(4, 16, 60);
+  expectBruteForceContact(10, 30, 40);
+}
+
 TEST(Contact, TheBoundsDoNotDependOnTheThreadCount) {
   const SimParams p = flatCrumple(true);
   const std::string text = fastCrumple(p, flatState());
