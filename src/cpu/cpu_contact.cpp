@@ -33,7 +33,8 @@ void lower(uint32_t& slot, float d2) {
 
 /// Calls f(entry) once for each entry of `grid` from `first` on whose box overlaps the box [lo,
 /// hi]: in the cell that holds the lowest corner of the two boxes' overlap (both boxes are in that
-/// cell; a bucket holds an entry once, so no entry is met twice).
+/// cell; a bucket holds an entry once, so no entry is met twice). A bucket's entries rise (Grid::
+/// build), so it is read from its end down to `first`.
 template <typename Grid, typename F>
 void visitBox(const Grid& grid, const std::vector<vec3>& lows, const std::vector<vec3>& highs, vec3 lo, vec3 hi,
               float inv_cell, uint32_t first, F&& f) {
@@ -43,9 +44,9 @@ void visitBox(const Grid& grid, const std::vector<vec3>& lows, const std::vector
       for (int x = a.x; x <= b.x; ++x) {
         const ivec3 cell(x, y, z);
         const uint32_t h = hashCell(cell, grid.mask);
-        for (uint32_t k = grid.start[h]; k < grid.start[h + 1]; ++k) {
+        for (uint32_t k = grid.start[h + 1]; k-- > grid.start[h];) {
           const uint32_t e = grid.entry[k];
-          if (e < first) continue;
+          if (e < first) break;
           const vec3 elo = lows[e], ehi = highs[e];
           if (!(lo.x <= ehi.x && elo.x <= hi.x && lo.y <= ehi.y && elo.y <= hi.y && lo.z <= ehi.z && elo.z <= hi.z))
             continue;

@@ -53,7 +53,7 @@ public:
 
 private:
   /// A uniform grid of boxes hashed into a power-of-two table: a box is an entry of every cell it
-  /// overlaps, once in each bucket; the entries of bucket h at [start[h], start[h + 1]).
+  /// overlaps, once in each bucket; the entries of bucket h at [start[h], start[h + 1]), rising.
   struct Grid {
     std::vector<uint32_t> start, entry, fill, last;
     uint32_t mask = 0;
