@@ -64,7 +64,7 @@ stuck_threads() {
     i=$((i + 1))
   done
   if command -v gdb >/dev/null; then
-    gdb -batch -p "$1" -ex "thread apply all bt 12" 2>/dev/null | grep '^#\|^Thread'
+    timeout 30 gdb -batch -p "$1" -ex "thread apply all bt 12" 2>/dev/null | grep '^#\|^Thread'
   fi
 }
 
@@ -81,12 +81,17 @@ stop_demo() {
   if kill -0 "$demo" 2>/dev/null; then
     local where
     where=$(stuck_threads "$demo")
+    # SIGTERM ends a demo whose frame loop still runs (the summary lines then reach its output)
+    local term="SIGTERM ended it"
     kill -TERM "$demo" 2>/dev/null
     for i in $(seq 50); do kill -0 "$demo" 2>/dev/null || break; sleep 0.1; done
-    kill -KILL "$demo" 2>/dev/null
+    if kill -0 "$demo" 2>/dev/null; then
+      term="SIGTERM did not end it either: killed"
+      kill -KILL "$demo" 2>/dev/null
+    fi
     wait "$demo"
     demo=
-    fail "tender-demo did not exit within 20 s of Escape; its threads (name: wait channel, CPU time):
+    fail "tender-demo did not exit within 20 s of Escape ($term); its threads (name: wait channel, CPU time):
 $where"
   fi
   wait "$demo"
