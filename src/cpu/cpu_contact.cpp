@@ -93,9 +93,7 @@ void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3
   entry.resize(start[size]);
   fill.assign(start.begin(), start.end() - 1);
   last.assign(size, ~0u);
-  for (uint32_t i = 0; i < n; ++i) {
-    buckets(i, [&](uint32_t h) { entry[fill[h]++] = i; });
-  }
+  for (uint32_t i = 0; i < n; ++i) buckets(i, [&](uint32_t h) { entry[fill[h]++] = i; });
 }
 
 void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::vec4>& prev,

@@ -497,29 +497,48 @@ TEST(Contact, ASheetFallingAsAWholeIsNotHeldBack) {
   EXPECT_EQ(hashPositions(free.pos), hashPositions(bounded.pos));
 }
 
+// `layers` layers of a side x side grid 0.15 apart, a triangle mesh each: layer l at height gap x l,
+// moved by shift x l in its plane
+struct Layers {
+  std::vector<glm::vec4> pos;
+  std::vector<glm::uvec4> triangles;
+};
+Layers stackedLayers(uint32_t side, uint32_t layers, float gap, glm::vec2 shift) {
+  Layers out;
+  out.pos.resize(layers * side * side);
+  for (uint32_t l = 0; l < layers; ++l)
+    for (uint32_t y = 0; y < side; ++y)
+      for (uint32_t x = 0; x < side; ++x) {
+        const uint32_t i = (l * side + y) * side + x;
+        out.pos[i] = glm::vec4(0.15f * float(x) + shift.x * float(l), gap * float(l),
+                               0.15f * float(y) + shift.y * float(l), 1.0f);
+        if (x + 1 < side && y + 1 < side) {
+          out.triangles.push_back(glm::uvec4(i, i + 1, i + side, 0));
+          out.triangles.push_back(glm::uvec4(i + 1, i + side + 1, i + side, 0));
+        }
+      }
+  return out;
+}
+
+// The contact's uniforms for a radius (its thickness and fixed point as the solver sets them), the
+// floor far below
+shaderio::SimUniforms contactUniforms(float radius) {
+  shaderio::SimUniforms u{};
+  const float thickness = radius * SIM_CONTACT_THICKNESS;
+  u.contact = glm::vec4(radius, SIM_CONTACT_FRACTION, thickness, SIM_CONTACT_FIXED / thickness);
+  u.floor_y = -10.0f;
+  return u;
+}
+
 TEST(ContactLists, ARepairKeepsEveryPairCloserThanTheRadius) {
   // Two layers of a 16 x 16 grid a radius apart, a triangle mesh of each, and at each call a few
   // particles carried up to half a radius and the rest nudged: the bounds and pushes from lists
   // repaired where particles travelled too far are those of lists built whole at every call
   // (a bound is the nearest pair's, so a pair closer than the radius missing from the lists shows)
-  constexpr uint32_t kSide = 16, kLayer = kSide * kSide;
+  constexpr uint32_t kLayer = 16 * 16;
   const float radius = 0.1f;
-  std::vector<glm::vec4> pos(2 * kLayer);
-  std::vector<glm::uvec4> triangles;
-  for (uint32_t l = 0; l < 2; ++l)
-    for (uint32_t y = 0; y < kSide; ++y)
-      for (uint32_t x = 0; x < kSide; ++x) {
-        const uint32_t i = l * kLayer + y * kSide + x;
-        pos[i] = glm::vec4(0.15f * float(x), radius * float(l), 0.15f * float(y) + 0.05f * float(l), 1.0f);
-        if (x + 1 < kSide && y + 1 < kSide) {
-          triangles.push_back(glm::uvec4(i, i + 1, i + kSide, 0));
-          triangles.push_back(glm::uvec4(i + 1, i + kSide + 1, i + kSide, 0));
-        }
-      }
-  shaderio::SimUniforms u{};
-  const float thickness = radius * SIM_CONTACT_THICKNESS;
-  u.contact = glm::vec4(radius, SIM_CONTACT_FRACTION, thickness, SIM_CONTACT_FIXED / thickness);
-  u.floor_y = -10.0f;
+  auto [pos, triangles] = stackedLayers(16, 2, radius, glm::vec2(0.0f, 0.05f));
+  const shaderio::SimUniforms u = contactUniforms(radius);
   WorkerPool pool(2);
   CpuContact whole(pool, false), repaired(pool, true);
   std::mt19937 rng(3);
@@ -550,31 +569,18 @@ TEST(ContactLists, ARepairKeepsEveryPairCloserThanTheRadius) {
 // pushed), at each call shaken about their rest and one particle in `carried` carried up to half a
 // radius in its layer's plane (the lists repaired or built whole): the bounds and pushes are those
 // of every particle-triangle and edge-edge pair weighed once, found without a grid. A small sheet
-// has a small hash table, where two cells of one box often share a bucket.
+// has a small hash table, where two cells of one box are likelier to share a bucket.
 void expectBruteForceContact(uint32_t side, uint32_t carried, uint32_t calls) {
-  const uint32_t kSide = side, kLayer = kSide * kSide, kLayers = 3, n = kLayers * kLayer;
+  const uint32_t n = 3 * side * side;
   const float radius = 0.1f, thickness = radius * SIM_CONTACT_THICKNESS, r2 = radius * radius;
-  std::vector<glm::vec4> rest(n);
-  std::vector<glm::uvec4> triangles;
-  for (uint32_t l = 0; l < kLayers; ++l)
-    for (uint32_t y = 0; y < kSide; ++y)
-      for (uint32_t x = 0; x < kSide; ++x) {
-        const uint32_t i = l * kLayer + y * kSide + x;
-        rest[i] = glm::vec4(0.15f * float(x) + 0.05f * float(l), 0.4f * radius * float(l), 0.15f * float(y), 1.0f);
-        if (x + 1 < kSide && y + 1 < kSide) {
-          triangles.push_back(glm::uvec4(i, i + 1, i + kSide, 0));
-          triangles.push_back(glm::uvec4(i + 1, i + kSide + 1, i + kSide, 0));
-        }
-      }
+  const auto [rest, triangles] = stackedLayers(side, 3, 0.4f * radius, glm::vec2(0.05f, 0.0f));
   std::vector<glm::uvec2> edges;
   for (const glm::uvec4& t : triangles)
     for (glm::uvec2 e : {glm::uvec2(t.x, t.y), glm::uvec2(t.y, t.z), glm::uvec2(t.z, t.x)})
       edges.push_back(glm::uvec2(std::min(e.x, e.y), std::max(e.x, e.y)));
   std::sort(edges.begin(), edges.end(), [](glm::uvec2 a, glm::uvec2 b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  shaderio::SimUniforms u{};
-  u.contact = glm::vec4(radius, SIM_CONTACT_FRACTION, thickness, SIM_CONTACT_FIXED / thickness);
-  u.floor_y = -10.0f;
+  const shaderio::SimUniforms u = contactUniforms(radius);
   WorkerPool pool(2);
   CpuContact contact(pool, true);
   std::mt19937 rng(5);
