@@ -33,6 +33,14 @@
 // one closer than m/2 (only a sheet that starts so) does not move. No pair ends a substep closer
 // than the least of its distance at the start and m/2. (A push cut to 0.1 d alone let a pair
 // pressed below m close by a fifth each substep, towards touching.)
+// The bound need not hold along a pair, only across it (slideConstraint has why): a pair d < r
+// apart sets each of its particles a half-space, towards the other primitive along the pair's
+// normal by at most fraction x (d - m), and along the planes nothing; the ball of fraction x
+// (r - m) (slideBound) keeps the pairs farther than r apart. So a particle pressed on a layer
+// slides along it as fast as a free particle moves, where b(v) above held it to a fraction of its
+// distance in every direction. The steps are cut after the floor (slideStep): each step's excess
+// beyond its half-spaces (the mean over its pairs) taken out, the rest cut to the largest share
+// that keeps every one (they hold the zero step), then to the ball.
 #ifndef SIM_CONTACT_H
 #define SIM_CONTACT_H
 #include "exact_math.h"
@@ -162,7 +170,7 @@ SIM_INLINE float stepBound(float nearest2, float radius, float fraction) {
 
 /// A particle's push (contactAverage) cut to SIM_CONTACT_PUSH_FRACTION of the distance to its
 /// nearest primitive, sqrt(nearest2), less half the margin of contact radius `radius`: it moves the
-/// particle on top of its bound (contactStep), and with the bounds' fraction below 1/2 no pair
+/// particle on top of its bound (slideStep), and with the bounds' fraction below 1/2 no pair
 /// ends a substep closer than the least of its distance at the start and half the margin.
 SIM_INLINE vec3 contactPushWithin(vec3 push, float nearest2, float radius) {
   float most = SIM_CONTACT_PUSH_FRACTION * max(simSqrt(nearest2) - 0.5f * SIM_CONTACT_MARGIN * radius, 0.0f);
@@ -225,7 +233,7 @@ SIM_INLINE vec3 boundedStep(vec3 x0, vec3 x, float bound) {
   return x0 + d * simDiv(bound, simSqrt(l2));
 }
 
-/// True when a particle's substep is cut to its bound (contactStep): a free particle (inverse mass
+/// True when a particle's substep is cut to its bound (slideStep): a free particle (inverse mass
 /// `w` > 0) and the grabbed one while the user places it (`grab_w`: its grab_target.w, 1 held, 2
 /// tossed). The grab follows the hand as fast as its bound lets it and no faster, so no hand can
 /// carry the sheet through itself; a pinned particle does not move.
@@ -233,14 +241,13 @@ SIM_INLINE bool contactBounded(float w, bool is_grabbed, float grab_w) {
   return w > 0.0f || (is_grabbed && grab_w > 0.5f);
 }
 
-/// A particle's substep with contact (st: where it ends after the floor and its previous
-/// position; x0: where it started; push: contactPushWithin; frame: contactFrame): the step less the
-/// frame is cut to `bound` (boundedStep from x0 + frame), then the push moves it without speeding it
-/// up. A step cut short keeps the particle's speed at most, along the step it made: the contact
-/// never adds energy.
-SIM_INLINE VerletState contactStep(VerletState st, vec3 x0, vec3 push, float bound, vec3 frame) {
+/// A particle's substep with contact, its step less the frame ending at `target` (where its pairs'
+/// half-spaces cut it: slideTarget) before it is cut to `bound` (boundedStep from x0 + frame); then
+/// the push moves it without speeding it up. A step cut short keeps the particle's speed at most,
+/// along the step it made: the contact never adds energy.
+SIM_INLINE VerletState contactStepTo(VerletState st, vec3 target, vec3 x0, vec3 push, float bound, vec3 frame) {
   vec3 p = vec3(st.position), q = vec3(st.previous);
-  vec3 x = boundedStep(x0 + frame, p, bound);
+  vec3 x = boundedStep(x0 + frame, target, bound);
   if (x != p) {
     vec3 step = x - x0, v = p - q;
     float s2 = dot3(step, step), v2 = dot3(v, v);
@@ -250,6 +257,82 @@ SIM_INLINE VerletState contactStep(VerletState st, vec3 x0, vec3 push, float bou
   r.position = vec4(x + push, st.position.w);
   r.previous = vec4(q + push, st.previous.w);
   return r;
+}
+
+/// The step bound of a particle whose nearest primitive is sqrt(nearest2) away, in every direction:
+/// stepBound of the radius (the pairs closer bound the step along their normals: slideConstraint),
+/// or none within the margin.
+SIM_INLINE float slideBound(float nearest2, float radius, float fraction) {
+  float margin = SIM_CONTACT_MARGIN * radius;
+  return nearest2 > margin * margin ? stepBound(radius * radius, radius, fraction) : 0.0f;
+}
+
+/// The half-space a contact pair sets one of its particles' steps in: h.xyz the unit normal on the
+/// particle's side, h.w the most the step may go against it (h.w < 0: none), and `slack` how far
+/// the normal may be off from rounding (per unit of the step's length), which the step's length
+/// times it takes from what the step may go (slideAgainst).
+struct SlideHalf {
+  vec4 h;
+  float slack;
+};
+
+/// The half-space contact pair c (x: its particles; `edge`: two edges, else a particle and a
+/// triangle) d < radius apart and beyond the margin m sets its particle k in: the normal from the
+/// other primitive towards k's, and fraction x (d - m).
+/// Why it holds: the primitives are convex, so every corner of k's lies beyond the plane through its
+/// nearest point normal to the pair's, and every corner of the other short of the plane through
+/// that one's; with no corner of either moving towards the other by more than fraction x (d - m),
+/// the slab between the two planes keeps (1 - 2 fraction) d + 2 fraction m, however far they move
+/// along them. The normal that rounds off the true one by e carries a step s along it by e |s| more
+/// than it says: the slack.
+SIM_INLINE SlideHalf slideConstraint(vec3 x0, vec3 x1, vec3 x2, vec3 x3, ContactPair c, bool edge, float radius,
+                                     float fraction, uint k) {
+  SlideHalf r;
+  r.h = vec4(0.0f, 0.0f, 0.0f, -1.0f);
+  r.slack = 0.0f;
+  float margin = SIM_CONTACT_MARGIN * radius;
+  if (!(c.d2 < radius * radius) || !(c.d2 > margin * margin)) return r;
+  vec3 sep = x0 * c.w.x + x1 * c.w.y + x2 * c.w.z + x3 * c.w.w;
+  vec3 big = max(max(abs(x0), abs(x1)), max(abs(x2), abs(x3)));
+  float len = simSqrt(c.d2);
+  r.h = vec4(sep * simDiv(k == 0u || (edge && k == 1u) ? 1.0f : -1.0f, len), fraction * (len - margin));
+  r.slack = SIM_CONTACT_SLACK * simDiv(max(big.x, max(big.y, big.z)) + 1.0f, len);
+  return r;
+}
+
+/// How far `step` goes along the half-space's normal, less its slack: against it when negative.
+SIM_INLINE float slideAgainst(SlideHalf c, vec3 step) {
+  return dot3(vec3(c.h), step) - c.slack * simSqrt(dot3(step, step));
+}
+
+/// The move along the half-space's normal that takes out what `step` goes against it beyond h.w;
+/// zero when the step keeps it.
+SIM_INLINE vec3 slideExcess(SlideHalf c, vec3 step) {
+  float a = slideAgainst(c, step);
+  return c.h.w >= 0.0f && a < -c.h.w ? vec3(c.h) * (-c.h.w - a) : vec3(0.0f);
+}
+
+/// The largest share in [0, 1] of `step` that keeps the half-space (slideAgainst scales with the
+/// step, and the zero step keeps it).
+SIM_INLINE float slideShare(SlideHalf c, vec3 step) {
+  float a = slideAgainst(c, step);
+  return c.h.w >= 0.0f && a < -c.h.w ? simDiv(c.h.w, -a) : 1.0f;
+}
+
+/// Where a particle's step less the frame goes before its bound (slideStep): p itself when no
+/// half-space cuts it (`share` 1, no `excess`), else its excess (the mean of slideExcess over its
+/// pairs) taken out and the rest cut to `share` (the least slideShare of that over its pairs).
+SIM_INLINE vec3 slideTarget(vec3 p, vec3 from, vec3 excess, float share) {
+  return share < 1.0f || dot3(excess, excess) > 0.0f ? from + ((p - from) + excess) * share : p;
+}
+
+/// A particle's substep with contact (st: where it ends after the floor and its previous position;
+/// x0: where it started; push: contactPushWithin; frame: contactFrame; excess and share: what its
+/// pairs' half-spaces take out of its step and leave of it, slideTarget): the step less the frame
+/// cut to them, then to `bound`, then pushed (contactStepTo).
+SIM_INLINE VerletState slideStep(VerletState st, vec3 x0, vec3 push, vec3 excess, float share, float bound,
+                                 vec3 frame) {
+  return contactStepTo(st, slideTarget(vec3(st.position), x0 + frame, excess, share), x0, push, bound, frame);
 }
 
 /// Six times the signed volume of the tetrahedron a, b, c, d: positive when d lies on the side of

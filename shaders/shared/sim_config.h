@@ -237,6 +237,10 @@
 // particle on top of its bound (contactPushWithin): two sides moving 0.4 (d - m) + 0.1 (d - m/2)
 // each keep 0.9 m between them, and no pair closes below m/2
 #define SIM_CONTACT_PUSH_FRACTION 0.1f
+// How far a pair's normal (slideConstraint) may turn from rounding, per unit of the largest
+// coordinate of its particles (and one) over their distance: far above the rounding of the nearest
+// points and their difference (a few parts in 2^23 of the coordinates)
+#define SIM_CONTACT_SLACK 1.52587890625e-5f
 // The thickness of the contact, per unit of contact radius: closer pairs are pushed apart
 #define SIM_CONTACT_THICKNESS 0.5f
 // Fixed-point units of the contact pushes per unit of thickness (contactFixed), and the largest

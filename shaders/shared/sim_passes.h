@@ -52,6 +52,9 @@
   X(limit, SIM, 1, 1)                                                                                                  \
   X(crease, SIM, 1, 1)                                                                                                 \
   X(floor, SIM, 1, 1)                                                                                                  \
+  X(contact_excess, SIM, 1, 0)                                                                                         \
+  X(contact_share, SIM, 1, 0)                                                                                          \
+  X(contact_step, SIM, 1, 0)                                                                                           \
   X(tear_mark, SIM, 1, 1)                                                                                              \
   X(tear_unsupported, NONE, 1, 1)                                                                                      \
   X(tear_flags, NONE, 1, 1)                                                                                            \
@@ -138,6 +141,9 @@
   X(limit, limit, RINGS, Threads, LIMIT, LIMIT, Project)                                                               \
   X(crease, crease, HINGES, Threads, CREASE, CREASE, Project)                                                          \
   X(floor, floor, PARTICLES, Threads, TICK, ALWAYS, Floor)                                                             \
+  X(floor, contact_excess, CONTACT_QUERIES, Threads, TICK, CONTACT, Floor)                                             \
+  X(floor, contact_share, CONTACT_QUERIES, Threads, TICK, CONTACT, Floor)                                              \
+  X(floor, contact_step, PARTICLES, Threads, TICK, CONTACT, Floor)                                                     \
   X(tear, tear_mark, CONSTRAINTS, Threads, TICK, CONSTRAINTS, Tear)                                                    \
   X(tear, tear_unsupported, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                       \
   X(tear, tear_flags, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                             \

@@ -408,6 +408,10 @@ void contactCross(uint t, uint s) {
 #define NEAR_ALL 0u
 #define NEAR_SEARCH 1u
 #define NEAR_WALK 2u
+// ... or every query's pairs at the start of the substep again, through its list or (overflowed)
+// the grid, for the half-spaces of the steps (contact_excess, contact_share: slidePair)
+#define NEAR_EXCESS 3u
+#define NEAR_SHARE 4u
 // Candidates contactNearOf gathers before it weighs them
 #define CONTACT_BATCH 16u
 
@@ -419,11 +423,38 @@ void contactCross(uint t, uint s) {
 // low corner of the two boxes' overlap), and one place weighs a pair: a CPU device runs every
 // instruction of a kernel for each group of invocations, whatever the branches, so the kernel is
 // kept short.
+// Where contactNearOf weighs particle j: where it is, or where it started the substep (the
+// half-spaces' passes, after the floor)
+vec4 nearPosition(uint j, uint only) { return only >= NEAR_EXCESS ? contact_particles[j].start : SIM_POSITION(j); }
+
+// The half-spaces pair q sets its particles' steps in (slideConstraint; `edge`: two edges), from
+// where they started the substep: each step's excess beyond them summed into its particle's sums
+// (NEAR_EXCESS), or the share of the step less that excess's mean that keeps them lowering its
+// share (NEAR_SHARE)
+void slidePair(uvec4 q, ContactPair c, bool edge, uint only) {
+  vec3 x0 = vec3(contact_particles[q.x].start), x1 = vec3(contact_particles[q.y].start),
+       x2 = vec3(contact_particles[q.z].start), x3 = vec3(contact_particles[q.w].start);
+  vec3 frame = contactFrameNow();
+  for (uint j = 0u; j < 4u; ++j) {
+    SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, u.contact.x, u.contact.y, j);
+    if (h.h.w < 0.0f) continue;
+    uint i = j == 0u ? q.x : (j == 1u ? q.y : (j == 2u ? q.z : q.w));
+    vec3 step = vec3(SIM_POSITION(i)) - (vec3(contact_particles[i].start) + frame);
+    if (only == NEAR_EXCESS) {
+      vec3 e = slideExcess(h, step);
+      if (e != vec3(0.0f)) addPush(i, e);
+    } else {
+      float share = slideShare(h, step + contactAverage(ivec4(contact_particles[i].sum), u.contact.w));
+      if (share < 1.0f) atomicMin(contact_particles[i].state.z, floatBitsToUint(share));
+    }
+  }
+}
+
 void contactNearOf(uint k, uint only, bool particle) {
   if (contactGoneWrong()) return;
   uint self = particle ? k : k - u.particle_count;
   uint list = listOf(k);
-  bool build = only != NEAR_WALK && listsRebuilt();
+  bool build = only < NEAR_WALK && listsRebuilt();
   uint count = build ? 0u : contact_lists[list];
   // Through its list (which holds only live primitives: a tear builds the lists again)
   bool walk = only == NEAR_WALK || (!build && count <= u.contact_check.w);
@@ -433,12 +464,12 @@ void contactNearOf(uint k, uint only, bool particle) {
   uvec2 edge = uvec2(0u);
   vec3 lo, hi;
   if (particle) {
-    lo = vec3(SIM_POSITION(k));
+    lo = vec3(nearPosition(k, only));
     hi = lo;
   } else {
     if (self >= contactEdgeCount() || !contactEdgeLive(self)) return;
     edge = contactEdge(self).xy;
-    vec3 ea = vec3(SIM_POSITION(edge.x)), eb = vec3(SIM_POSITION(edge.y));
+    vec3 ea = vec3(nearPosition(edge.x, only)), eb = vec3(nearPosition(edge.y, only));
     lo = min(ea, eb);
     hi = max(ea, eb);
   }
@@ -502,9 +533,13 @@ void contactNearOf(uint k, uint only, bool particle) {
       }
       bool free = contactFree(q.x) || contactFree(q.y) || contactFree(q.z) || contactFree(q.w);
       if (free && into == SIM_NONE) continue;
-      vec3 x0 = vec3(SIM_POSITION(q.x)), x1 = vec3(SIM_POSITION(q.y)), x2 = vec3(SIM_POSITION(q.z)),
-           x3 = vec3(SIM_POSITION(q.w));
+      vec3 x0 = vec3(nearPosition(q.x, only)), x1 = vec3(nearPosition(q.y, only)), x2 = vec3(nearPosition(q.z, only)),
+           x3 = vec3(nearPosition(q.w, only));
       ContactPair c = particle ? pointTriangle(x0, x1, x2, x3) : segmentSegment(x0, x1, x2, x3);
+      if (only >= NEAR_EXCESS) {
+        if (!free) slidePair(q, c, !particle, only);
+        continue;
+      }
       if (into != SIM_NONE) listPair(into, c.d2, other);
       if (!free) contactPair(q, c);
     }
@@ -579,10 +614,27 @@ void contactBound(uint i) {
   uint nearest = contactGoneWrong() ? 0u : contact_particles[i].state.x;
   if (nearest < floatBitsToUint(r * r)) atomicAdd(contact_words[CONTACT_COUNT], 1u);
   contact_particles[i].start.w =
-      contactFree(i) ? uintBitsToFloat(0x7F800000u) : stepBound(uintBitsToFloat(nearest), r, u.contact.y);
+      contactFree(i) ? uintBitsToFloat(0x7F800000u) : slideBound(uintBitsToFloat(nearest), r, u.contact.y);
   contact_particles[i].push =
       vec4(contactPushWithin(contactAverage(ivec4(contact_particles[i].sum), u.contact.w), uintBitsToFloat(nearest), r),
            0.0f);
+}
+
+// The floor's step with contact (after floor.comp, contact_excess and contact_share): particle i's
+// step less the frame cut to its pairs' half-spaces (the excess's mean taken out, the rest cut to
+// the share), then to its bound, then pushed (slideStep)
+VerletState contactSlideStep(uint i, VerletState st, uint s) {
+  if (!contactBounded(st.position.w, i == u.grab_index, u.grab_target[s].w)) return st;
+  return slideStep(st, vec3(contact_particles[i].start), vec3(contact_particles[i].push),
+                   contactAverage(ivec4(contact_particles[i].sum), u.contact.w),
+                   uintBitsToFloat(contact_particles[i].state.z), contact_particles[i].start.w, contactFrameNow());
+}
+
+// What the floor pass leaves for the half-spaces' passes: particle i's sums cleared for the
+// excess and its share whole
+void contactSlideClear(uint i) {
+  contact_particles[i].sum = uvec4(0u);
+  contact_particles[i].state.z = floatBitsToUint(1.0f);
 }
 
 #endif

@@ -71,6 +71,26 @@ void scanWorkgroup(uint mode, uint offset, uint count, uint sums) {
 }
 
 #ifdef SIM_FUSED_CONTACT
+// The floor's steps with contact (as contact_excess, contact_share and contact_step): each query's
+// pairs from where the particles started, twice, then each step cut
+void contactSlideSubstep(uint s, uint n) {
+  uint lid = gl_LocalInvocationID.x;
+  uint queries = u.particle_count + contactEdgeCount();
+  for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_EXCESS);
+  sync();
+  for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_SHARE);
+  sync();
+  for (uint i = lid; i < n; i += kInvocations) {
+    VerletState st;
+    st.position = s_pos[i];
+    st.previous = prev[i];
+    st = contactSlideStep(i, st, s);
+    s_pos[i] = st.position;
+    prev[i] = st.previous;
+  }
+  sync();
+}
+
 // Contact (as the contact_* passes, contact.glsl): each particle's step bound and push for substep
 // s, from where it starts it.
 void contactSubstep(uint s, uint n) {
@@ -272,14 +292,17 @@ void main() {
     for (uint i = lid; i < n; i += kInvocations) {
       VerletState st = floorContact(s_pos[i], prev[i], u.floor_y, u.restitution, u.friction);
 #ifdef SIM_FUSED_CONTACT
-      if (u.contact.x > 0.0f && contactBounded(st.position.w, i == u.grab_index, u.grab_target[s].w))
-        st = contactStep(st, vec3(contact_particles[i].start), vec3(contact_particles[i].push),
-                         contact_particles[i].start.w, contactFrameNow());
+      if (u.contact.x > 0.0f) contactSlideClear(i);
 #endif
       s_pos[i] = st.position;
       prev[i] = st.previous;
     }
     sync();
+#ifdef SIM_FUSED_CONTACT
+    // With contact, the steps cut to their pairs' half-spaces and their bounds (as contact_excess,
+    // contact_share and contact_step)
+    if (u.contact.x > 0.0f) contactSlideSubstep(s, n);
+#endif
     if (stopsAfter(first_pass + floor_pass)) {
       storePositions(n);
       return;

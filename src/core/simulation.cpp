@@ -232,10 +232,8 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   u.hinge = glm::uvec4(topo_.hinge_first, topo_.hingeCount(), 0u, 0u);
   u.crease = glm::vec4(p.hingeCompliance(), float(double(p.crease_yield) * (3.14159265358979323846 / 180.0)),
                        p.crease_hardening, 0.0f);
-  // The stretch limit, off with contact: a limit that draws a particle to a parent across a layer
-  // fights the contact's bound, which keeps the speed of a step it cuts
-  if (p.stretch_limit > 0.0f && !(p.contactRadius() > 0.0f))
-    u.limit = glm::vec4(p.stretch_limit * p.spacing, p.spacing, 0.0f, 0.0f);
+  // The stretch limit (with contact, its places are steps the contact cuts as any)
+  if (p.stretch_limit > 0.0f) u.limit = glm::vec4(p.stretch_limit * p.spacing, p.spacing, 0.0f, 0.0f);
   u.reset_active = reset_frame_ > 0 ? 1u : 0u;
   u.reset_alpha = reset_frame_ > 0 ? float(SIM_RESET_FRAMES - reset_frame_ + 1) / float(SIM_RESET_FRAMES) : 0.0f;
   u.iterations = p.iterations;

@@ -186,11 +186,55 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   uint64_t contacts = 0;
   for (uint32_t i = 0; i < n; ++i) {
     contacts += nearest2_[i] < none ? 1u : 0u;
-    bound[i] = free_[i] ? INFINITY : stepBound(std::bit_cast<float>(nearest2_[i]), radius, u.contact.y);
+    bound[i] = free_[i] ? INFINITY : slideBound(std::bit_cast<float>(nearest2_[i]), radius, u.contact.y);
     push[i] =
         glm::vec4(contactPushWithin(contactAverage(sums_[i], scale), std::bit_cast<float>(nearest2_[i]), radius), 0.0f);
   }
   contacts_ = contacts;
+}
+
+void CpuContact::slide(const std::vector<glm::vec4>& start, const std::vector<glm::vec4>& pos, const SimUniforms& u,
+                       std::vector<glm::vec4>& excess, std::vector<float>& share) {
+  const uint32_t n = uint32_t(pos.size());
+  const float radius = u.contact.x, fraction = u.contact.y, scale = u.contact.w;
+  excess.assign(n, glm::vec4(0.0f));
+  share.assign(n, 1.0f);
+  sums_.assign(n, glm::ivec4(0));
+  auto at = [&](uint32_t i) { return vec3(start[i]); };
+  auto step = [&](uint32_t i) { return vec3(pos[i]) - (vec3(start[i]) + frame_); };
+  // Each pair's half-spaces, weighed at the start as computeBounds weighed it; `visit` sees each
+  // of its particles' (a pair once; the sums and minimums do not depend on the order)
+  auto pairs = [&](auto&& visit) {
+    for (const bool edge : {false, true}) {
+      const std::vector<uvec4>& list = edge ? ee_ : vf_;
+      pool_.parallelFor(uint32_t(list.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
+        for (uint32_t k = begin; k < end; ++k) {
+          const uvec4 q = list[k];
+          if (free_[q.x] | free_[q.y] | free_[q.z] | free_[q.w]) continue;
+          const vec3 x0 = at(q.x), x1 = at(q.y), x2 = at(q.z), x3 = at(q.w);
+          const ContactPair c = edge ? segmentSegment(x0, x1, x2, x3) : pointTriangle(x0, x1, x2, x3);
+          if (!(c.d2 < radius * radius)) continue;
+          for (uint32_t j = 0; j < 4; ++j) {
+            const SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, radius, fraction, j);
+            if (h.h.w >= 0.0f) visit(q[j], h);
+          }
+        }
+      });
+    }
+  };
+  if (!lists_) return; // positions gone wrong: the bounds hold every particle
+  pairs([&](uint32_t i, const SlideHalf& h) {
+    const vec3 e = slideExcess(h, step(i));
+    if (e != vec3(0.0f)) addPush(i, e, scale);
+  });
+  for (uint32_t i = 0; i < n; ++i) excess[i] = glm::vec4(contactAverage(sums_[i], scale), 0.0f);
+  std::vector<uint32_t>& bits = share_bits_;
+  bits.assign(n, std::bit_cast<uint32_t>(1.0f));
+  pairs([&](uint32_t i, const SlideHalf& h) {
+    const float s = slideShare(h, step(i) + vec3(excess[i]));
+    if (s < 1.0f) lower(bits[i], s);
+  });
+  for (uint32_t i = 0; i < n; ++i) share[i] = std::bit_cast<float>(bits[i]);
 }
 
 void CpuContact::addPush(uint32_t i, vec3 push, float scale) {

@@ -1,10 +1,11 @@
 #pragma once
 /// Penetration-free self-contact of the CPU solver: the step bound of every particle at the start
-/// of a substep (contact.h: the smallest of the contact radius and its distances to the triangles
-/// and edges near it, times SIM_CONTACT_FRACTION), from lists of the pairs near each other that a
-/// uniform grid of the triangles', then the edges', boxes finds, kept while the particles travel
-/// little and repaired where a few travelled far. Each distance lowers the bounds of the particles
-/// of its pair by an atomic minimum, so the bounds are the same whatever the thread count or order
+/// of a substep (contact.h: slideBound, from the nearest of the triangles and edges near it) and,
+/// after the floor, the cut of each step to its pairs' half-spaces (slide), from lists of the
+/// pairs near each other that a uniform grid of the triangles', then the edges', boxes finds, kept
+/// while the particles travel little and repaired where a few travelled far. Each distance lowers
+/// the bounds of the particles of its pair by an atomic minimum, and each half-space their shares
+/// (their excesses are integer sums), so the bits are the same whatever the thread count or order
 /// and whatever the lists hold beyond the pairs closer than the radius.
 #include <cstdint>
 #include <vector>
@@ -30,6 +31,12 @@ public:
   void computeBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::vec4>& prev,
                      const std::vector<glm::uvec4>& triangles, uint32_t count, const shaderio::SimUniforms& u,
                      uint32_t s, std::vector<float>& bound, std::vector<glm::vec4>& push);
+  /// The half-spaces of the pairs of the last computeBounds on the steps of the substep (the
+  /// particles from `start`, where that call had them, to `pos`, less frame()): each particle's
+  /// excess beyond them, the mean of slideExcess over its pairs, into `excess`, and the share of its
+  /// step with that taken out that keeps every one, the least slideShare, into `share` (slideStep).
+  void slide(const std::vector<glm::vec4>& start, const std::vector<glm::vec4>& pos, const shaderio::SimUniforms& u,
+             std::vector<glm::vec4>& excess, std::vector<float>& share);
   /// The translation taken out of the steps of the substep of the last call before their bounds.
   glm::vec3 frame() const { return frame_; }
   /// Particles within the radius of a primitive at the last call.
@@ -91,25 +98,26 @@ private:
 
   WorkerPool& pool_;
   bool repairs_;
-  std::vector<glm::uvec4> vf_;     ///< particle, then the triangle's three: pairs within radius + skin
-  std::vector<glm::ivec4> sums_;   ///< each particle's pushes in fixed point, and their count
-  std::vector<glm::uvec4> ee_;     ///< two edges' particles: pairs within radius + skin
-  std::vector<glm::vec4> base_;    ///< where the particles were when the lists were built
-  bool lists_ = false;             ///< the lists are usable
-  std::vector<uint8_t> free_;      ///< particles of triangles crossing another: not bounded
-  std::vector<uint8_t> was_free_;  ///< free_ of the last call
-  std::vector<uint32_t> checked_;  ///< scratch: the triangles checked for crossing
-  std::vector<uint8_t> crossing_;  ///< scratch: the triangles crossing another
-  bool tangles_ = false;           ///< the sheet crossed itself at the last call
-  float list_radius_ = 0.0f;       ///< the contact radius they were built for
-  std::vector<glm::uvec2> edges_;  ///< the sheet's edges, each once (a < b)
-  uint64_t edges_key_ = ~0ull;     ///< the triangle count the edges were worked out for
-  std::vector<glm::vec3> lo_, hi_; ///< scratch: the boxes of the triangles, then of the edges
-  std::vector<glm::vec3> points_;  ///< scratch: the particles (a repair's grid of them)
-  std::vector<uint8_t> moved_;     ///< scratch: the particles a repair looks at
-  std::vector<float> travels_;     ///< scratch: one component of every particle's travel
-  std::vector<uint32_t> dirty_;    ///< scratch: the particles, triangles, edges a repair looks at
-  std::vector<uint32_t> nearest2_; ///< the bits of each particle's smallest squared distance
+  std::vector<glm::uvec4> vf_;       ///< particle, then the triangle's three: pairs within radius + skin
+  std::vector<glm::ivec4> sums_;     ///< each particle's pushes in fixed point, and their count
+  std::vector<glm::uvec4> ee_;       ///< two edges' particles: pairs within radius + skin
+  std::vector<glm::vec4> base_;      ///< where the particles were when the lists were built
+  bool lists_ = false;               ///< the lists are usable
+  std::vector<uint8_t> free_;        ///< particles of triangles crossing another: not bounded
+  std::vector<uint8_t> was_free_;    ///< free_ of the last call
+  std::vector<uint32_t> checked_;    ///< scratch: the triangles checked for crossing
+  std::vector<uint8_t> crossing_;    ///< scratch: the triangles crossing another
+  bool tangles_ = false;             ///< the sheet crossed itself at the last call
+  float list_radius_ = 0.0f;         ///< the contact radius they were built for
+  std::vector<glm::uvec2> edges_;    ///< the sheet's edges, each once (a < b)
+  uint64_t edges_key_ = ~0ull;       ///< the triangle count the edges were worked out for
+  std::vector<glm::vec3> lo_, hi_;   ///< scratch: the boxes of the triangles, then of the edges
+  std::vector<glm::vec3> points_;    ///< scratch: the particles (a repair's grid of them)
+  std::vector<uint8_t> moved_;       ///< scratch: the particles a repair looks at
+  std::vector<float> travels_;       ///< scratch: one component of every particle's travel
+  std::vector<uint32_t> dirty_;      ///< scratch: the particles, triangles, edges a repair looks at
+  std::vector<uint32_t> nearest2_;   ///< the bits of each particle's smallest squared distance
+  std::vector<uint32_t> share_bits_; ///< scratch: the bits of each particle's share (slide)
   Grid grid_, points_grid_;
   uint64_t contacts_ = 0;
   uint32_t builds_ = 0;

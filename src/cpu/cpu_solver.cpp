@@ -242,15 +242,25 @@ void CpuSolver::repelPass(const SimUniforms& u) {
 void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
   const bool contact = u.contact.x > 0.0f;
   const vec3 frame = contact ? contact_.frame() : vec3(0.0f);
-  pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
-    vec4* pos = pos_.data();
-    vec4* prev = prev_.data();
+  const uint32_t n = uint32_t(pos_.size());
+  pool_->parallelFor(n, grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
     for (uint32_t i = begin; i < end; ++i) {
-      VerletState st = floorContact(pos[i], prev[i], u.floor_y, u.restitution, u.friction);
-      if (contact && contactBounded(st.position.w, i == u.grab_index, u.grab_target[s].w))
-        st = contactStep(st, vec3(start_[i]), vec3(push_[i]), bound_[i], frame);
-      pos[i] = st.position;
-      prev[i] = st.previous;
+      const VerletState st = floorContact(pos_[i], prev_[i], u.floor_y, u.restitution, u.friction);
+      pos_[i] = st.position;
+      prev_[i] = st.previous;
+    }
+  });
+  if (!contact) return;
+  // The steps' excess beyond their pairs' half-spaces and the share that keeps them, then each
+  // step cut to them and to its bound
+  contact_.slide(start_, pos_, u, excess_, share_);
+  pool_->parallelFor(n, grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
+    for (uint32_t i = begin; i < end; ++i) {
+      if (!contactBounded(pos_[i].w, i == u.grab_index, u.grab_target[s].w)) continue;
+      const VerletState st = slideStep(VerletState{pos_[i], prev_[i]}, vec3(start_[i]), vec3(push_[i]),
+                                       vec3(excess_[i]), share_[i], bound_[i], frame);
+      pos_[i] = st.position;
+      prev_[i] = st.previous;
     }
   });
 }

@@ -144,10 +144,12 @@ private:
   Grain grain_;
   CpuCollision collision_;
   CpuContact contact_;
-  bool contact_on_ = false;      ///< the last tick had contact on
-  std::vector<glm::vec4> start_; ///< with contact on: the positions at the start of the substep
-  std::vector<float> bound_;     ///< with contact on: each particle's step bound in this substep
-  std::vector<glm::vec4> push_;  ///< with contact on: the push parting its contacts (CpuContact)
+  bool contact_on_ = false;       ///< the last tick had contact on
+  std::vector<glm::vec4> start_;  ///< with contact on: the positions at the start of the substep
+  std::vector<float> bound_;      ///< with contact on: each particle's step bound in this substep
+  std::vector<glm::vec4> excess_; ///< with contact on: each step's excess beyond its pairs' half-spaces
+  std::vector<float> share_;      ///< with contact on: the share of each step that keeps them
+  std::vector<glm::vec4> push_;   ///< with contact on: the push parting its contacts (CpuContact)
   const SheetTopology* topo_ = nullptr;
   std::vector<glm::vec4> pos_, prev_, rest_, normal_, reset_from_;
   std::vector<glm::vec4> air_; ///< the air on each particle in this substep (SIM_FLAG_AIR)

@@ -240,7 +240,7 @@ uint32_t marksPerSubstep() {
 void recordContactPasses(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,
                          uint32_t s) {
   for (const Dispatch& d : kDispatches)
-    if (d.needs == Needs::CONTACT) recordDispatch(sink, pipes, topo, sizes, d, s, 0);
+    if (d.needs == Needs::CONTACT && d.stage == SIM_STAGE_integrate) recordDispatch(sink, pipes, topo, sizes, d, s, 0);
 }
 
 bool recordSubstep(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,

@@ -113,8 +113,9 @@ struct SubstepPlan {
 /// Timestamps a substep of the per-colour path records (one where each category ends).
 uint32_t marksPerSubstep();
 
-/// Records the contact passes of substep `s` (the rows of SIM_DISPATCHES that need CONTACT), each
-/// followed by a barrier: what a CPU device dispatches before each substep of the fused tick.
+/// Records the contact passes that start substep `s` (the integrate stage's rows of SIM_DISPATCHES
+/// that need CONTACT), each followed by a barrier: what a CPU device dispatches before each substep
+/// of the fused tick (whose workgroup runs the floor's contact bodies).
 void recordContactPasses(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,
                          uint32_t s);
 

@@ -198,10 +198,11 @@ SimState flatState() {
 /// Expects the script `text` to pass the flat sheet through itself with the particle repulsion
 /// alone (the scene is a real test) and never with contact, judged every 5 ticks. Returns the
 /// constraints torn at the end with contact.
-uint32_t expectContactHolds(const char* scene, const std::string& text, int ticks) {
+uint32_t expectContactHolds(const char* scene, const std::string& text, int ticks,
+                            const std::vector<std::string>& sets = {}) {
   uint32_t torn = 0;
-  const uint64_t without = mostPairs(flatCrumple(false), text, ticks, 5);
-  const uint64_t with = mostPairs(flatCrumple(true), text, ticks, 5, 2, &torn);
+  const uint64_t without = mostPairs(flatCrumple(false, sets), text, ticks, 5);
+  const uint64_t with = mostPairs(flatCrumple(true, sets), text, ticks, 5, 2, &torn);
   std::printf("%s: %llu intersecting pairs at most without contact, %llu with (%u torn)\n", scene,
               (unsigned long long)without, (unsigned long long)with, torn);
   EXPECT_GT(without, 0u) << scene;
@@ -352,8 +353,7 @@ TEST(Contact, AHandFasterThanTheBoundDragsTheSheetWithoutStretchingIt) {
 
 TEST(Contact, AFastFoldAndAYankNeverPassTheSheetThroughItself) {
   // A corner carried across the sheet in a quarter of a second and pressed down, then yanked away
-  // hard enough to tear (100 units/s; the grab, bounded, falls behind such a hand, and a yank of
-  // half that pace tears nothing or a few edges by chance: 0-6 at 40-72 units/s)
+  // hard enough to tear (100 units/s; the grab, bounded, falls behind such a hand)
   const SimParams p = flatCrumple(true);
   const SimState flat = flatState();
   const vec3 far(flat.pos[p.cols * p.rows - 1]);
@@ -372,8 +372,11 @@ TEST(Contact, AFastFoldAndAYankNeverPassTheSheetThroughItself) {
     text += line;
   }
   text += "41 release\n";
-  // Torn triangles stop colliding at once: the layers still never cross
-  EXPECT_GT(expectContactHolds("fold and yank", text, 90), 0u);
+  // Torn triangles stop colliding at once: the layers still never cross. (The stretch limit holds
+  // every edge within a percent of its length, short of tearing, so it is off, and the paper tears
+  // at 1.5 x its length: the sheet that slides along its layers follows a yank the crumple
+  // preset's 2.5 lets through whole.)
+  EXPECT_GT(expectContactHolds("fold and yank", text, 90, {"stretch_limit=0", "tear_factor=1.5"}), 0u);
 }
 
 TEST(Contact, TheHandCrumplesItIntoABallWithoutPassingItThroughItself) {
@@ -568,7 +571,8 @@ TEST(ContactLists, ARepairKeepsEveryPairCloserThanTheRadius) {
 // Three layers of a side x side grid 0.4 radius apart (closer than the thickness: every particle
 // pushed), at each call shaken about their rest and one particle in `carried` carried up to half a
 // radius in its layer's plane (the lists repaired or built whole): the bounds and pushes are those
-// of every particle-triangle and edge-edge pair weighed once, found without a grid. A small sheet
+// of every particle-triangle and edge-edge pair weighed once, found without a grid, and so are the
+// excess and share of each particle's step beyond its pairs' half-spaces (slide). A small sheet
 // has a small hash table, where two cells of one box are likelier to share a bucket.
 void expectBruteForceContact(uint32_t side, uint32_t carried, uint32_t calls) {
   const uint32_t n = 3 * side * side;
@@ -596,11 +600,26 @@ void expectBruteForceContact(uint32_t side, uint32_t carried, uint32_t calls) {
                glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.03f * radius;
     }
     contact.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound, push);
+    // Every particle then stepped up to 0.3 radius (towards the other layers too): the share of each
+    // step its pairs' half-spaces keep, and the excess they take out
+    std::vector<glm::vec4> moved(n);
+    for (uint32_t i = 0; i < n; ++i)
+      moved[i] = pos[i] + glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.3f * radius;
+    std::vector<glm::vec4> excess;
+    std::vector<float> share;
+    contact.slide(pos, moved, u, excess, share);
+    auto at = [&](uint32_t i) { return vec3(pos[i]); };
     // Every pair once, without lists or a grid
     std::vector<float> nearest2(n, r2);
     std::vector<glm::ivec4> sums(n, glm::ivec4(0));
-    auto weigh = [&](glm::uvec4 q, ContactPair c) {
+    std::vector<std::pair<uint32_t, shaderio::SlideHalf>> halves;
+    auto weigh = [&](glm::uvec4 q, ContactPair c, bool edge) {
       if (!(c.d2 < r2)) return;
+      for (uint32_t j = 0; j < 4; ++j) {
+        const shaderio::SlideHalf h =
+            shaderio::slideConstraint(at(q.x), at(q.y), at(q.z), at(q.w), c, edge, radius, u.contact.y, j);
+        if (h.h.w >= 0.0f) halves.emplace_back(q[j], h);
+      }
       for (uint32_t i : {q.x, q.y, q.z, q.w}) nearest2[i] = std::min(nearest2[i], c.d2);
       if (!(c.d2 < thickness * thickness)) return;
       for (uint32_t j = 0; j < 4; ++j) {
@@ -609,24 +628,41 @@ void expectBruteForceContact(uint32_t side, uint32_t carried, uint32_t calls) {
         sums[q[j]] += glm::ivec4(f, 1);
       }
     };
-    auto at = [&](uint32_t i) { return vec3(pos[i]); };
     for (uint32_t v = 0; v < n; ++v)
       for (const glm::uvec4& t : triangles)
         if (v != t.x && v != t.y && v != t.z)
-          weigh(glm::uvec4(v, t.x, t.y, t.z), shaderio::pointTriangle(at(v), at(t.x), at(t.y), at(t.z)));
+          weigh(glm::uvec4(v, t.x, t.y, t.z), shaderio::pointTriangle(at(v), at(t.x), at(t.y), at(t.z)), false);
     for (size_t a = 0; a < edges.size(); ++a)
       for (size_t b = a + 1; b < edges.size(); ++b) {
         const glm::uvec2 e = edges[a], f = edges[b];
         if (e.x != f.x && e.x != f.y && e.y != f.x && e.y != f.y)
-          weigh(glm::uvec4(e, f), shaderio::segmentSegment(at(e.x), at(e.y), at(f.x), at(f.y)));
+          weigh(glm::uvec4(e, f), shaderio::segmentSegment(at(e.x), at(e.y), at(f.x), at(f.y)), true);
       }
     uint32_t pushed = 0;
     for (uint32_t i = 0; i < n; ++i) {
-      want_bound[i] = shaderio::stepBound(nearest2[i], radius, u.contact.y);
+      want_bound[i] = shaderio::slideBound(nearest2[i], radius, u.contact.y);
       want_push[i] = glm::vec4(
           shaderio::contactPushWithin(shaderio::contactAverage(sums[i], u.contact.w), nearest2[i], radius), 0.0f);
       pushed += sums[i].w > 0 ? 1u : 0u;
     }
+    // The half-spaces: each step's excess (the mean, in fixed point) and its share
+    std::vector<glm::ivec4> excess_sums(n, glm::ivec4(0));
+    auto step = [&](uint32_t i) { return vec3(moved[i]) - (vec3(pos[i]) + contact.frame()); };
+    for (const auto& [i, h] : halves) {
+      const vec3 e = shaderio::slideExcess(h, step(i));
+      if (e != vec3(0.0f)) excess_sums[i] += glm::ivec4(shaderio::contactFixed(e, u.contact.w), 1);
+    }
+    std::vector<glm::vec4> want_excess(n);
+    std::vector<float> want_share(n, 1.0f);
+    for (uint32_t i = 0; i < n; ++i)
+      want_excess[i] = glm::vec4(shaderio::contactAverage(excess_sums[i], u.contact.w), 0.0f);
+    uint32_t cut = 0;
+    for (const auto& [i, h] : halves)
+      want_share[i] = std::min(want_share[i], shaderio::slideShare(h, step(i) + vec3(want_excess[i])));
+    for (uint32_t i = 0; i < n; ++i) cut += want_share[i] < 1.0f || excess_sums[i].w > 0 ? 1u : 0u;
+    ASSERT_TRUE(sameBytes(excess, want_excess)) << side << " x " << side << ", call " << call;
+    ASSERT_TRUE(sameBytes(share, want_share)) << side << " x " << side << ", call " << call;
+    ASSERT_GT(cut, n / 8) << side << " x " << side << ", call " << call;
     ASSERT_TRUE(sameBytes(bound, want_bound)) << side << " x " << side << ", call " << call;
     ASSERT_TRUE(sameBytes(push, want_push)) << side << " x " << side << ", call " << call;
     ASSERT_GT(pushed, n / 2) << side << " x " << side << ", call " << call;

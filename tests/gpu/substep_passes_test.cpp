@@ -122,7 +122,9 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
       }
   expected.push_back("limit");
   expected.push_back("crease");
-  for (const char* k : {"floor", "tear_mark", "tear_unsupported", "tear_flags", "scan", "tear_compact"})
+  // The floor, then the steps cut to their pairs' half-spaces
+  for (const char* k : {"floor", "contact_excess", "contact_share", "contact_step", "tear_mark", "tear_unsupported",
+                        "tear_flags", "scan", "tear_compact"})
     expected.push_back(k);
   EXPECT_EQ(kernels(sink.passes), expected);
   for (size_t k = 0, project = 0, shorten = 0; k < sink.passes.size(); ++k)
