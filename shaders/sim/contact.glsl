@@ -415,25 +415,15 @@ void contactCross(uint t, uint s) {
 // Candidates contactNearOf gathers before it weighs them
 #define CONTACT_BATCH 16u
 
-// contact_near: query k (`particle`: k < particles), particle k (against the triangles near it) or edge
-// e = k - particles (against the edges after it near it): through its list, or when the lists are
-// built (or its list overflowed) through the grid, its box widened past the reach (or the radius):
-// which pairs are kept and which count is their distance's call. One loop walks the candidates,
-// the list's slots or the entries of the grid in the box's cells (a pair once: in the cell of the
-// low corner of the two boxes' overlap), and one place weighs a pair: a CPU device runs every
-// instruction of a kernel for each group of invocations, whatever the branches, so the kernel is
-// kept short.
 // Where contactNearOf weighs particle j: where it is, or where it started the substep (the
 // half-spaces' passes, after the floor)
 vec4 nearPosition(uint j, uint only) { return only >= NEAR_EXCESS ? contact_particles[j].start : SIM_POSITION(j); }
 
-// The half-spaces pair q sets its particles' steps in (slideConstraint; `edge`: two edges), from
-// where they started the substep: each step's excess beyond them summed into its particle's sums
-// (NEAR_EXCESS), or the share of the step less that excess's mean that keeps them lowering its
-// share (NEAR_SHARE)
-void slidePair(uvec4 q, ContactPair c, bool edge, uint only) {
-  vec3 x0 = vec3(contact_particles[q.x].start), x1 = vec3(contact_particles[q.y].start),
-       x2 = vec3(contact_particles[q.z].start), x3 = vec3(contact_particles[q.w].start);
+// The half-spaces pair q sets its particles' steps in (slideConstraint; `edge`: two edges; x0..x3
+// where they started the substep, c their nearest points): each step's excess beyond them summed
+// into its particle's sums (NEAR_EXCESS), or the share of the step less that excess's mean that
+// keeps them lowering its share (NEAR_SHARE)
+void slidePair(uvec4 q, vec3 x0, vec3 x1, vec3 x2, vec3 x3, ContactPair c, bool edge, uint only) {
   vec3 frame = contactFrameNow();
   for (uint j = 0u; j < 4u; ++j) {
     SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, u.contact.x, u.contact.y, j);
@@ -450,6 +440,14 @@ void slidePair(uvec4 q, ContactPair c, bool edge, uint only) {
   }
 }
 
+// contact_near: query k (`particle`: k < particles), particle k (against the triangles near it) or edge
+// e = k - particles (against the edges after it near it): through its list, or when the lists are
+// built (or its list overflowed) through the grid, its box widened past the reach (or the radius):
+// which pairs are kept and which count is their distance's call. One loop walks the candidates,
+// the list's slots or the entries of the grid in the box's cells (a pair once: in the cell of the
+// low corner of the two boxes' overlap), and one place weighs a pair: a CPU device runs every
+// instruction of a kernel for each group of invocations, whatever the branches, so the kernel is
+// kept short.
 void contactNearOf(uint k, uint only, bool particle) {
   if (contactGoneWrong()) return;
   uint self = particle ? k : k - u.particle_count;
@@ -537,7 +535,7 @@ void contactNearOf(uint k, uint only, bool particle) {
            x3 = vec3(nearPosition(q.w, only));
       ContactPair c = particle ? pointTriangle(x0, x1, x2, x3) : segmentSegment(x0, x1, x2, x3);
       if (only >= NEAR_EXCESS) {
-        if (!free) slidePair(q, c, !particle, only);
+        if (!free) slidePair(q, x0, x1, x2, x3, c, !particle, only);
         continue;
       }
       if (into != SIM_NONE) listPair(into, c.d2, other);
