@@ -59,6 +59,7 @@ static_assert(offsetof(SimUniforms, hinge) == 128);
 static_assert(offsetof(SimUniforms, hand) == 160);
 static_assert(offsetof(SimUniforms, contact) == 192);
 static_assert(offsetof(SimUniforms, contact_check) == 208);
-static_assert(offsetof(SimUniforms, wind) == 272);
-static_assert(sizeof(SimUniforms) == 272 + 4 * 16 * SIM_MAX_SUBSTEPS);
+static_assert(offsetof(SimUniforms, limit_roots) == 256);
+static_assert(offsetof(SimUniforms, wind) == 288);
+static_assert(sizeof(SimUniforms) == 288 + 4 * 16 * SIM_MAX_SUBSTEPS);
 } // namespace shaderio

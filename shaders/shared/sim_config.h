@@ -21,6 +21,8 @@
 // slots of each): lavapipe ends every loop of a shader after 65535 in all (LP_MAX_TGSI_LOOP_ITERATIONS,
 // bench/README.md), so a large sheet's rings take several dispatches (limitRingsPerDispatch)
 #define SIM_LIMIT_LOOP_BUDGET 16384u
+// Roots the stretch limit runs from at most (SimUniforms::limit_roots: a sheet's pins)
+#define SIM_LIMIT_ROOTS 3u
 // Workgroup size of the block scan; each thread scans SIM_SCAN_PER_THREAD elements
 #define SIM_WG_SCAN 256
 // Elements scanned per thread in the block scan

@@ -75,6 +75,9 @@ struct SimUniforms {
   // The stretch limit (limitParticle in sim_bodies.h): x the longest a structural edge may be after
   // the projection (stretch_limit x spacing; 0: off), y its rest length (the spacing)
   vec4 limit;
+  // The roots its rings run from (limitRootSet in xpbd.h): xyz the particles (SIM_NONE past the
+  // last), w how many (0: the grabbed particle, else the sheet's middle)
+  uvec4 limit_roots;
   // The Verlet step: x the damping of the first substep, which also rescales the velocity its
   // previous position carries from the last tick's substeps to this tick's (damping x dt / the
   // last tick's dt, when the substeps key changed between them or the hand's pace asks for more,

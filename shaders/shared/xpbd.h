@@ -216,14 +216,58 @@ SIM_INLINE uint limitRings(uint root, uint cols, uint rows) {
   return max(x, cols - 1u - x) + max(y, rows - 1u - y);
 }
 
+/// Steps along the grid's rows and columns from particle a to particle b.
+SIM_INLINE uint gridSteps(uint a, uint b, uint cols) {
+  uint ax = a % cols, ay = a / cols, bx = b % cols, by = b / cols;
+  return (ax > bx ? ax - bx : bx - ax) + (ay > by ? ay - by : by - ay);
+}
+
+/// The roots the stretch limit runs from: those SimUniforms::limit_roots names (w > 0: the pins
+/// of a sheet no hand holds, Simulation::makeUniforms), else the one of limitRoot. With several,
+/// each particle belongs to the root nearest it along the grid (limitRootOf) and is placed in its
+/// ring around that root, after its parents towards it: each pin holds the edges around it. (Rings
+/// from the middle of a sheet hanging from its corners hold none at the pins: 1.54 at 128 x 192;
+/// from one corner, 1.09 at the other.)
+SIM_INLINE uvec4 limitRootSet(uvec4 roots, uint grab_index, uint cols, uint rows) {
+  return roots.w > 0u ? roots : uvec4(limitRoot(grab_index, cols, rows), SIM_NONE, SIM_NONE, 1u);
+}
+
+/// Which of `count` roots at columns rx and rows ry the particle at column x, row y belongs to: the
+/// nearest along the grid, the first of equals. A parent of it (one step nearer that root) is
+/// nearer that root too, so it lies in an earlier ring. (No division: a ring's walk asks it of
+/// every slot, and a CPU device divides slowly.)
+SIM_INLINE uint limitRootAt(uint x, uint y, uvec4 rx, uvec4 ry, uint count) {
+  uint best = 0u, steps = 0xFFFFFFFFu;
+  for (uint j = 0u; j < count; ++j) {
+    uint s = (x > rx[j] ? x - rx[j] : rx[j] - x) + (y > ry[j] ? y - ry[j] : ry[j] - y);
+    if (s < steps) {
+      best = j;
+      steps = s;
+    }
+  }
+  return best;
+}
+
+/// Which of `roots` (limitRootSet) particle i belongs to (limitRootAt).
+SIM_INLINE uint limitRootOf(uint i, uvec4 roots, uint cols) {
+  return limitRootAt(i % cols, i / cols, roots % cols, roots / cols, roots.w);
+}
+
+/// The last ring of the stretch limit from `roots`: no particle lies farther from its own root.
+SIM_INLINE uint limitRingsOf(uvec4 roots, uint cols, uint rows) {
+  uint last = 0u;
+  for (uint j = 0u; j < roots.w; ++j) last = max(last, limitRings(roots[j], cols, rows));
+  return last;
+}
+
 /// Slots of a ring (ringParticle): two for each line of the grid's shorter side.
 SIM_INLINE uint limitSlots(uint cols, uint rows) { return 2u * min(cols, rows); }
 
 /// Rings one dispatch of the stretch limit walks with a workgroup of `invocations`
-/// (SIM_LIMIT_LOOP_BUDGET), and the rings a sheet can have from any root: its dispatches cover
-/// rings 1 to cols + rows - 2.
+/// (SIM_LIMIT_LOOP_BUDGET; a ring walks the slots of each root, limitRing), and the rings a sheet
+/// can have from any root: its dispatches cover rings 1 to cols + rows - 2.
 SIM_INLINE uint limitRingsPerDispatch(uint cols, uint rows, uint invocations) {
-  uint per_ring = 1u + (limitSlots(cols, rows) + invocations - 1u) / invocations;
+  uint per_ring = 1u + SIM_LIMIT_ROOTS * (1u + (limitSlots(cols, rows) + invocations - 1u) / invocations);
   return max(1u, SIM_LIMIT_LOOP_BUDGET / per_ring);
 }
 SIM_INLINE uint limitMostRings(uint cols, uint rows) { return cols + rows - 2u; }

@@ -267,11 +267,12 @@ void main() {
           return;
         }
       }
-    // 5. The stretch limit (as limit.comp): ring after ring from the root
+    // 5. The stretch limit (as limit.comp): ring after ring from the roots
     if (u.limit.x > 0.0f) {
-      uint root = limitRoot(u.grab_index, u.cols, u.rows), rings = limitRings(root, u.cols, u.rows);
+      uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
+      uint rings = limitRingsOf(roots, u.cols, u.rows);
       for (uint k = 1u; k <= rings; ++k) {
-        limitRing(root, k, lid, kInvocations);
+        limitRing(roots, k, lid, kInvocations);
         sync();
       }
     }

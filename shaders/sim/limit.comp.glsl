@@ -1,6 +1,6 @@
 #version 460
 // The stretch limit of a substep: one workgroup a sheet walks rings p.first to p.first + p.count - 1
-// around its root (limitRoot), a barrier after each, so every particle is placed after its parents
+// around its roots (limitRootSet), a barrier after each, so every particle is placed after its parents
 // (limitParticle); a large sheet's rings take several dispatches (limitRingsPerDispatch).
 // Workgroup size: specialization constant 0, the device's (limitWorkgroup in sim_pipeline.h)
 #define SIM_LOCAL_SIZE SIM_WG_LIMIT
@@ -13,10 +13,10 @@
 
 void main() {
   if (!(u.limit.x > 0.0f)) return; // the same branch for the whole workgroup
-  uint root = limitRoot(u.grab_index, u.cols, u.rows);
-  uint last = min(limitRings(root, u.cols, u.rows), p.first + p.count - 1u);
+  uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
+  uint last = min(limitRingsOf(roots, u.cols, u.rows), p.first + p.count - 1u);
   for (uint k = p.first; k <= last; ++k) {
-    limitRing(root, k, gl_LocalInvocationID.x, gl_WorkGroupSize.x);
+    limitRing(roots, k, gl_LocalInvocationID.x, gl_WorkGroupSize.x);
     memoryBarrierBuffer();
     barrier();
   }

@@ -245,13 +245,19 @@ void tearCompact(uint k) {
   }
 }
 
-// Ring k of the stretch limit from `root` (limitParticle), slots `first`, first + `stride`, ... of it:
-// a workgroup's invocations share a ring, and a barrier follows it (limit.comp, the fused tick).
-void limitRing(uint root, uint k, uint first, uint stride) {
+// Ring k of the stretch limit from `roots` (limitRootSet; limitParticle), slots `first`, first +
+// `stride`, ... of it around each root, each particle around its own (limitRootOf): a workgroup's
+// invocations share a ring, and a barrier follows it (limit.comp, the fused tick).
+void limitRing(uvec4 roots, uint k, uint first, uint stride) {
   uint slots = limitSlots(u.cols, u.rows);
-  for (uint t = first; t < slots; t += stride) {
-    uint i = ringParticle(root, k, t, u.cols, u.rows);
-    if (i != SIM_NONE) limitParticle(i, root);
+  uvec4 rx = roots % u.cols, ry = roots / u.cols;
+  for (uint j = 0u; j < roots.w; ++j) {
+    uint root = roots[j];
+    for (uint t = first; t < slots; t += stride) {
+      uint i = ringParticle(root, k, t, u.cols, u.rows);
+      if (i != SIM_NONE && (roots.w == 1u || limitRootAt(i % u.cols, i / u.cols, rx, ry, roots.w) == j))
+        limitParticle(i, root);
+    }
   }
 }
 

@@ -232,8 +232,17 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   u.hinge = glm::uvec4(topo_.hinge_first, topo_.hingeCount(), 0u, 0u);
   u.crease = glm::vec4(p.hingeCompliance(), float(double(p.crease_yield) * (3.14159265358979323846 / 180.0)),
                        p.crease_hardening, 0.0f);
-  // The stretch limit (with contact, its places are steps the contact cuts as any)
-  if (p.stretch_limit > 0.0f) u.limit = glm::vec4(p.stretch_limit * p.spacing, p.spacing, 0.0f, 0.0f);
+  // The stretch limit (with contact, its places are steps the contact cuts as any), from the grab,
+  // else from the pins that hold the sheet (limitRootSet)
+  if (p.stretch_limit > 0.0f) {
+    u.limit = glm::vec4(p.stretch_limit * p.spacing, p.spacing, 0.0f, 0.0f);
+    const std::vector<uint32_t> pins = pins_ ? pinIndices(p.pins, p.cols, p.rows) : std::vector<uint32_t>{};
+    if (grab_index_ == SIM_NONE && release_index_ == SIM_NONE && !pins.empty()) {
+      u.limit_roots = glm::uvec4(SIM_NONE, SIM_NONE, SIM_NONE, 0u);
+      for (const uint32_t pin : pins)
+        if (u.limit_roots.w < SIM_LIMIT_ROOTS) u.limit_roots[int(u.limit_roots.w++)] = pin;
+    }
+  }
   u.reset_active = reset_frame_ > 0 ? 1u : 0u;
   u.reset_alpha = reset_frame_ > 0 ? float(SIM_RESET_FRAMES - reset_frame_ + 1) / float(SIM_RESET_FRAMES) : 0.0f;
   u.iterations = p.iterations;

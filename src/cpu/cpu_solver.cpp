@@ -224,7 +224,31 @@ void CpuSolver::limitPass(const SimUniforms& u) {
   // from its column, one quadrant after the other (the root's row and column with the first
   // quadrants that reach them, before those that lean on them)
   const int cols = int(u.cols), rows = int(u.rows);
-  const uint32_t root = limitRoot(u.grab_index, u.cols, u.rows);
+  const uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
+  if (roots.w > 1u) {
+    // Several roots: each particle around its own, in the order of its steps from it (a counting
+    // sort; its parents are nearer their root, and so come first)
+    const uint32_t n = uint32_t(pos_.size());
+    std::vector<uint32_t>& root_of = limit_root_of_;
+    std::vector<uint32_t>& order = limit_order_;
+    if (limit_roots_ != roots || root_of.size() != n) { // the order stands while the roots do
+      std::vector<uint32_t> start(limitRingsOf(roots, u.cols, u.rows) + 2u, 0u);
+      root_of.resize(n);
+      order.resize(n);
+      auto ring = [&](uint32_t i) { return gridSteps(i, roots[int(root_of[i])], u.cols); };
+      for (uint32_t i = 0; i < n; ++i) {
+        root_of[i] = limitRootOf(i, roots, u.cols);
+        ++start[ring(i) + 1u];
+      }
+      for (uint32_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
+      for (uint32_t i = 0; i < n; ++i) order[start[ring(i)]++] = i;
+      limit_first_ = start[0]; // ring 0 (the roots themselves) ends there
+      limit_roots_ = roots;
+    }
+    for (uint32_t k = limit_first_; k < n; ++k) e.limitParticle(order[k], roots[int(root_of[order[k]])]);
+    return;
+  }
+  const uint32_t root = roots.x;
   const int rx = int(root) % cols, ry = int(root) / cols;
   for (const int dy : {1, -1})
     for (const int dx : {1, -1})

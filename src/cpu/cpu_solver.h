@@ -158,6 +158,11 @@ private:
   std::vector<ColorRange> colors_;
   std::vector<uint32_t> project_passes_; ///< projectColors' passes that project (scratch)
   std::vector<uint32_t> shorten_edges_;  ///< shortenColors' edges at the head of each colour (scratch)
+  /// limitPass's rings from several roots: each particle's root, the particles in the rings'
+  /// order from where ring 1 starts, for those roots
+  std::vector<uint32_t> limit_root_of_, limit_order_;
+  uint32_t limit_first_ = 0;
+  glm::uvec4 limit_roots_{0u};
   // constraints_ split into one array per field, each colour ordered by first particle
   std::vector<uint32_t> con_a_, con_b_, con_kind_, con_id_;
   std::vector<uint32_t> con_hinge_; ///< per slot of a hinge: its hinge

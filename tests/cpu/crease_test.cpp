@@ -444,6 +444,58 @@ TEST(Stretch, TheRingsVisitEveryParticleOnceAfterItsParents) {
   EXPECT_EQ(shaderio::limitSlots(512, 768), uint32_t(SIM_WG_LIMIT_GPU));
 }
 
+TEST(Stretch, RingsFromSeveralRootsVisitEveryParticleOnceAfterItsParents) {
+  // Each particle around the root nearest it (the first of equals), in the ring of its steps from
+  // that root, once, after its parents towards it: the walk of limitRing (sim_elements.glsl)
+  for (const glm::uvec2 size : {glm::uvec2(7, 5), glm::uvec2(5, 9), glm::uvec2(12, 3)}) {
+    const uint32_t cols = size.x, rows = size.y, n = cols * rows;
+    for (const glm::uvec4 roots : {glm::uvec4(0, cols - 1, SIM_NONE, 2), glm::uvec4(0, cols / 2, cols - 1, 3),
+                                   glm::uvec4(0, n - 1, n / 2, 3), glm::uvec4(3, 3, SIM_NONE, 2)}) {
+      const uint32_t rings = shaderio::limitRingsOf(roots, cols, rows);
+      std::vector<int> seen(n, 0), ring(n, -1);
+      for (uint32_t j = 0; j < roots.w; ++j) ring[roots[int(j)]] = 0;
+      for (uint32_t k = 1; k <= rings; ++k)
+        for (uint32_t j = 0; j < roots.w; ++j)
+          for (uint32_t t = 0; t < shaderio::limitSlots(cols, rows); ++t) {
+            const uint32_t i = shaderio::ringParticle(roots[int(j)], k, t, cols, rows);
+            if (i == SIM_NONE || shaderio::limitRootOf(i, roots, cols) != j) continue;
+            ++seen[i];
+            ring[i] = int(k);
+            uint32_t nearest = n;
+            for (uint32_t r = 0; r < roots.w; ++r)
+              nearest = std::min(nearest, shaderio::gridSteps(i, roots[int(r)], cols));
+            EXPECT_EQ(nearest, k) << i;
+            const glm::uvec2 parent = shaderio::limitParents(i, roots[int(j)], cols);
+            for (uint32_t q : {parent.x, parent.y}) {
+              if (q == SIM_NONE) continue;
+              EXPECT_GE(ring[q], 0) << cols << "x" << rows << " " << i << " before its parent " << q;
+              EXPECT_LT(ring[q], int(k));
+            }
+          }
+      for (uint32_t i = 0; i < n; ++i) EXPECT_EQ(seen[i], ring[i] == 0 ? 0 : 1) << cols << "x" << rows << " " << i;
+    }
+  }
+  // No uniforms' roots: the grab's, else the middle's
+  EXPECT_EQ(shaderio::limitRootSet(glm::uvec4(0u), 7u, 4, 5), glm::uvec4(7u, SIM_NONE, SIM_NONE, 1u));
+  EXPECT_EQ(shaderio::limitRootSet(glm::uvec4(0u), SIM_NONE, 4, 5).x, 10u);
+}
+
+TEST(Stretch, ASheetHangingFromItsPinsHoldsTheLimitAtEachPin) {
+  // The bench's sheet (the crumple preset scaled to 128 x 192), hanging from its corners and from
+  // three pins: the rings run from every pin, so the edges at each are held too (rings from the
+  // sheet's middle left those at the pins to the projection alone: 1.54)
+  for (const char* pins : {"pins=corners", "pins=top3"}) {
+    const SimParams base = preset("crumple", {});
+    const float scale = float(base.cols - 1) / 127.0f;
+    SimParams p = preset("crumple", {"cols=128", "rows=192", pins});
+    p.spacing = base.spacing * scale;
+    p.cell_size = base.cell_size * scale;
+    const float most = mostStretch(p, "", 30);
+    std::printf("%s: most stretch %.4f\n", pins, double(most));
+    EXPECT_LE(most, p.stretch_limit + 1e-4f) << pins;
+  }
+}
+
 TEST(Stretch, AHeldSheetYankedTearsAndALyingOneIsLeftAlone) {
   // The sheet hanging from its corners, its bottom middle yanked down at 20 sheet lengths a second:
   // the limit draws the sheet after the hand, the pins hold their corners, and the paper tears

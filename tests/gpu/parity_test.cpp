@@ -230,6 +230,19 @@ TEST_F(Parity, TheStretchLimitIsTheSameOnEveryPath) {
       }
     }
   }
+  // Sheets hanging from their pins, one iteration and a tight limit: the rings run from every pin
+  // (limitRootSet), each particle around the one nearest it, and place particles every substep
+  for (const char* pins : {"pins=corners", "pins=top3"}) {
+    const SimParams p = preset("crumple", {"cols=16", "rows=24", pins, "iterations=1", "stretch_limit=1.001"});
+    for (bool fused : {true, false}) {
+      auto [cpu, gpu] = runBoth(ctx(), p, "", 20, fused);
+      const SheetStats st = computeStats(cpu, p.substepDt());
+      std::printf("stretch limit %s, %s: most stretch %.5f\n", pins, fused ? "fused tick" : "per-colour passes",
+                  double(st.max_stretch));
+      EXPECT_LE(st.max_stretch, 1.0011f) << pins;
+      EXPECT_TRUE(sameState(cpu, gpu)) << pins << (fused ? " fused tick" : " per-colour passes");
+    }
+  }
   // A sheet whose rings take two dispatches on a CPU device (limitRingsPerDispatch; a GPU's
   // larger workgroup walks them in one), its corner carried far off
   const SimParams big = preset("crumple", {"cols=512", "rows=520", "wind=off"});
