@@ -65,6 +65,7 @@ void CpuSolver::upload(const SheetTopology& topo) {
   grain_ = Grain{options_.min_chunk, n < kSmallSheet};
   rest_ = topo.rest_pos;
   uv_ = topo.uv;
+  limit_root_of_.clear(); // a new sheet: limitPass orders its rings again
   pos_.resize(n);
   for (uint32_t i = 0; i < n; ++i) pos_[i] = startPosition(rest_[i]);
   prev_ = pos_;
@@ -231,7 +232,7 @@ void CpuSolver::limitPass(const SimUniforms& u) {
     const uint32_t n = uint32_t(pos_.size());
     std::vector<uint32_t>& root_of = limit_root_of_;
     std::vector<uint32_t>& order = limit_order_;
-    if (limit_roots_ != roots || root_of.size() != n) { // the order stands while the roots do
+    if (limit_roots_ != roots || root_of.size() != n) { // the order stands while the sheet and roots do
       std::vector<uint32_t> start(limitRingsOf(roots, u.cols, u.rows) + 2u, 0u);
       root_of.resize(n);
       order.resize(n);
