@@ -3,12 +3,16 @@
 /// of a substep (contact.h: slideBound, from the nearest of the triangles and edges near it) and,
 /// after the floor, the cut of each step to its pairs' half-spaces (slide), from lists of the
 /// pairs near each other that a uniform grid of the triangles', then the edges', boxes finds, kept
-/// while the particles travel little and repaired where a few travelled far. Each distance lowers
+/// while the particles travel little (once the sheet's turn is taken out, and where clusters of
+/// them next to each other travel alike) and repaired where a few travelled far. Each distance lowers
 /// the bounds of the particles of its pair by an atomic minimum, and each half-space their shares
 /// (their excesses are integer sums), so the bits are the same whatever the thread count or order
 /// and whatever the lists hold beyond the pairs closer than the radius.
 #include <cstdint>
+#include <utility>
 #include <vector>
+
+#include <glm/gtc/quaternion.hpp>
 
 #include "shaderio.h"
 
@@ -18,9 +22,13 @@ class WorkerPool;
 
 class CpuContact {
 public:
-  /// `repairs`: repair the pair lists where a few particles travelled too far instead of building
-  /// them whole (the bounds and pushes are the same bits either way).
-  CpuContact(WorkerPool& pool, bool repairs) : pool_(pool), repairs_(repairs) {}
+  /// How the pair lists are kept; the bounds and pushes are the same bits every way.
+  enum class Lists {
+    Rebuilt, ///< built whole at every call
+    Kept,    ///< kept while they hold every pair that can touch (the travels, turned, clusters), then built whole
+    Repaired ///< kept so, else repaired where a few particles travelled too far, else built whole
+  };
+  CpuContact(WorkerPool& pool, Lists lists) : pool_(pool), lists_kept_(lists) {}
 
   /// The step bound of each particle at `pos` (xyz; w inverse mass; `prev` where each was a
   /// substep before) in substep `s`, of the sheet made of the first `count` triangles of
@@ -43,6 +51,11 @@ public:
   uint64_t contacts() const { return contacts_; }
   /// The times the pair lists were built whole.
   uint32_t listBuilds() const { return builds_; }
+  /// The substeps whose pair lists stood only once the sheet's turn was taken out of the travels
+  /// (turnedTravel).
+  uint32_t listTurns() const { return turns_; }
+  /// The substeps whose pair lists stood only by the clusters' travels (clustersHold).
+  uint32_t listHolds() const { return held_; }
   /// The times the pair lists were repaired: the pairs of the particles that travelled too far
   /// looked for again (repairLists).
   uint32_t listRepairs() const { return repairs_done_; }
@@ -86,6 +99,20 @@ private:
   /// False (nothing changed) when too many did.
   bool repairLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                    float radius);
+  /// Each particle's travel since its base in the frame of the sheet's turn since, into travel_:
+  /// R^T (x - c) - (b - c') for the rotation R that best carries the bases (b, centroid c') onto
+  /// the positions (x, centroid c), so that a sheet swinging about its pins travels as little as
+  /// one at rest; the componentwise lowest and highest of them.
+  std::pair<glm::vec3, glm::vec3> turnedTravel(const std::vector<glm::vec4>& pos);
+  /// Sorts the particles into clusters by the cells of a grid kClusterWidth x (reach + longest
+  /// edge) wide of their bases: cluster_members_, cluster_start_, cluster_pairs_ (each with itself
+  /// and the clusters in the 26 cells around it), cluster_far_.
+  void clusterBases(float radius);
+  /// True when the pair lists still hold every pair closer than the radius although the travels
+  /// (travel_, componentwise lowest `lo` and highest `hi`) outgrew one point: the travels of
+  /// each two clusters next to each other lie within two contactTravel, and the whole spread
+  /// within cluster_far_.
+  bool clustersHold(glm::vec3 lo, glm::vec3 hi, float radius);
   /// The boxes of the first `count` triangles at `pos`, then of the edges, into lo_ and hi_.
   void boxTriangles(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count);
   void boxEdges(const std::vector<glm::vec4>& pos);
@@ -93,11 +120,13 @@ private:
   /// the positions have gone wrong.
   float listCell(const std::vector<glm::vec4>& pos, float reach) const;
 
+  /// A cluster's width, in reaches and longest edges
+  static constexpr float kClusterWidth = 4.0f;
   /// A repair looks for the pairs of at most 1 / kRepairShare of the particles; more build whole
   static constexpr uint32_t kRepairShare = 8;
 
   WorkerPool& pool_;
-  bool repairs_;
+  Lists lists_kept_;
   std::vector<glm::uvec4> vf_;       ///< particle, then the triangle's three: pairs within radius + skin
   std::vector<glm::ivec4> sums_;     ///< each particle's pushes in fixed point, and their count
   std::vector<glm::uvec4> ee_;       ///< two edges' particles: pairs within radius + skin
@@ -122,7 +151,21 @@ private:
   uint64_t contacts_ = 0;
   uint32_t builds_ = 0;
   uint32_t repairs_done_ = 0;
+  uint32_t turns_ = 0;
+  uint32_t held_ = 0;
+  size_t built_pairs_ = 0; ///< the pairs the last build listed
   glm::vec3 frame_{0.0f};
+
+  // The travels in the turned frame and the clusters (turnedTravel, clustersHold)
+  std::vector<glm::vec3> travel_;         ///< each particle's travel in the turned frame
+  glm::dquat turn_{1.0, 0.0, 0.0, 0.0};   ///< the sheet's turn since the lists were built, last fitted
+  std::vector<uint32_t> cluster_members_; ///< the particles, a cluster's together
+  std::vector<uint32_t> cluster_start_;   ///< where each cluster's particles start in cluster_members_
+  std::vector<glm::uvec2> cluster_pairs_; ///< clusters next to each other (or one twice), each pair once
+  std::vector<glm::vec4> cluster_box_;    ///< scratch: each cluster's travels' middle (xyz) and half-diagonal
+  uint32_t cluster_count_ = 0;
+  float cluster_far_ = 0.0f;   ///< the spread of the travels that clusters apart allow
+  uint32_t cluster_key_ = ~0u; ///< builds + repairs when the clusters were made
 };
 
 } // namespace tender

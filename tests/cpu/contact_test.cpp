@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "common/sim_helpers.h"
 #include "core/intersections.h"
 #include "core/stats.h"
@@ -543,7 +545,7 @@ TEST(ContactLists, ARepairKeepsEveryPairCloserThanTheRadius) {
   auto [pos, triangles] = stackedLayers(16, 2, radius, glm::vec2(0.0f, 0.05f));
   const shaderio::SimUniforms u = contactUniforms(radius);
   WorkerPool pool(2);
-  CpuContact whole(pool, false), repaired(pool, true);
+  CpuContact whole(pool, CpuContact::Lists::Rebuilt), repaired(pool, CpuContact::Lists::Repaired);
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
   std::vector<float> bound_a, bound_b;
@@ -568,6 +570,118 @@ TEST(ContactLists, ARepairKeepsEveryPairCloserThanTheRadius) {
   EXPECT_EQ(whole.listRepairs(), 0u);
 }
 
+TEST(ContactLists, ASheetThatTurnsAndStretchesKeepsItsListsAndEveryPairCloserThanTheRadius) {
+  // Two layers of a 40 x 40 grid 0.6 radius apart, one over half of the other, turned about a tilted axis by up to 1.2
+  // rad, stretched in their plane by 0.4 % about their middle over the 20th to the 29th call, the upper one slid
+  // farther over the lower by two radii from the 40th to the 50th, and every particle nudged: the corners travel
+  // hundreds of times the lists' travel, the stretch alone carries particles farther from one another than it lets, and
+  // the slide brings new pairs within the radius. The lists stand through the turn (taken out of the travels) and the
+  // stretch (clusters next to each other travel alike), not through the slide, and the bounds and pushes are those of
+  // lists built whole at every call, and so are the steps' cuts to their pairs' half-spaces.
+  constexpr uint32_t kSide = 40, kCalls = 60;
+  const float radius = 0.1f;
+  const auto [rest, triangles] = stackedLayers(kSide, 2, 0.6f * radius, glm::vec2(0.075f * kSide, 0.05f));
+  const uint32_t n = uint32_t(rest.size());
+  vec3 middle(0.0f);
+  for (const glm::vec4& p : rest) middle += vec3(p) / float(n);
+  const shaderio::SimUniforms u = contactUniforms(radius);
+  WorkerPool pool(2);
+  CpuContact rebuilt(pool, CpuContact::Lists::Rebuilt), kept(pool, CpuContact::Lists::Repaired);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  const vec3 axis = glm::normalize(vec3(0.3f, 1.0f, 0.2f));
+  std::vector<glm::vec4> pos = rest, prev;
+  std::vector<float> bound_a, bound_b;
+  std::vector<glm::vec4> push_a, push_b, moved(n), excess_a, excess_b;
+  std::vector<float> share_a, share_b;
+  uint64_t contacts = 0;
+  float widest = 0.0f;
+  uint32_t turned = 0, held = 0; // the calls of the first two phases the lists stood by the turn, the clusters
+  for (uint32_t call = 0; call < kCalls; ++call) {
+    prev = pos;
+    const float t = float(call) / float(kCalls - 1);
+    const float stretch = 1.0f + 0.004f * std::clamp((float(call) - 20.0f) / 9.0f, 0.0f, 1.0f);
+    const float slide = 2.0f * radius * std::clamp((float(call) - 40.0f) / 10.0f, 0.0f, 1.0f);
+    const glm::mat3 turn = glm::mat3(glm::rotate(glm::mat4(1.0f), 1.2f * t, axis));
+    for (uint32_t i = 0; i < n; ++i) {
+      vec3 d = vec3(rest[i]) - middle;
+      d = vec3(d.x * stretch - (i >= n / 2 ? slide : 0.0f), d.y, d.z * stretch);
+      const vec3 nudge = vec3(unit(rng), unit(rng), unit(rng)) * 0.01f * radius;
+      pos[i] = glm::vec4(middle + turn * d + nudge, 1.0f);
+      widest = std::max(widest, glm::length(vec3(pos[i]) - vec3(rest[i])));
+    }
+    const uint32_t turns = kept.listTurns(), holds = kept.listHolds();
+    rebuilt.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_a, push_a);
+    kept.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_b, push_b);
+    ASSERT_TRUE(sameBytes(bound_a, bound_b)) << "call " << call;
+    ASSERT_TRUE(sameBytes(push_a, push_b)) << "call " << call;
+    // and so are the cuts of steps up to 0.3 radius to the pairs' half-spaces (every pair closer
+    // than the radius has one)
+    for (uint32_t i = 0; i < n; ++i)
+      moved[i] = pos[i] + glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.3f * radius;
+    rebuilt.slide(pos, moved, u, excess_a, share_a);
+    kept.slide(pos, moved, u, excess_b, share_b);
+    ASSERT_TRUE(sameBytes(excess_a, excess_b)) << "call " << call;
+    ASSERT_TRUE(sameBytes(share_a, share_b)) << "call " << call;
+    contacts += rebuilt.contacts();
+    if (call < 20) turned += kept.listTurns() - turns;
+    if (call >= 20 && call < 40) held += kept.listHolds() - holds;
+  }
+  std::printf("%llu particles in contact a call, travels up to %.2f (%.0f x the lists' travel); lists built %u "
+              "times, repaired %u times, kept by the turn %u times and by the clusters %u times in %u calls\n",
+              (unsigned long long)(contacts / kCalls), double(widest), double(widest / shaderio::contactTravel(radius)),
+              kept.listBuilds(), kept.listRepairs(), kept.listTurns(), kept.listHolds(), kCalls);
+  EXPECT_GT(contacts / kCalls, n / 4);
+  EXPECT_GT(widest, 100.0f * shaderio::contactTravel(radius));
+  EXPECT_GE(turned, 18u);
+  EXPECT_GE(held, 15u);
+  EXPECT_GE(kept.listBuilds() + kept.listRepairs(), 5u); // the slide
+}
+
+TEST(ContactLists, TwoLayersClosingInHaveTheirListsBuiltBeforeTheyMeet) {
+  // Two layers of a 24 x 24 grid 100 radii apart, the upper one let down by 6 radii a call until it
+  // lies half a radius over the lower, and every particle nudged: each layer travels as one, so
+  // clusters next to each other travel alike, and only the spread of the clusters apart
+  // (cluster_far_) has the lists built again before a pair comes within the radius. The bounds,
+  // pushes and cuts to the half-spaces are those of lists built whole at every call.
+  constexpr uint32_t kCalls = 24;
+  const float radius = 0.1f, gap = 100.0f * radius;
+  const auto [rest, triangles] = stackedLayers(24, 2, gap, glm::vec2(0.0f));
+  const uint32_t n = uint32_t(rest.size());
+  const shaderio::SimUniforms u = contactUniforms(radius);
+  WorkerPool pool(2);
+  CpuContact rebuilt(pool, CpuContact::Lists::Rebuilt), kept(pool, CpuContact::Lists::Repaired);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::vector<glm::vec4> pos = rest, prev, moved(n), push_a, push_b, excess_a, excess_b;
+  std::vector<float> bound_a, bound_b, share_a, share_b;
+  uint64_t contacts = 0;
+  for (uint32_t call = 0; call < kCalls; ++call) {
+    prev = pos;
+    const float drop = std::min(6.0f * radius * float(call), gap - 0.5f * radius);
+    for (uint32_t i = 0; i < n; ++i)
+      pos[i] = rest[i] + glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.01f * radius -
+               glm::vec4(0.0f, i >= n / 2 ? drop : 0.0f, 0.0f, 0.0f);
+    rebuilt.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_a, push_a);
+    kept.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_b, push_b);
+    for (uint32_t i = 0; i < n; ++i)
+      moved[i] = pos[i] + glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.3f * radius;
+    rebuilt.slide(pos, moved, u, excess_a, share_a);
+    kept.slide(pos, moved, u, excess_b, share_b);
+    ASSERT_TRUE(sameBytes(bound_a, bound_b)) << "call " << call;
+    ASSERT_TRUE(sameBytes(push_a, push_b)) << "call " << call;
+    ASSERT_TRUE(sameBytes(excess_a, excess_b)) << "call " << call;
+    ASSERT_TRUE(sameBytes(share_a, share_b)) << "call " << call;
+    contacts += rebuilt.contacts();
+  }
+  std::printf("%llu particles in contact in all; lists built %u times, repaired %u times, kept by the clusters %u "
+              "times in %u calls\n",
+              (unsigned long long)contacts, kept.listBuilds(), kept.listRepairs(), kept.listHolds(), kCalls);
+  EXPECT_GT(contacts, uint64_t(n));
+  EXPECT_GE(kept.listHolds(), 4u);
+  EXPECT_GE(kept.listBuilds(), 8u);
+}
+
 // Three layers of a side x side grid 0.4 radius apart (closer than the thickness: every particle
 // pushed), at each call shaken about their rest and one particle in `carried` carried up to half a
 // radius in its layer's plane (the lists repaired or built whole): the bounds and pushes are those
@@ -586,7 +700,7 @@ void expectBruteForceContact(uint32_t side, uint32_t carried, uint32_t calls) {
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   const shaderio::SimUniforms u = contactUniforms(radius);
   WorkerPool pool(2);
-  CpuContact contact(pool, true);
+  CpuContact contact(pool, CpuContact::Lists::Repaired);
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
   std::vector<glm::vec4> pos = rest, prev;
