@@ -73,7 +73,8 @@ struct SimUniforms {
   uvec4 contact_grid;
 
   // The stretch limit (limitParticle in sim_bodies.h): x the longest a structural edge may be after
-  // the projection (stretch_limit x spacing; 0: off), y its rest length (the spacing)
+  // the projection (stretch_limit x spacing; 0: off), y its rest length (the spacing), z the last
+  // ring from limitRootSet's roots (limitLastRing, a whole number)
   vec4 limit;
   // The roots its rings run from (limitRootSet in xpbd.h): xyz the particles (SIM_NONE past the
   // last), w how many (0: the grabbed particle, else the sheet's middle)

@@ -260,6 +260,40 @@ SIM_INLINE uint limitRingsOf(uvec4 roots, uint cols, uint rows) {
   return last;
 }
 
+/// The fewest steps along the grid from the particle at column x, row y to one of `count` roots at
+/// columns rx and rows ry: the ring it is placed in (limitRootAt names that root).
+SIM_INLINE uint limitStepsAt(uint x, uint y, uvec4 rx, uvec4 ry, uint count) {
+  uint steps = 0xFFFFFFFFu;
+  for (uint j = 0u; j < count; ++j)
+    steps = min(steps, (x > rx[j] ? x - rx[j] : rx[j] - x) + (y > ry[j] ? y - ry[j] : ry[j] - y));
+  return steps;
+}
+
+/// The last ring of the stretch limit from `roots` exactly (limitRingsOf bounds it: 78 for a 32 x
+/// 48 sheet from its two top corners, where the farthest particle from its own pin is 62 steps
+/// away): the most of limitStepsAt over the grid. Along a row each root's steps fall to its column
+/// and rise after it, so their least is highest at the row's ends or where one root's rising steps
+/// meet another's falling ones, at (rx_i + rx_j + dy_j - dy_i) / 2 (dy: the rows to the root):
+/// those columns of each row are all it weighs. Rows x (2 + 4 x pairs of roots) places, for the
+/// host (SimUniforms::limit.z).
+SIM_INLINE uint limitLastRing(uvec4 roots, uint cols, uint rows) {
+  uvec4 rx = roots % cols, ry = roots / cols;
+  uint count = roots.w, last = 0u;
+  for (uint y = 0u; y < rows; ++y) {
+    last = max(last, max(limitStepsAt(0u, y, rx, ry, count), limitStepsAt(cols - 1u, y, rx, ry, count)));
+    for (uint i = 0u; i < count; ++i)
+      for (uint j = 0u; j < count; ++j) {
+        if (i == j) continue;
+        int twice = int(rx[i] + rx[j]) + abs(int(y) - int(ry[j])) - abs(int(y) - int(ry[i]));
+        for (int up = 0; up <= 1; ++up) {
+          int x = (twice + up) >> 1;
+          if (x >= 0 && x < int(cols)) last = max(last, limitStepsAt(uint(x), y, rx, ry, count));
+        }
+      }
+  }
+  return last;
+}
+
 /// Slots of a ring (ringParticle): two for each line of the grid's shorter side.
 SIM_INLINE uint limitSlots(uint cols, uint rows) { return 2u * min(cols, rows); }
 

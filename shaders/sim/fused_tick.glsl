@@ -270,7 +270,8 @@ void main() {
     // 5. The stretch limit (as limit.comp): ring after ring from the roots
     if (u.limit.x > 0.0f) {
       uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
-      uint rings = limitRingsOf(roots, u.cols, u.rows);
+      vec4 limit = u.limit; // read whole (limitParticle says why)
+      uint rings = uint(limit.z);
       for (uint k = 1u; k <= rings; ++k) {
         limitRing(roots, k, lid, kInvocations);
         sync();

@@ -14,7 +14,8 @@
 void main() {
   if (!(u.limit.x > 0.0f)) return; // the same branch for the whole workgroup
   uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
-  uint last = min(limitRingsOf(roots, u.cols, u.rows), p.first + p.count - 1u);
+  vec4 limit = u.limit; // read whole (limitParticle says why)
+  uint last = min(uint(limit.z), p.first + p.count - 1u);
   for (uint k = p.first; k <= last; ++k) {
     limitRing(roots, k, gl_LocalInvocationID.x, gl_WorkGroupSize.x);
     memoryBarrierBuffer();

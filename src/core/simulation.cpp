@@ -255,6 +255,10 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   const double dts = 1.0 / (double(p.tick_hz) * p.substeps);
   const float amp = wind_ ? p.wind_strength * p.wind_scale : 0.0f;
   u.grab_index = grab_index_ != SIM_NONE ? grab_index_ : release_index_;
+  if (u.limit.x > 0.0f) {
+    const glm::uvec4 roots = shaderio::limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
+    u.limit.z = float(shaderio::limitLastRing(roots, u.cols, u.rows));
+  }
   if (grab_index_ != SIM_NONE && closure_ > 0.0f && p.hand_reach > 0.0f) {
     const double dt = double(u.dt);
     const float ball = std::min(p.handBallRadius(), p.hand_reach);

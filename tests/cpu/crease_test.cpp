@@ -451,7 +451,7 @@ TEST(Stretch, RingsFromSeveralRootsVisitEveryParticleOnceAfterItsParents) {
     const uint32_t cols = size.x, rows = size.y, n = cols * rows;
     for (const glm::uvec4 roots : {glm::uvec4(0, cols - 1, SIM_NONE, 2), glm::uvec4(0, cols / 2, cols - 1, 3),
                                    glm::uvec4(0, n - 1, n / 2, 3), glm::uvec4(3, 3, SIM_NONE, 2)}) {
-      const uint32_t rings = shaderio::limitRingsOf(roots, cols, rows);
+      const uint32_t rings = shaderio::limitLastRing(roots, cols, rows);
       std::vector<int> seen(n, 0), ring(n, -1);
       for (uint32_t j = 0; j < roots.w; ++j) ring[roots[int(j)]] = 0;
       for (uint32_t k = 1; k <= rings; ++k)
@@ -475,6 +475,29 @@ TEST(Stretch, RingsFromSeveralRootsVisitEveryParticleOnceAfterItsParents) {
       for (uint32_t i = 0; i < n; ++i) EXPECT_EQ(seen[i], ring[i] == 0 ? 0 : 1) << cols << "x" << rows << " " << i;
     }
   }
+  // The last ring is exactly the most steps any particle lies from its nearest root, for any roots
+  // (the walk above, cut there, visits every particle): a brute-force count over the grid
+  std::mt19937 rng(9);
+  for (int trial = 0; trial < 400; ++trial) {
+    const uint32_t cols = 1 + rng() % 40, rows = 1 + rng() % 40, n = cols * rows, count = 1 + rng() % SIM_LIMIT_ROOTS;
+    glm::uvec4 roots(SIM_NONE, SIM_NONE, SIM_NONE, count);
+    for (uint32_t j = 0; j < count; ++j) roots[int(j)] = rng() % n;
+    uint32_t most = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      uint32_t nearest = ~0u;
+      for (uint32_t j = 0; j < count; ++j) nearest = std::min(nearest, shaderio::gridSteps(i, roots[int(j)], cols));
+      most = std::max(most, nearest);
+    }
+    ASSERT_EQ(shaderio::limitLastRing(roots, cols, rows), most)
+        << cols << "x" << rows << " roots " << roots.x << " " << roots.y << " " << roots.z << " (" << count << ")";
+    EXPECT_LE(most, shaderio::limitRingsOf(roots, cols, rows));
+    if (count == 1) {
+      EXPECT_EQ(most, shaderio::limitRings(roots.x, cols, rows));
+    }
+  }
+  // The bench's 32 x 48 sheet from its two top corners: 62 rings, not the 78 from each corner's farthest
+  EXPECT_EQ(shaderio::limitLastRing(glm::uvec4(0, 31, SIM_NONE, 2), 32, 48), 62u);
+  EXPECT_EQ(shaderio::limitRingsOf(glm::uvec4(0, 31, SIM_NONE, 2), 32, 48), 78u);
   // No uniforms' roots: the grab's, else the middle's
   EXPECT_EQ(shaderio::limitRootSet(glm::uvec4(0u), 7u, 4, 5), glm::uvec4(7u, SIM_NONE, SIM_NONE, 1u));
   EXPECT_EQ(shaderio::limitRootSet(glm::uvec4(0u), SIM_NONE, 4, 5).x, 10u);
