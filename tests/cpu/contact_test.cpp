@@ -535,21 +535,46 @@ shaderio::SimUniforms contactUniforms(float radius) {
   return u;
 }
 
+// Pair lists kept (Lists::Repaired: standing, turned, by clusters, repaired) against lists built
+// whole at every call, on the same positions: the same bounds and pushes, and the same cuts of
+// random steps up to 0.3 radius to the pairs' half-spaces (every pair closer than the radius has
+// one, so a pair missing from the kept lists shows)
+struct KeptAgainstRebuilt {
+  WorkerPool pool{2};
+  CpuContact rebuilt{pool, CpuContact::Lists::Rebuilt}, kept{pool, CpuContact::Lists::Repaired};
+  std::vector<float> bound_a, bound_b, share_a, share_b;
+  std::vector<glm::vec4> push_a, push_b, moved, excess_a, excess_b;
+
+  testing::AssertionResult call(const std::vector<glm::vec4>& pos, const std::vector<glm::vec4>& prev,
+                                const std::vector<glm::uvec4>& triangles, const shaderio::SimUniforms& u,
+                                std::mt19937& rng) {
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    rebuilt.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_a, push_a);
+    kept.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_b, push_b);
+    moved.resize(pos.size());
+    for (size_t i = 0; i < pos.size(); ++i)
+      moved[i] = pos[i] + glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.3f * u.contact.x;
+    rebuilt.slide(pos, moved, u, excess_a, share_a);
+    kept.slide(pos, moved, u, excess_b, share_b);
+    if (!sameBytes(bound_a, bound_b)) return testing::AssertionFailure() << "the bounds differ";
+    if (!sameBytes(push_a, push_b)) return testing::AssertionFailure() << "the pushes differ";
+    if (!sameBytes(excess_a, excess_b)) return testing::AssertionFailure() << "the excesses differ";
+    if (!sameBytes(share_a, share_b)) return testing::AssertionFailure() << "the shares differ";
+    return testing::AssertionSuccess();
+  }
+};
+
 TEST(ContactLists, ARepairKeepsEveryPairCloserThanTheRadius) {
   // Two layers of a 16 x 16 grid a radius apart, a triangle mesh of each, and at each call a few
-  // particles carried up to half a radius and the rest nudged: the bounds and pushes from lists
-  // repaired where particles travelled too far are those of lists built whole at every call
-  // (a bound is the nearest pair's, so a pair closer than the radius missing from the lists shows)
+  // particles carried up to half a radius and the rest nudged: lists repaired where particles
+  // travelled too far hold every pair closer than the radius (KeptAgainstRebuilt)
   constexpr uint32_t kLayer = 16 * 16;
   const float radius = 0.1f;
   auto [pos, triangles] = stackedLayers(16, 2, radius, glm::vec2(0.0f, 0.05f));
   const shaderio::SimUniforms u = contactUniforms(radius);
-  WorkerPool pool(2);
-  CpuContact whole(pool, CpuContact::Lists::Rebuilt), repaired(pool, CpuContact::Lists::Repaired);
+  KeptAgainstRebuilt lists;
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-  std::vector<float> bound_a, bound_b;
-  std::vector<glm::vec4> push_a, push_b;
   uint32_t contacts = 0;
   for (uint32_t call = 0; call < 120; ++call) {
     const std::vector<glm::vec4> prev = pos;
@@ -557,17 +582,14 @@ TEST(ContactLists, ARepairKeepsEveryPairCloserThanTheRadius) {
       const float reach = rng() % 40 == 0 ? 0.5f * radius : 0.03f * radius;
       p += glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * reach;
     }
-    whole.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_a, push_a);
-    repaired.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_b, push_b);
-    ASSERT_TRUE(sameBytes(bound_a, bound_b)) << "call " << call;
-    ASSERT_TRUE(sameBytes(push_a, push_b)) << "call " << call;
-    contacts += uint32_t(whole.contacts());
+    ASSERT_TRUE(lists.call(pos, prev, triangles, u, rng)) << "call " << call;
+    contacts += uint32_t(lists.rebuilt.contacts());
   }
   std::printf("%u particles in contact a call; lists built whole %u times, or %u times and repaired %u times\n",
-              contacts / 120u, whole.listBuilds(), repaired.listBuilds(), repaired.listRepairs());
+              contacts / 120u, lists.rebuilt.listBuilds(), lists.kept.listBuilds(), lists.kept.listRepairs());
   EXPECT_GT(contacts / 120u, kLayer);
-  EXPECT_GT(repaired.listRepairs(), 60u);
-  EXPECT_EQ(whole.listRepairs(), 0u);
+  EXPECT_GT(lists.kept.listRepairs(), 60u);
+  EXPECT_EQ(lists.rebuilt.listRepairs(), 0u);
 }
 
 TEST(ContactLists, ASheetThatTurnsAndStretchesKeepsItsListsAndEveryPairCloserThanTheRadius) {
@@ -576,8 +598,8 @@ TEST(ContactLists, ASheetThatTurnsAndStretchesKeepsItsListsAndEveryPairCloserTha
   // farther over the lower by two radii from the 40th to the 50th, and every particle nudged: the corners travel
   // hundreds of times the lists' travel, the stretch alone carries particles farther from one another than it lets, and
   // the slide brings new pairs within the radius. The lists stand through the turn (taken out of the travels) and the
-  // stretch (clusters next to each other travel alike), not through the slide, and the bounds and pushes are those of
-  // lists built whole at every call, and so are the steps' cuts to their pairs' half-spaces.
+  // stretch (clusters next to each other travel alike), not through the slide, and hold every pair closer than the
+  // radius (KeptAgainstRebuilt).
   constexpr uint32_t kSide = 40, kCalls = 60;
   const float radius = 0.1f;
   const auto [rest, triangles] = stackedLayers(kSide, 2, 0.6f * radius, glm::vec2(0.075f * kSide, 0.05f));
@@ -585,15 +607,12 @@ TEST(ContactLists, ASheetThatTurnsAndStretchesKeepsItsListsAndEveryPairCloserTha
   vec3 middle(0.0f);
   for (const glm::vec4& p : rest) middle += vec3(p) / float(n);
   const shaderio::SimUniforms u = contactUniforms(radius);
-  WorkerPool pool(2);
-  CpuContact rebuilt(pool, CpuContact::Lists::Rebuilt), kept(pool, CpuContact::Lists::Repaired);
+  KeptAgainstRebuilt lists;
+  const CpuContact& kept = lists.kept;
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
   const vec3 axis = glm::normalize(vec3(0.3f, 1.0f, 0.2f));
   std::vector<glm::vec4> pos = rest, prev;
-  std::vector<float> bound_a, bound_b;
-  std::vector<glm::vec4> push_a, push_b, moved(n), excess_a, excess_b;
-  std::vector<float> share_a, share_b;
   uint64_t contacts = 0;
   float widest = 0.0f;
   uint32_t turned = 0, held = 0; // the calls of the first two phases the lists stood by the turn, the clusters
@@ -611,19 +630,8 @@ TEST(ContactLists, ASheetThatTurnsAndStretchesKeepsItsListsAndEveryPairCloserTha
       widest = std::max(widest, glm::length(vec3(pos[i]) - vec3(rest[i])));
     }
     const uint32_t turns = kept.listTurns(), holds = kept.listHolds();
-    rebuilt.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_a, push_a);
-    kept.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_b, push_b);
-    ASSERT_TRUE(sameBytes(bound_a, bound_b)) << "call " << call;
-    ASSERT_TRUE(sameBytes(push_a, push_b)) << "call " << call;
-    // and so are the cuts of steps up to 0.3 radius to the pairs' half-spaces (every pair closer
-    // than the radius has one)
-    for (uint32_t i = 0; i < n; ++i)
-      moved[i] = pos[i] + glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.3f * radius;
-    rebuilt.slide(pos, moved, u, excess_a, share_a);
-    kept.slide(pos, moved, u, excess_b, share_b);
-    ASSERT_TRUE(sameBytes(excess_a, excess_b)) << "call " << call;
-    ASSERT_TRUE(sameBytes(share_a, share_b)) << "call " << call;
-    contacts += rebuilt.contacts();
+    ASSERT_TRUE(lists.call(pos, prev, triangles, u, rng)) << "call " << call;
+    contacts += lists.rebuilt.contacts();
     if (call < 20) turned += kept.listTurns() - turns;
     if (call >= 20 && call < 40) held += kept.listHolds() - holds;
   }
@@ -642,19 +650,18 @@ TEST(ContactLists, TwoLayersClosingInHaveTheirListsBuiltBeforeTheyMeet) {
   // Two layers of a 24 x 24 grid 100 radii apart, the upper one let down by 6 radii a call until it
   // lies half a radius over the lower, and every particle nudged: each layer travels as one, so
   // clusters next to each other travel alike, and only the spread of the clusters apart
-  // (cluster_far_) has the lists built again before a pair comes within the radius. The bounds,
-  // pushes and cuts to the half-spaces are those of lists built whole at every call.
+  // (cluster_far_) has the lists built again before a pair comes within the radius
+  // (KeptAgainstRebuilt).
   constexpr uint32_t kCalls = 24;
   const float radius = 0.1f, gap = 100.0f * radius;
   const auto [rest, triangles] = stackedLayers(24, 2, gap, glm::vec2(0.0f));
   const uint32_t n = uint32_t(rest.size());
   const shaderio::SimUniforms u = contactUniforms(radius);
-  WorkerPool pool(2);
-  CpuContact rebuilt(pool, CpuContact::Lists::Rebuilt), kept(pool, CpuContact::Lists::Repaired);
+  KeptAgainstRebuilt lists;
+  const CpuContact& kept = lists.kept;
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-  std::vector<glm::vec4> pos = rest, prev, moved(n), push_a, push_b, excess_a, excess_b;
-  std::vector<float> bound_a, bound_b, share_a, share_b;
+  std::vector<glm::vec4> pos = rest, prev;
   uint64_t contacts = 0;
   for (uint32_t call = 0; call < kCalls; ++call) {
     prev = pos;
@@ -662,17 +669,8 @@ TEST(ContactLists, TwoLayersClosingInHaveTheirListsBuiltBeforeTheyMeet) {
     for (uint32_t i = 0; i < n; ++i)
       pos[i] = rest[i] + glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.01f * radius -
                glm::vec4(0.0f, i >= n / 2 ? drop : 0.0f, 0.0f, 0.0f);
-    rebuilt.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_a, push_a);
-    kept.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_b, push_b);
-    for (uint32_t i = 0; i < n; ++i)
-      moved[i] = pos[i] + glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.3f * radius;
-    rebuilt.slide(pos, moved, u, excess_a, share_a);
-    kept.slide(pos, moved, u, excess_b, share_b);
-    ASSERT_TRUE(sameBytes(bound_a, bound_b)) << "call " << call;
-    ASSERT_TRUE(sameBytes(push_a, push_b)) << "call " << call;
-    ASSERT_TRUE(sameBytes(excess_a, excess_b)) << "call " << call;
-    ASSERT_TRUE(sameBytes(share_a, share_b)) << "call " << call;
-    contacts += rebuilt.contacts();
+    ASSERT_TRUE(lists.call(pos, prev, triangles, u, rng)) << "call " << call;
+    contacts += lists.rebuilt.contacts();
   }
   std::printf("%llu particles in contact in all; lists built %u times, repaired %u times, kept by the clusters %u "
               "times in %u calls\n",
