@@ -211,35 +211,39 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   contacts_ = contacts;
 }
 
+// Each pair's half-spaces, weighed at `start` as computeBounds weighed it; `visit` sees each of its
+// particles' (a pair once, from any thread: what it sums and lowers must not depend on the order)
+template <class Visit>
+void CpuContact::visitHalfSpaces(const std::vector<glm::vec4>& start, const SimUniforms& u, Visit&& visit) {
+  const float radius = u.contact.x, fraction = u.contact.y;
+  auto at = [&](uint32_t i) { return vec3(start[i]); };
+  for (const bool edge : {false, true}) {
+    const std::vector<uvec4>& list = edge ? ee_ : vf_;
+    pool_.parallelFor(uint32_t(list.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
+      for (uint32_t k = begin; k < end; ++k) {
+        const uvec4 q = list[k];
+        if (free_[q.x] | free_[q.y] | free_[q.z] | free_[q.w]) continue;
+        const vec3 x0 = at(q.x), x1 = at(q.y), x2 = at(q.z), x3 = at(q.w);
+        const ContactPair c = edge ? segmentSegment(x0, x1, x2, x3) : pointTriangle(x0, x1, x2, x3);
+        if (!(c.d2 < radius * radius)) continue;
+        for (uint32_t j = 0; j < 4; ++j) {
+          const SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, radius, fraction, j);
+          if (h.h.w >= 0.0f) visit(q[j], h);
+        }
+      }
+    });
+  }
+}
+
 void CpuContact::slide(const std::vector<glm::vec4>& start, const std::vector<glm::vec4>& pos, const SimUniforms& u,
                        std::vector<glm::vec4>& excess, std::vector<float>& share) {
   const uint32_t n = uint32_t(pos.size());
-  const float radius = u.contact.x, fraction = u.contact.y, scale = u.contact.w;
+  const float scale = u.contact.w;
   excess.assign(n, glm::vec4(0.0f));
   share.assign(n, 1.0f);
   sums_.assign(n, glm::ivec4(0));
-  auto at = [&](uint32_t i) { return vec3(start[i]); };
   auto step = [&](uint32_t i) { return vec3(pos[i]) - (vec3(start[i]) + frame_); };
-  // Each pair's half-spaces, weighed at the start as computeBounds weighed it; `visit` sees each
-  // of its particles' (a pair once; the sums and minimums do not depend on the order)
-  auto pairs = [&](auto&& visit) {
-    for (const bool edge : {false, true}) {
-      const std::vector<uvec4>& list = edge ? ee_ : vf_;
-      pool_.parallelFor(uint32_t(list.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
-        for (uint32_t k = begin; k < end; ++k) {
-          const uvec4 q = list[k];
-          if (free_[q.x] | free_[q.y] | free_[q.z] | free_[q.w]) continue;
-          const vec3 x0 = at(q.x), x1 = at(q.y), x2 = at(q.z), x3 = at(q.w);
-          const ContactPair c = edge ? segmentSegment(x0, x1, x2, x3) : pointTriangle(x0, x1, x2, x3);
-          if (!(c.d2 < radius * radius)) continue;
-          for (uint32_t j = 0; j < 4; ++j) {
-            const SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, radius, fraction, j);
-            if (h.h.w >= 0.0f) visit(q[j], h);
-          }
-        }
-      });
-    }
-  };
+  auto pairs = [&](auto&& visit) { visitHalfSpaces(start, u, visit); };
   if (!lists_) return; // positions gone wrong: the bounds hold every particle
   pairs([&](uint32_t i, const SlideHalf& h) {
     const vec3 e = slideExcess(h, step(i));
@@ -253,6 +257,45 @@ void CpuContact::slide(const std::vector<glm::vec4>& start, const std::vector<gl
     if (s < 1.0f) lower(bits[i], s);
   });
   for (uint32_t i = 0; i < n; ++i) share[i] = std::bit_cast<float>(bits[i]);
+}
+
+void CpuContact::listHalfSpaces(const std::vector<glm::vec4>& start, const SimUniforms& u) {
+  // Counted, scanned, filled (a particle's in any order: room() takes their minimum)
+  const uint32_t n = uint32_t(start.size());
+  half_start_.assign(n + 1, 0u);
+  if (!lists_) return;
+  visitHalfSpaces(start, u, [&](uint32_t i, const SlideHalf&) {
+    std::atomic_ref<uint32_t>(half_start_[i + 1]).fetch_add(1u, std::memory_order_relaxed);
+  });
+  for (uint32_t i = 0; i < n; ++i) half_start_[i + 1] += half_start_[i];
+  half_.resize(half_start_[n]);
+  half_slack_.resize(half_start_[n]);
+  half_fill_.assign(half_start_.begin(), half_start_.end() - 1);
+  visitHalfSpaces(start, u, [&](uint32_t i, const SlideHalf& h) {
+    const uint32_t k = std::atomic_ref<uint32_t>(half_fill_[i]).fetch_add(1u, std::memory_order_relaxed);
+    half_[k] = h.h;
+    half_slack_[k] = h.slack;
+  });
+}
+
+float CpuContact::room(uint32_t i, vec3 s, vec3 d, float ball) const {
+  float t = 1.0f;
+  const float dd = dot3(d, d);
+  if (!(dd > 0.0f)) return 0.0f;
+  const float ss = dot3(s, s), sd = dot3(s, d), dl = simSqrt(dd), sl = simSqrt(ss);
+  // |s + t d| <= ball
+  const float disc = sd * sd - dd * (ss - ball * ball);
+  if (!(disc >= 0.0f)) return 0.0f;
+  t = std::min(t, simDiv(simSqrt(disc) - sd, dd));
+  if (half_start_.size() > i + 1)
+    for (uint32_t k = half_start_[i]; k < half_start_[i + 1]; ++k) {
+      // n.(s + t d) - slack |s + t d| + h >= A + t B with |s + t d| <= |s| + t |d|
+      const vec3 nrm = vec3(half_[k]);
+      const float a = dot3(nrm, s) - half_slack_[k] * sl + half_[k].w, b = dot3(nrm, d) - half_slack_[k] * dl;
+      // (a <= 0: a half-space the step already meets, up to rounding, which it may not go further against)
+      if (b < 0.0f) t = std::min(t, simDiv(std::max(a, 0.0f), -b));
+    }
+  return std::max(t, 0.0f);
 }
 
 void CpuContact::addPush(uint32_t i, vec3 push, float scale) {
@@ -687,7 +730,8 @@ std::pair<vec3, vec3> CpuContact::turnedTravel(const std::vector<glm::vec4>& pos
 }
 
 uint64_t CpuContact::memoryBytes() const {
-  return capacityBytes(edges_) + capacityBytes(free_) + capacityBytes(was_free_) + capacityBytes(checked_) +
+  return capacityBytes(half_start_) + capacityBytes(half_) + capacityBytes(half_slack_) + capacityBytes(half_fill_) +
+         capacityBytes(edges_) + capacityBytes(free_) + capacityBytes(was_free_) + capacityBytes(checked_) +
          capacityBytes(sums_) + capacityBytes(crossing_) + capacityBytes(vf_) + capacityBytes(ee_) +
          capacityBytes(base_) + capacityBytes(lo_) + capacityBytes(hi_) + capacityBytes(nearest2_) +
          capacityBytes(grid_.start) + capacityBytes(grid_.entry) + capacityBytes(grid_.fill) +

@@ -45,6 +45,14 @@ public:
   /// step with that taken out that keeps every one, the least slideShare, into `share` (slideStep).
   void slide(const std::vector<glm::vec4>& start, const std::vector<glm::vec4>& pos, const shaderio::SimUniforms& u,
              std::vector<glm::vec4>& excess, std::vector<float>& share);
+  /// Lists each particle's half-spaces of the last computeBounds's pairs (those slide cuts the
+  /// steps to; the pairs from `start`, where that call had the particles) for room().
+  void listHalfSpaces(const std::vector<glm::vec4>& start, const shaderio::SimUniforms& u);
+  /// A t in [0, 1] for which particle i's step `s` (less the frame; one that keeps its listed
+  /// half-spaces and the ball of radius `ball`) moved by t x `d` still keeps them all: the largest
+  /// for the ball, and for each half-space the largest by |s + t d| <= |s| + t |d| (its slack's
+  /// term so bounded, slideAgainst is linear in t). What it keeps does not depend on the lists' order.
+  float room(uint32_t i, glm::vec3 s, glm::vec3 d, float ball) const;
   /// The translation taken out of the steps of the substep of the last call before their bounds.
   glm::vec3 frame() const { return frame_; }
   /// Particles within the radius of a primitive at the last call.
@@ -80,6 +88,10 @@ private:
     void build(const std::vector<glm::vec3>& lo, const std::vector<glm::vec3>& hi, float inv_cell);
   };
 
+  /// Calls visit(particle, SlideHalf) for each half-space the pairs closer than the radius set
+  /// their particles at `start`, from the pool's threads.
+  template <class Visit>
+  void visitHalfSpaces(const std::vector<glm::vec4>& start, const shaderio::SimUniforms& u, Visit&& visit);
   /// Box tests below which the crossing check tests its triangles against every triangle
   static constexpr uint64_t kBruteForceTests = 1u << 20;
   /// Adds a push to particle i's sum in fixed point (contactFixed, `scale` units a unit of length)
@@ -147,6 +159,10 @@ private:
   std::vector<uint32_t> dirty_;      ///< scratch: the particles, triangles, edges a repair looks at
   std::vector<uint32_t> nearest2_;   ///< the bits of each particle's smallest squared distance
   std::vector<uint32_t> share_bits_; ///< scratch: the bits of each particle's share (slide)
+  std::vector<uint32_t> half_start_; ///< each particle's half-spaces at [half_start_[i], half_start_[i + 1])
+  std::vector<glm::vec4> half_;      ///< the half-spaces (SlideHalf::h)
+  std::vector<float> half_slack_;    ///< and their slack
+  std::vector<uint32_t> half_fill_;  ///< scratch: where each particle's next half-space goes
   Grid grid_, points_grid_;
   uint64_t contacts_ = 0;
   uint32_t builds_ = 0;

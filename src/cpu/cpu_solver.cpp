@@ -280,15 +280,84 @@ void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
   // The steps' excess beyond their pairs' half-spaces and the share that keeps them, then each
   // step cut to them and to its bound
   contact_.slide(start_, pos_, u, excess_, share_);
+  // With settle sweeps (CpuOptions::contact_settle) the push comes after them
+  const bool settle = options_.contact_settle > 0 && u.limit.x > 0.0f;
   pool_->parallelFor(n, grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
     for (uint32_t i = begin; i < end; ++i) {
       if (!contactBounded(pos_[i].w, i == u.grab_index, u.grab_target[s].w)) continue;
-      const VerletState st = slideStep(VerletState{pos_[i], prev_[i]}, vec3(start_[i]), vec3(push_[i]),
-                                       vec3(excess_[i]), share_[i], bound_[i], frame);
+      const VerletState st =
+          settle ? contactStepTo(VerletState{pos_[i], prev_[i]},
+                                 slideTarget(vec3(pos_[i]), vec3(start_[i]) + frame, vec3(excess_[i]), share_[i]),
+                                 vec3(start_[i]), vec3(0.0f), bound_[i], frame)
+                 : slideStep(VerletState{pos_[i], prev_[i]}, vec3(start_[i]), vec3(push_[i]), vec3(excess_[i]),
+                             share_[i], bound_[i], frame);
       pos_[i] = st.position;
       prev_[i] = st.previous;
     }
   });
+  if (!settle) return;
+  contact_.listHalfSpaces(start_, u);
+  settlePass(u, s, frame);
+  pool_->parallelFor(n, grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
+    for (uint32_t i = begin; i < end; ++i) {
+      if (!contactBounded(pos_[i].w, i == u.grab_index, u.grab_target[s].w)) continue;
+      pos_[i] = vec4(vec3(pos_[i]) + vec3(push_[i]), pos_[i].w);
+      prev_[i] = vec4(vec3(prev_[i]) + vec3(push_[i]), prev_[i].w);
+    }
+  });
+}
+
+// The settle sweeps: Gauss-Seidel over the structural edges in the colours' order, each edge
+// longer than the stretch limit shortened from both ends, each end moved along the edge only as far
+// as its half-spaces and ball let its step go (CpuContact::room), what one end cannot take left to
+// the other. A step, as the shorten stage's: the previous positions stay. Every step stays within
+// the bounds the cut kept, so the contact's guarantee holds.
+void CpuSolver::settlePass(const SimUniforms& u, uint32_t s, vec3 frame) {
+  const uint32_t colors = uint32_t(colors_.size());
+  const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data();
+  const float* rest = con_rest_.data();
+  const float reach = u.limit.x;
+  std::vector<uint32_t>& edges = shorten_edges_;
+  edges.assign(colors, 0);
+  for (uint32_t c = 0; c < colors; ++c) {
+    const uint32_t* at = kind + colors_[c].first;
+    edges[c] = uint32_t(
+        std::partition_point(at, at + colors_[c].count, [](uint32_t k) { return k == SIM_KIND_STRUCTURAL; }) - at);
+  }
+  auto movable = [&](uint32_t i) {
+    return pos_[i].w > 0.0f && contactBounded(pos_[i].w, i == u.grab_index, u.grab_target[s].w);
+  };
+  // Moves particle i by up to `want` along `dir` (its room's share of it); what it moved
+  auto move = [&](uint32_t i, vec3 dir, float want) {
+    if (!(want > 0.0f)) return 0.0f;
+    const vec3 step = vec3(pos_[i]) - (vec3(start_[i]) + frame);
+    const float t = contact_.room(i, step, dir * want, bound_[i]);
+    pos_[i] = vec4(vec3(pos_[i]) + dir * (want * t), pos_[i].w);
+    return want * t;
+  };
+  auto settleEdge = [&](uint32_t k) {
+    const uint32_t a = ca[k], b = cb[k];
+    const vec4 pa = pos_[a], pb = pos_[b];
+    if (shouldTear(pa, pb, rest[k], SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return;
+    const vec3 d = vec3(pb) - vec3(pa);
+    const float len2 = dot3(d, d);
+    if (!(len2 > reach * reach)) return;
+    const bool ma = movable(a), mb = movable(b);
+    if (!ma && !mb) return;
+    const float len = simSqrt(len2), over = len - reach;
+    const vec3 e = d * simDiv(1.0f, len);
+    const float want_a = ma ? (mb ? 0.5f * over : over) : 0.0f;
+    const float got_a = move(a, e, want_a);
+    const float got_b = mb ? move(b, -e, over - got_a) : 0.0f;
+    if (ma) move(a, e, over - got_a - got_b);
+  };
+  for (uint32_t sweep = 0; sweep < options_.contact_settle; ++sweep)
+    for (uint32_t c = 0; c < colors; ++c) {
+      if (edges[c] == 0) continue;
+      pool_->parallelFor(edges[c], grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
+        for (uint32_t k = colors_[c].first + begin; k < colors_[c].first + end; ++k) settleEdge(k);
+      });
+    }
 }
 
 // Marks the live constraints among array slots [begin, end) of the split arrays that the shaders'

@@ -35,6 +35,11 @@ struct CpuOptions {
   /// Repair the contact's pair lists where a few particles travelled too far (CpuContact: their
   /// pairs looked for again) instead of building them whole. The results are the same either way.
   bool contact_repairs = true;
+  /// Sweeps of the settle stage after the contact's cut (settlePass; 0: none): over-long edges
+  /// shortened within what the contact lets each end move. It changes the results: a trial of the
+  /// stage that would let contact and the stretch limit run together (bench/README, Contact), with
+  /// no GPU counterpart yet, so no key turns it on.
+  uint32_t contact_settle = 0;
   /// Run the SIMD kernels (simd_kernels.h: SSE, and AVX where the CPU has it) for the projection,
   /// the tear test and the collision gather; off runs the scalar reference alone. The results are
   /// bitwise the same either way.
@@ -105,6 +110,8 @@ public:
   /// The ground contact; with contact on (SimUniforms::contact),
   /// no free particle ends farther from where it started the substep than its bound (contact.h).
   void floorPass(const shaderio::SimUniforms& u, uint32_t substep);
+  /// With contact and the stretch limit on: the settle sweeps after the contact's cut (CpuOptions::contact_settle).
+  void settlePass(const shaderio::SimUniforms& u, uint32_t s, glm::vec3 frame);
   /// Marks constraints beyond the tear threshold; returns how many tore.
   uint32_t markTears(const shaderio::SimUniforms& u);
   /// After a tear: marks the shear and tri-bend constraints whose triangles are gone (unsupported
