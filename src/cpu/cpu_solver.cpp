@@ -280,38 +280,28 @@ void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
   // The steps' excess beyond their pairs' half-spaces and the share that keeps them, then each
   // step cut to them and to its bound
   contact_.slide(start_, pos_, u, excess_, share_);
-  // With settle sweeps (CpuOptions::contact_settle) the push comes after them
-  const bool settle = options_.contact_settle > 0 && u.limit.x > 0.0f;
   pool_->parallelFor(n, grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
     for (uint32_t i = begin; i < end; ++i) {
       if (!contactBounded(pos_[i].w, i == u.grab_index, u.grab_target[s].w)) continue;
-      const VerletState st =
-          settle ? contactStepTo(VerletState{pos_[i], prev_[i]},
-                                 slideTarget(vec3(pos_[i]), vec3(start_[i]) + frame, vec3(excess_[i]), share_[i]),
-                                 vec3(start_[i]), vec3(0.0f), bound_[i], frame)
-                 : slideStep(VerletState{pos_[i], prev_[i]}, vec3(start_[i]), vec3(push_[i]), vec3(excess_[i]),
-                             share_[i], bound_[i], frame);
+      const VerletState st = slideStep(VerletState{pos_[i], prev_[i]}, vec3(start_[i]), vec3(push_[i]),
+                                       vec3(excess_[i]), share_[i], bound_[i], frame);
       pos_[i] = st.position;
       prev_[i] = st.previous;
     }
   });
-  if (!settle) return;
+  if (options_.contact_settle == 0 || !(u.limit.x > 0.0f)) return;
   contact_.listHalfSpaces(start_, u);
   settlePass(u, s, frame);
-  pool_->parallelFor(n, grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
-    for (uint32_t i = begin; i < end; ++i) {
-      if (!contactBounded(pos_[i].w, i == u.grab_index, u.grab_target[s].w)) continue;
-      pos_[i] = vec4(vec3(pos_[i]) + vec3(push_[i]), pos_[i].w);
-      prev_[i] = vec4(vec3(prev_[i]) + vec3(push_[i]), prev_[i].w);
-    }
-  });
 }
 
-// The settle sweeps: Gauss-Seidel over the structural edges in the colours' order, each edge
-// longer than the stretch limit shortened from both ends, each end moved along the edge only as far
-// as its half-spaces and ball let its step go (CpuContact::room), what one end cannot take left to
-// the other. A step, as the shorten stage's: the previous positions stay. Every step stays within
-// the bounds the cut kept, so the contact's guarantee holds.
+// The settle sweeps, after the contact's cut and push: Gauss-Seidel over the structural edges in
+// the colours' order, each edge longer than the stretch limit shortened from both ends, each end
+// moved along the edge only as far as its half-spaces and ball let its step (less the frame and the
+// push) go (CpuContact::room), what one end cannot take offered to the other; what neither can,
+// taken from the steps that went away from the other end (a step taken back towards where it
+// started keeps every half-space and the ball: they hold the zero step, and hold convex sets).
+// Moves, as the shorten stage's: the previous positions stay. Every step stays within what the cut
+// allowed, so the contact's guarantee holds.
 void CpuSolver::settlePass(const SimUniforms& u, uint32_t s, vec3 frame) {
   const uint32_t colors = uint32_t(colors_.size());
   const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data();
@@ -330,7 +320,7 @@ void CpuSolver::settlePass(const SimUniforms& u, uint32_t s, vec3 frame) {
   // Moves particle i by up to `want` along `dir` (its room's share of it); what it moved
   auto move = [&](uint32_t i, vec3 dir, float want) {
     if (!(want > 0.0f)) return 0.0f;
-    const vec3 step = vec3(pos_[i]) - (vec3(start_[i]) + frame);
+    const vec3 step = vec3(pos_[i]) - (vec3(start_[i]) + frame) - vec3(push_[i]);
     const float t = contact_.room(i, step, dir * want, bound_[i]);
     pos_[i] = vec4(vec3(pos_[i]) + dir * (want * t), pos_[i].w);
     return want * t;
@@ -349,7 +339,24 @@ void CpuSolver::settlePass(const SimUniforms& u, uint32_t s, vec3 frame) {
     const float want_a = ma ? (mb ? 0.5f * over : over) : 0.0f;
     const float got_a = move(a, e, want_a);
     const float got_b = mb ? move(b, -e, over - got_a) : 0.0f;
-    if (ma) move(a, e, over - got_a - got_b);
+    const float got_a2 = ma ? move(a, e, over - got_a - got_b) : 0.0f;
+    float left = over - got_a - got_b - got_a2;
+    if (!(left > 0.0f)) return;
+    // An end whose step this substep went away from the other may take it back (towards where it
+    // started, which keeps every half-space and the ball): each shortens by its share
+    auto back = [&](uint32_t i, vec3 dir, float want) {
+      const vec3 step = vec3(pos_[i]) - (vec3(start_[i]) + frame) - vec3(push_[i]);
+      const float rate = -dot3(step, dir); // the shortening of taking the whole step back
+      if (!(want > 0.0f) || !(rate > 0.0f)) return 0.0f;
+      const float l = std::min(1.0f, simDiv(want, rate));
+      pos_[i] = vec4(vec3(pos_[i]) - step * l, pos_[i].w);
+      return rate * l;
+    };
+    const float back_a = ma ? back(a, e, mb ? 0.5f * left : left) : 0.0f;
+    left -= back_a;
+    const float back_b = mb ? back(b, -e, left) : 0.0f;
+    left -= back_b;
+    if (ma) back(a, e, left);
   };
   for (uint32_t sweep = 0; sweep < options_.contact_settle; ++sweep)
     for (uint32_t c = 0; c < colors; ++c) {

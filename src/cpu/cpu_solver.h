@@ -36,9 +36,9 @@ struct CpuOptions {
   /// pairs looked for again) instead of building them whole. The results are the same either way.
   bool contact_repairs = true;
   /// Sweeps of the settle stage after the contact's cut (settlePass; 0: none): over-long edges
-  /// shortened within what the contact lets each end move. It changes the results: a trial of the
-  /// stage that would let contact and the stretch limit run together (bench/README, Contact), with
-  /// no GPU counterpart yet, so no key turns it on.
+  /// shortened within what the contact lets each end move, so that contact and the stretch limit
+  /// run together (bench/README, Contact: 16 sweeps). It changes the results and has no GPU
+  /// counterpart yet, so no key turns it on.
   uint32_t contact_settle = 0;
   /// Run the SIMD kernels (simd_kernels.h: SSE, and AVX where the CPU has it) for the projection,
   /// the tear test and the collision gather; off runs the scalar reference alone. The results are

@@ -410,9 +410,9 @@ TEST(Stretch, TheHandDragsFoldsAndCrumplesPaperWithinThreePercent) {
 TEST(Stretch, TheSettleSweepsHoldAFoldWithContactNearerTheLimitAndApart) {
   // The settle stage's trial (CpuOptions::contact_settle): the fold in half and back of the
   // `crumple` sheet at 30 x 45 with contact on. The contact's cut alone leaves edges it held back
-  // far beyond the limit (1.19); the sweeps shorten them within the cut's bounds (1.031: not yet
-  // the limit's 1.01, bench/README, Contact), the sheet stays apart (the exact judge every 10
-  // ticks), and the bits do not depend on the threads
+  // far beyond the limit (1.19); the sweeps shorten them within the cut's bounds to within the 3 %
+  // of `Stretch.TheHandDragsFoldsAndCrumplesPaperWithinThreePercent` (1.013), the sheet stays apart
+  // (the exact judge every 10 ticks), and the bits do not depend on the threads
   const SimParams p = flatSheet("crumple", {"cols=30", "rows=45", "contact_factor=0.5"});
   const auto [text, ticks] = foldScript(p, 0.5);
   struct Run {
@@ -439,13 +439,13 @@ TEST(Stretch, TheSettleSweepsHoldAFoldWithContactNearerTheLimitAndApart) {
     r.pos = s.pos;
     return r;
   };
-  const Run cut = run(2, 0), settled = run(2, 8), one = run(1, 8);
-  std::printf("fold with contact: most stretch %.4f cut alone, %.4f with 8 settle sweeps\n", double(cut.most),
+  const Run cut = run(2, 0), settled = run(2, 16), one = run(1, 16);
+  std::printf("fold with contact: most stretch %.4f cut alone, %.4f with 16 settle sweeps\n", double(cut.most),
               double(settled.most));
   EXPECT_EQ(cut.pairs, 0u);
   EXPECT_EQ(settled.pairs, 0u);
   EXPECT_GT(cut.most, 1.1f);
-  EXPECT_LE(settled.most, 1.05f);
+  EXPECT_LE(settled.most, 1.03f);
   ASSERT_EQ(one.pos.size(), settled.pos.size());
   EXPECT_EQ(std::memcmp(one.pos.data(), settled.pos.data(), one.pos.size() * sizeof(glm::vec4)), 0);
 }
