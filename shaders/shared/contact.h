@@ -335,6 +335,25 @@ SIM_INLINE VerletState slideStep(VerletState st, vec3 x0, vec3 push, vec3 excess
   return contactStepTo(st, slideTarget(vec3(st.position), x0 + frame, excess, share), x0, push, bound, frame);
 }
 
+/// The largest t in [0, 1] for which the step s + t d stays within the ball of radius `ball` (s
+/// within it); 0 for no move.
+SIM_INLINE float ballRoom(vec3 s, vec3 d, float ball) {
+  float dd = dot3(d, d), sd = dot3(s, d);
+  if (!(dd > 0.0f)) return 0.0f;
+  float disc = sd * sd - dd * (dot3(s, s) - ball * ball);
+  if (!(disc >= 0.0f)) return 0.0f;
+  return max(min(1.0f, simDiv(simSqrt(disc) - sd, dd)), 0.0f);
+}
+
+/// A t in [0, 1] for which the step s + t d keeps half-space c (slideAgainst of it at least -h.w)
+/// when s does (`s_len`, `d_len`: their lengths): slideAgainst is at least A + t B with
+/// |s + t d| <= |s| + t |d|, linear in t. A step that already meets it (A <= 0, up to rounding) may
+/// not go further against it.
+SIM_INLINE float halfSpaceRoom(SlideHalf c, vec3 s, float s_len, vec3 d, float d_len) {
+  float a = dot3(vec3(c.h), s) - c.slack * s_len + c.h.w, b = dot3(vec3(c.h), d) - c.slack * d_len;
+  return b < 0.0f ? min(1.0f, simDiv(max(a, 0.0f), -b)) : 1.0f;
+}
+
 /// Six times the signed volume of the tetrahedron a, b, c, d: positive when d lies on the side of
 /// the triangle a, b, c that (b - a) x (c - a) points to.
 SIM_INLINE float orient3(vec3 a, vec3 b, vec3 c, vec3 d) { return dot3(cross3(b - a, c - a), d - a); }

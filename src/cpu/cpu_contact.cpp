@@ -278,26 +278,6 @@ void CpuContact::listHalfSpaces(const std::vector<glm::vec4>& start, const SimUn
   });
 }
 
-float CpuContact::room(uint32_t i, vec3 s, vec3 d, float ball) const {
-  float t = 1.0f;
-  const float dd = dot3(d, d);
-  if (!(dd > 0.0f)) return 0.0f;
-  const float ss = dot3(s, s), sd = dot3(s, d), dl = simSqrt(dd), sl = simSqrt(ss);
-  // |s + t d| <= ball
-  const float disc = sd * sd - dd * (ss - ball * ball);
-  if (!(disc >= 0.0f)) return 0.0f;
-  t = std::min(t, simDiv(simSqrt(disc) - sd, dd));
-  if (half_start_.size() > i + 1)
-    for (uint32_t k = half_start_[i]; k < half_start_[i + 1]; ++k) {
-      // n.(s + t d) - slack |s + t d| + h >= A + t B with |s + t d| <= |s| + t |d|
-      const vec3 nrm = vec3(half_[k]);
-      const float a = dot3(nrm, s) - half_slack_[k] * sl + half_[k].w, b = dot3(nrm, d) - half_slack_[k] * dl;
-      // (a <= 0: a half-space the step already meets, up to rounding, which it may not go further against)
-      if (b < 0.0f) t = std::min(t, simDiv(std::max(a, 0.0f), -b));
-    }
-  return std::max(t, 0.0f);
-}
-
 void CpuContact::addPush(uint32_t i, vec3 push, float scale) {
   const glm::ivec3 f = contactFixed(push, scale);
   int32_t* sum = &sums_[i].x;

@@ -46,13 +46,13 @@ public:
   void slide(const std::vector<glm::vec4>& start, const std::vector<glm::vec4>& pos, const shaderio::SimUniforms& u,
              std::vector<glm::vec4>& excess, std::vector<float>& share);
   /// Lists each particle's half-spaces of the last computeBounds's pairs (those slide cuts the
-  /// steps to; the pairs from `start`, where that call had the particles) for room().
+  /// steps to; the pairs from `start`, where that call had the particles) for the settle stage.
   void listHalfSpaces(const std::vector<glm::vec4>& start, const shaderio::SimUniforms& u);
-  /// A t in [0, 1] for which particle i's step `s` (less the frame; one that keeps its listed
-  /// half-spaces and the ball of radius `ball`) moved by t x `d` still keeps them all: the largest
-  /// for the ball, and for each half-space the largest by |s + t d| <= |s| + t |d| (its slack's
-  /// term so bounded, slideAgainst is linear in t). What it keeps does not depend on the lists' order.
-  float room(uint32_t i, glm::vec3 s, glm::vec3 d, float ball) const;
+  /// The lists of listHalfSpaces: particle i's half-spaces (SlideHalf::h, and their slack) from
+  /// halfStart()[i] to halfStart()[i + 1], in no fixed order (settle_bodies.h takes minimums).
+  const std::vector<uint32_t>& halfStart() const { return half_start_; }
+  const std::vector<glm::vec4>& halfSpaces() const { return half_; }
+  const std::vector<float>& halfSlack() const { return half_slack_; }
   /// The translation taken out of the steps of the substep of the last call before their bounds.
   glm::vec3 frame() const { return frame_; }
   /// Particles within the radius of a primitive at the last call.

@@ -6,6 +6,7 @@
 
 #include "core/host_queries.h"
 #include "denormal_mode.h"
+#include "settle_elements.h"
 #include "simd_kernels.h"
 #include "worker_pool.h"
 
@@ -294,19 +295,12 @@ void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
   settlePass(u, s, frame);
 }
 
-// The settle sweeps, after the contact's cut and push: Gauss-Seidel over the structural edges in
-// the colours' order, each edge longer than the stretch limit shortened from both ends, each end
-// moved along the edge only as far as its half-spaces and ball let its step (less the frame and the
-// push) go (CpuContact::room), what one end cannot take offered to the other; what neither can,
-// taken from the steps that went away from the other end (a step taken back towards where it
-// started keeps every half-space and the ball: they hold the zero step, and hold convex sets).
-// Moves, as the shorten stage's: the previous positions stay. Every step stays within what the cut
-// allowed, so the contact's guarantee holds.
+// The settle sweeps, after the contact's cut and push (settle_bodies.h): over the structural edges
+// of each colour, `contact_settle` times.
 void CpuSolver::settlePass(const SimUniforms& u, uint32_t s, vec3 frame) {
   const uint32_t colors = uint32_t(colors_.size());
-  const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data();
+  const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
   const float* rest = con_rest_.data();
-  const float reach = u.limit.x;
   std::vector<uint32_t>& edges = shorten_edges_;
   edges.assign(colors, 0);
   for (uint32_t c = 0; c < colors; ++c) {
@@ -314,55 +308,22 @@ void CpuSolver::settlePass(const SimUniforms& u, uint32_t s, vec3 frame) {
     edges[c] = uint32_t(
         std::partition_point(at, at + colors_[c].count, [](uint32_t k) { return k == SIM_KIND_STRUCTURAL; }) - at);
   }
-  auto movable = [&](uint32_t i) {
-    return pos_[i].w > 0.0f && contactBounded(pos_[i].w, i == u.grab_index, u.grab_target[s].w);
-  };
-  // Moves particle i by up to `want` along `dir` (its room's share of it); what it moved
-  auto move = [&](uint32_t i, vec3 dir, float want) {
-    if (!(want > 0.0f)) return 0.0f;
-    const vec3 step = vec3(pos_[i]) - (vec3(start_[i]) + frame) - vec3(push_[i]);
-    const float t = contact_.room(i, step, dir * want, bound_[i]);
-    pos_[i] = vec4(vec3(pos_[i]) + dir * (want * t), pos_[i].w);
-    return want * t;
-  };
-  auto settleEdge = [&](uint32_t k) {
-    const uint32_t a = ca[k], b = cb[k];
-    const vec4 pa = pos_[a], pb = pos_[b];
-    if (shouldTear(pa, pb, rest[k], SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return;
-    const vec3 d = vec3(pb) - vec3(pa);
-    const float len2 = dot3(d, d);
-    if (!(len2 > reach * reach)) return;
-    const bool ma = movable(a), mb = movable(b);
-    if (!ma && !mb) return;
-    const float len = simSqrt(len2), over = len - reach;
-    const vec3 e = d * simDiv(1.0f, len);
-    const float want_a = ma ? (mb ? 0.5f * over : over) : 0.0f;
-    const float got_a = move(a, e, want_a);
-    const float got_b = mb ? move(b, -e, over - got_a) : 0.0f;
-    const float got_a2 = ma ? move(a, e, over - got_a - got_b) : 0.0f;
-    float left = over - got_a - got_b - got_a2;
-    if (!(left > 0.0f)) return;
-    // An end whose step this substep went away from the other may take it back (towards where it
-    // started, which keeps every half-space and the ball): each shortens by its share
-    auto back = [&](uint32_t i, vec3 dir, float want) {
-      const vec3 step = vec3(pos_[i]) - (vec3(start_[i]) + frame) - vec3(push_[i]);
-      const float rate = -dot3(step, dir); // the shortening of taking the whole step back
-      if (!(want > 0.0f) || !(rate > 0.0f)) return 0.0f;
-      const float l = std::min(1.0f, simDiv(want, rate));
-      pos_[i] = vec4(vec3(pos_[i]) - step * l, pos_[i].w);
-      return rate * l;
-    };
-    const float back_a = ma ? back(a, e, mb ? 0.5f * left : left) : 0.0f;
-    left -= back_a;
-    const float back_b = mb ? back(b, -e, left) : 0.0f;
-    left -= back_b;
-    if (ma) back(a, e, left);
-  };
+  SettleElements e{u,
+                   pos_.data(),
+                   start_.data(),
+                   push_.data(),
+                   bound_.data(),
+                   contact_.halfStart().data(),
+                   contact_.halfSpaces().data(),
+                   contact_.halfSlack().data(),
+                   frame,
+                   s};
   for (uint32_t sweep = 0; sweep < options_.contact_settle; ++sweep)
     for (uint32_t c = 0; c < colors; ++c) {
       if (edges[c] == 0) continue;
       pool_->parallelFor(edges[c], grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
-        for (uint32_t k = colors_[c].first + begin; k < colors_[c].first + end; ++k) settleEdge(k);
+        for (uint32_t k = colors_[c].first + begin; k < colors_[c].first + end; ++k)
+          e.settleConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]});
       });
     }
 }

@@ -1,0 +1,89 @@
+// The settle stage's per-edge body, shared by GLSL and C++ (src/cpu/settle_elements.h includes it
+// inside a struct whose members bear the buffers' names): after the contact's cut and push, each
+// structural edge longer than the stretch limit is shortened from both ends within what the
+// contact lets each end's step go. It reads u (SimUniforms), the positions through SIM_POSITION(j),
+// and for each particle where it started the substep (settle_start), its push (settle_push), its
+// ball (settle_bound) and its half-spaces (half_spaces and half_slack, particle i's from
+// half_start[i] to half_start[i + 1]); settle_frame is the substep's frame (contactFrame) and
+// settle_substep the substep.
+//
+// Why the contact's guarantee stands: a particle's half-spaces and ball (the cut's, slideStep) are
+// convex and hold the zero step, and the particle's step after the cut keeps them; each move here
+// goes only as far as halfSpaceRoom and ballRoom let the step go, or takes the step back towards
+// zero, so every step still keeps them. The rooms are minimums over a particle's half-spaces: the
+// order they are listed in changes no bit.
+#ifndef SIM_SETTLE_BODIES_H
+#define SIM_SETTLE_BODIES_H
+
+#ifndef SIM_POSITION
+#define SIM_POSITION(j) pos[j]
+#endif
+
+/// Particle i's step in the substep less the frame and its push: what its half-spaces and ball hold.
+SIM_INLINE vec3 settleStep(uint i) {
+  return vec3(SIM_POSITION(i)) - (vec3(settle_start[i]) + settle_frame) - vec3(settle_push[i]);
+}
+
+/// True when the settle may move particle i: a free particle the contact bounds (a grab the hand
+/// places stays where the hand has it).
+SIM_INLINE bool settleMovable(uint i) {
+  vec4 p = SIM_POSITION(i);
+  return p.w > 0.0f && contactBounded(p.w, i == u.grab_index, u.grab_target[settle_substep].w);
+}
+
+/// Moves particle i by up to `want` along the unit `dir`, as far as its ball and half-spaces let
+/// its step go; how far it moved.
+SIM_INLINE float settleMove(uint i, vec3 dir, float want) {
+  if (!(want > 0.0f)) return 0.0f;
+  vec3 s = settleStep(i), d = dir * want;
+  float s_len = simSqrt(dot3(s, s)), d_len = simSqrt(dot3(d, d));
+  float t = ballRoom(s, d, settle_bound[i]);
+  for (uint k = half_start[i]; k < half_start[i + 1u]; ++k) {
+    SlideHalf c;
+    c.h = half_spaces[k];
+    c.slack = half_slack[k];
+    t = min(t, halfSpaceRoom(c, s, s_len, d, d_len));
+  }
+  SIM_POSITION(i) = SIM_POSITION(i) + vec4(dir * (want * t), 0.0f);
+  return want * t;
+}
+
+/// Takes back particle i's step (towards where it started, with the frame and its push) by up to
+/// what shortens its edge by `want`, when the step went away along -`dir`; the shortening.
+SIM_INLINE float settleBack(uint i, vec3 dir, float want) {
+  vec3 s = settleStep(i);
+  float rate = -dot3(s, dir); // what taking the whole step back shortens the edge by
+  if (!(want > 0.0f) || !(rate > 0.0f)) return 0.0f;
+  float l = min(1.0f, simDiv(want, rate));
+  SIM_POSITION(i) = SIM_POSITION(i) - vec4(s * l, 0.0f);
+  return rate * l;
+}
+
+/// The settle on constraint c, in the colour order of the projection (no two of a colour share a
+/// particle): a structural edge longer than the stretch limit (and short of its tear length) is
+/// shortened by each end's move along it (half each, what one cannot take offered to the other),
+/// then by the ends' steps taken back.
+SIM_INLINE void settleConstraint(Constraint c) {
+  if ((c.kind_id & SIM_KIND_MASK) != SIM_KIND_STRUCTURAL) return;
+  vec4 limit = u.limit;
+  vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b);
+  if (shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return;
+  vec3 d = vec3(pb) - vec3(pa);
+  float len2 = dot3(d, d);
+  if (!(len2 > limit.x * limit.x)) return;
+  bool ma = settleMovable(c.a), mb = settleMovable(c.b);
+  if (!ma && !mb) return;
+  float len = simSqrt(len2), over = len - limit.x;
+  vec3 e = d * simDiv(1.0f, len);
+  float got_a = ma ? settleMove(c.a, e, mb ? 0.5f * over : over) : 0.0f;
+  float got_b = mb ? settleMove(c.b, -e, over - got_a) : 0.0f;
+  float got_a2 = ma ? settleMove(c.a, e, over - got_a - got_b) : 0.0f;
+  float left = over - got_a - got_b - got_a2;
+  if (!(left > 0.0f)) return;
+  float back_a = ma ? settleBack(c.a, e, mb ? 0.5f * left : left) : 0.0f;
+  left -= back_a;
+  float back_b = mb ? settleBack(c.b, -e, left) : 0.0f;
+  left -= back_b;
+  if (ma) settleBack(c.a, e, left);
+}
+#endif
