@@ -169,25 +169,30 @@ void CpuSolver::projectColors(const SimUniforms& u, uint32_t first, uint32_t cou
     });
 }
 
+const std::vector<uint32_t>& CpuSolver::countColourEdges() {
+  // A colour holds its edges first (splitConstraints sorts them there; the compaction keeps the
+  // order)
+  const uint32_t* kind = con_kind_.data();
+  colour_edges_.assign(colors_.size(), 0);
+  for (size_t c = 0; c < colors_.size(); ++c) {
+    const uint32_t* at = kind + colors_[c].first;
+    colour_edges_[c] = uint32_t(
+        std::partition_point(at, at + colors_[c].count, [](uint32_t k) { return k == SIM_KIND_STRUCTURAL; }) - at);
+  }
+  return colour_edges_;
+}
+
 void CpuSolver::shortenColors(const SimUniforms& u, uint32_t first, uint32_t count) {
   const uint32_t colors = uint32_t(colors_.size());
   if (colors == 0 || !limitShortens(u.limit.x, u.grab_index, u.flags)) return;
   SheetElements e = elements(u);
-  // A colour holds its edges first (splitConstraints sorts them there; the compaction keeps the
-  // order), so the stage visits that run of each colour alone.
+  // The stage visits the run of structural edges at the head of each colour alone
   const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
   const float* rest = con_rest_.data();
   std::vector<uint32_t>& passes = project_passes_;
-  std::vector<uint32_t>& edges = shorten_edges_;
+  const std::vector<uint32_t>& edges = countColourEdges();
   passes.clear();
-  edges.assign(colors, 0);
-  uint32_t largest = 0;
-  for (uint32_t c = 0; c < colors; ++c) {
-    const uint32_t* at = kind + colors_[c].first;
-    edges[c] = uint32_t(
-        std::partition_point(at, at + colors_[c].count, [](uint32_t k) { return k == SIM_KIND_STRUCTURAL; }) - at);
-    largest = std::max(largest, edges[c]);
-  }
+  const uint32_t largest = *std::max_element(edges.begin(), edges.end());
   for (uint32_t pass = first; pass < first + count; ++pass) {
     const ColorRange& range = colors_[pass % colors];
     if (range.count > 0 && shortensColour(kind[range.first]) && edges[pass % colors] > 0) passes.push_back(pass);
@@ -301,13 +306,7 @@ void CpuSolver::settlePass(const SimUniforms& u, uint32_t s, vec3 frame) {
   const uint32_t colors = uint32_t(colors_.size());
   const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
   const float* rest = con_rest_.data();
-  std::vector<uint32_t>& edges = shorten_edges_;
-  edges.assign(colors, 0);
-  for (uint32_t c = 0; c < colors; ++c) {
-    const uint32_t* at = kind + colors_[c].first;
-    edges[c] = uint32_t(
-        std::partition_point(at, at + colors_[c].count, [](uint32_t k) { return k == SIM_KIND_STRUCTURAL; }) - at);
-  }
+  const std::vector<uint32_t>& edges = countColourEdges();
   SettleElements e{u,
                    pos_.data(),
                    start_.data(),

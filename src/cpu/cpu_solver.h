@@ -112,6 +112,8 @@ public:
   void floorPass(const shaderio::SimUniforms& u, uint32_t substep);
   /// With contact and the stretch limit on: the settle sweeps after the contact's cut (CpuOptions::contact_settle).
   void settlePass(const shaderio::SimUniforms& u, uint32_t s, glm::vec3 frame);
+  /// How many structural edges each colour holds at its head (the shorten and settle stages visit those).
+  const std::vector<uint32_t>& countColourEdges();
   /// Marks constraints beyond the tear threshold; returns how many tore.
   uint32_t markTears(const shaderio::SimUniforms& u);
   /// After a tear: marks the shear and tri-bend constraints whose triangles are gone (unsupported
@@ -164,7 +166,7 @@ private:
   std::vector<shaderio::Constraint> constraints_;
   std::vector<ColorRange> colors_;
   std::vector<uint32_t> project_passes_; ///< projectColors' passes that project (scratch)
-  std::vector<uint32_t> shorten_edges_;  ///< shortenColors' edges at the head of each colour (scratch)
+  std::vector<uint32_t> colour_edges_;   ///< the structural edges at the head of each colour (countColourEdges)
   /// limitPass's rings from several roots: each particle's root, the particles in the rings'
   /// order from where ring 1 starts, for those roots
   std::vector<uint32_t> limit_root_of_, limit_order_;
