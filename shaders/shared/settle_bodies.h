@@ -2,10 +2,11 @@
 // inside a struct whose members bear the buffers' names): after the contact's cut and push, each
 // structural edge longer than the stretch limit is shortened from both ends within what the
 // contact lets each end's step go. It reads u (SimUniforms), the positions through SIM_POSITION(j),
-// and for each particle where it started the substep (settle_start), its push (settle_push), its
-// ball (settle_bound) and its half-spaces (half_spaces and half_slack, particle i's from
-// half_start[i] to half_start[i + 1]); settle_frame is the substep's frame (contactFrame) and
-// settle_substep the substep.
+// and through functions each side defines: for particle i where it started the substep
+// (settleStart), its push (settlePush), its ball (settleBound), its half-spaces (halfSpace(k) for
+// k from halfFirst(i) to halfEnd(i)), and the substep's frame (settleFrame, contactFrame). The
+// half-spaces are listed by particle, counted, scanned and filled (SIM_CONTACT_HALF_CAPACITY a
+// particle on average); a particle whose list ends past them is not moved.
 //
 // Why the contact's guarantee stands: a particle's half-spaces and ball (the cut's, slideStep) are
 // convex and hold the zero step, and the particle's step after the cut keeps them; each move here
@@ -20,15 +21,14 @@
 #endif
 
 /// Particle i's step in the substep less the frame and its push: what its half-spaces and ball hold.
-SIM_INLINE vec3 settleStep(uint i) {
-  return vec3(SIM_POSITION(i)) - (vec3(settle_start[i]) + settle_frame) - vec3(settle_push[i]);
-}
+SIM_INLINE vec3 settleStep(uint i) { return vec3(SIM_POSITION(i)) - (settleStart(i) + settleFrame()) - settlePush(i); }
 
-/// True when the settle may move particle i: a free particle the contact bounds (a grab the hand
-/// places stays where the hand has it).
-SIM_INLINE bool settleMovable(uint i) {
+/// True when the settle may move particle i in substep s: a free particle the contact bounds (a
+/// grab the hand places stays where the hand has it) whose half-spaces are all listed.
+SIM_INLINE bool settleMovable(uint i, uint s) {
   vec4 p = SIM_POSITION(i);
-  return p.w > 0.0f && contactBounded(p.w, i == u.grab_index, u.grab_target[settle_substep].w);
+  return p.w > 0.0f && contactBounded(p.w, i == u.grab_index, u.grab_target[s].w) &&
+         halfEnd(i) <= SIM_CONTACT_HALF_CAPACITY * u.particle_count;
 }
 
 /// Moves particle i by up to `want` along the unit `dir`, as far as its ball and half-spaces let
@@ -37,13 +37,8 @@ SIM_INLINE float settleMove(uint i, vec3 dir, float want) {
   if (!(want > 0.0f)) return 0.0f;
   vec3 s = settleStep(i), d = dir * want;
   float s_len = simSqrt(dot3(s, s)), d_len = simSqrt(dot3(d, d));
-  float t = ballRoom(s, d, settle_bound[i]);
-  for (uint k = half_start[i]; k < half_start[i + 1u]; ++k) {
-    SlideHalf c;
-    c.h = half_spaces[k];
-    c.slack = half_slack[k];
-    t = min(t, halfSpaceRoom(c, s, s_len, d, d_len));
-  }
+  float t = ballRoom(s, d, settleBound(i));
+  for (uint k = halfFirst(i); k < halfEnd(i); ++k) t = min(t, halfSpaceRoom(halfSpace(k), s, s_len, d, d_len));
   SIM_POSITION(i) = SIM_POSITION(i) + vec4(dir * (want * t), 0.0f);
   return want * t;
 }
@@ -59,11 +54,11 @@ SIM_INLINE float settleBack(uint i, vec3 dir, float want) {
   return rate * l;
 }
 
-/// The settle on constraint c, in the colour order of the projection (no two of a colour share a
+/// The settle on constraint c in substep s, in the colour order of the projection (no two of a colour share a
 /// particle): a structural edge longer than the stretch limit (and short of its tear length) is
 /// shortened by each end's move along it (half each, what one cannot take offered to the other),
 /// then by the ends' steps taken back.
-SIM_INLINE void settleConstraint(Constraint c) {
+SIM_INLINE void settleConstraint(Constraint c, uint s) {
   if ((c.kind_id & SIM_KIND_MASK) != SIM_KIND_STRUCTURAL) return;
   vec4 limit = u.limit;
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b);
@@ -71,7 +66,7 @@ SIM_INLINE void settleConstraint(Constraint c) {
   vec3 d = vec3(pb) - vec3(pa);
   float len2 = dot3(d, d);
   if (!(len2 > limit.x * limit.x)) return;
-  bool ma = settleMovable(c.a), mb = settleMovable(c.b);
+  bool ma = settleMovable(c.a, s), mb = settleMovable(c.b, s);
   if (!ma && !mb) return;
   float len = simSqrt(len2), over = len - limit.x;
   vec3 e = d * simDiv(1.0f, len);

@@ -262,6 +262,11 @@
 // the grid every substep)
 #define SIM_CONTACT_LIST_HEADER 5u
 #define SIM_CONTACT_LIST_CAPACITY 16u
+// The settle stage's half-spaces (settle_bodies.h), listed by particle: room for this many a
+// particle on average (a particle whose list ends past them is not moved), on the CPU and the GPU
+#define SIM_CONTACT_HALF_CAPACITY 16u
+// The settle stage's sweeps at most (the contact_settle key)
+#define SIM_SETTLE_MAX_SWEEPS 64u
 // The GPU's contact grid: words of its header in SIM_BIND_CONTACT_GRID (x the bits of the longest
 // live edge's squared length, y 1 when a triangle crosses another, z the particles in contact, w 1
 // when the pair lists are built this substep, then 1 when the grid is built this substep and 1 when a

@@ -55,6 +55,9 @@
   X(contact_excess, SIM, 1, 0)                                                                                         \
   X(contact_share, SIM, 1, 0)                                                                                          \
   X(contact_step, SIM, 1, 0)                                                                                           \
+  X(contact_half_count, SIM, 1, 0)                                                                                     \
+  X(contact_half_fill, SIM, 1, 0)                                                                                      \
+  X(contact_settle, SIM, 1, 0)                                                                                         \
   X(tear_mark, SIM, 1, 1)                                                                                              \
   X(tear_unsupported, NONE, 1, 1)                                                                                      \
   X(tear_flags, NONE, 1, 1)                                                                                            \
@@ -78,8 +81,9 @@
   X(limit, 4u, ONCE, ALWAYS)                                                                                           \
   X(crease, 5u, ONCE, ALWAYS)                                                                                          \
   X(floor, 6u, ONCE, ALWAYS)                                                                                           \
-  X(tear, 7u, ONCE, ALWAYS)
-#define SIM_STAGE_COUNT 8u
+  X(settle, 7u, ONCE, ALWAYS)                                                                                          \
+  X(tear, 8u, ONCE, ALWAYS)
+#define SIM_STAGE_COUNT 9u
 
 // The dispatches of each stage, in the order the per-colour path records them (a barrier after
 // each). The fused tick and the CPU run the same bodies in the same order.
@@ -96,7 +100,9 @@
 //             CONTACT_BOXES (triangle slots, then edges), CONTACT_QUERIES (particles, then
 //             edges), CONTACT_CELLS (a scan of its grid's buckets), CONTACT_ACTIVE (the queries
 //             and their end, from the scratch offset of their flags) and CONTACT_ACTIVE_CELLS (a
-//             scan of those flags)
+//             scan of those flags); the settle's: CONTACT_HALF_CELLS (a scan of the particles'
+//             half-space counts) and SWEEPS (the colours with structural edges, once each sweep:
+//             SimPush.first the sweep)
 //   grid      Threads (from the elements), Hash (the live hash arguments candidates_decide
 //             copies), Contact (the live arguments of contact's grid passes contact_arm copies:
 //             none in a substep that does not build the grid), Walk (contact_walk's, over the
@@ -107,8 +113,9 @@
 //   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)
 //   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases), LIMIT
 //             (the sheet has a stretch limit), SHORTEN (the limit shortens edges: limitShortens),
-//             CONSTRAINTS (the sheet has constraints) or CONTACT (contact is on: a sheet alone,
-//             or a fleet's sheet recorded on its own)
+//             CONSTRAINTS (the sheet has constraints), CONTACT (contact is on: a sheet alone,
+//             or a fleet's sheet recorded on its own) or SETTLE (contact is on with the settle's
+//             sweeps: SubstepPlan::sweeps)
 //   category  its timestamp category (gpu::PassCategory k<category>)
 #define SIM_DISPATCHES(X)                                                                                              \
   X(integrate, contact_begin, ONE, Threads, TICK, CONTACT, Contact)                                                    \
@@ -144,6 +151,10 @@
   X(floor, contact_excess, CONTACT_QUERIES, Threads, TICK, CONTACT, Floor)                                             \
   X(floor, contact_share, CONTACT_QUERIES, Threads, TICK, CONTACT, Floor)                                              \
   X(floor, contact_step, PARTICLES, Threads, TICK, CONTACT, Floor)                                                     \
+  X(settle, contact_half_count, CONTACT_QUERIES, Threads, TICK, SETTLE, Floor)                                         \
+  X(settle, scan, CONTACT_HALF_CELLS, Threads, TICK, SETTLE, Floor)                                                    \
+  X(settle, contact_half_fill, CONTACT_QUERIES, Threads, TICK, SETTLE, Floor)                                          \
+  X(settle, contact_settle, SWEEPS, Threads, TICK, SETTLE, Floor)                                                      \
   X(tear, tear_mark, CONSTRAINTS, Threads, TICK, CONSTRAINTS, Tear)                                                    \
   X(tear, tear_unsupported, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                       \
   X(tear, tear_flags, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                             \

@@ -64,8 +64,10 @@ struct SimUniforms {
   // pairs are pushed apart), w the fixed-point units of a push per unit of length (contactFixed)
   vec4 contact;
   // Which triangles are checked for crossing the sheet (crossingChecked): x SIM_CONTACT_CHECK_*; y
-  // and z unused (0); w the GPU's pairs a contact query keeps in its list (at most
-  // SIM_CONTACT_LIST_CAPACITY)
+  // the settle stage's sweeps (contact_settle; 0 without the stretch limit); z the GPU's scratch
+  // offset of the settle's half-space counts, then starts (particles + 1), their fills (particles)
+  // and their scan's sums (the solver fills it in); w the GPU's pairs a contact query keeps in its
+  // list (at most SIM_CONTACT_LIST_CAPACITY)
   uvec4 contact_check;
   // The GPU's contact grid (the solver fills it in): x the hash mask of each half, y the scratch offset of its
   // bucket counts (then starts), z of its bucket fills, w the sheet's edges (SIM_BIND_CONTACT_LISTS);

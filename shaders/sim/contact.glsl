@@ -412,6 +412,10 @@ void contactCross(uint t, uint s) {
 // the grid, for the half-spaces of the steps (contact_excess, contact_share: slidePair)
 #define NEAR_EXCESS 3u
 #define NEAR_SHARE 4u
+// ... or those half-spaces listed by particle for the settle stage: counted (contact_half_count),
+// then, after the counts' scan, filled (contact_half_fill)
+#define NEAR_HALF_COUNT 5u
+#define NEAR_HALF_FILL 6u
 // Candidates contactNearOf gathers before it weighs them
 #define CONTACT_BATCH 16u
 
@@ -419,16 +423,53 @@ void contactCross(uint t, uint s) {
 // half-spaces' passes, after the floor)
 vec4 nearPosition(uint j, uint only) { return only >= NEAR_EXCESS ? contact_particles[j].start : SIM_POSITION(j); }
 
+// The settle stage's half-spaces listed by particle (settle_bodies.h), in scratch from
+// u.contact_check.z: particle i's count, then (their exclusive scan) where its list starts
+// (particles + 1 words), then its fill (particles words); the lists themselves (SlideHalf: five
+// words each, SIM_CONTACT_HALF_CAPACITY a particle) after the queries' pair lists
+uint halfStarts() { return u.contact_check.z; }
+uint halfFills() { return u.contact_check.z + u.particle_count + 1u; }
+uint halfEntries() { return listOf(u.particle_count + contactEdgeCount()); }
+uint halfFirst(uint i) { return scratch[halfStarts() + i]; }
+uint halfEnd(uint i) { return scratch[halfStarts() + i + 1u]; }
+SlideHalf halfSpace(uint k) {
+  uint w = halfEntries() + 5u * k;
+  SlideHalf h;
+  h.h = uintBitsToFloat(uvec4(contact_lists[w], contact_lists[w + 1u], contact_lists[w + 2u], contact_lists[w + 3u]));
+  h.slack = uintBitsToFloat(contact_lists[w + 4u]);
+  return h;
+}
+// Half-space h of particle i: counted, or put in its list (within the capacity)
+void listHalf(uint i, SlideHalf h, uint only) {
+  if (only == NEAR_HALF_COUNT) {
+    atomicAdd(scratch[halfStarts() + i], 1u);
+    return;
+  }
+  uint k = halfFirst(i) + atomicAdd(scratch[halfFills() + i], 1u);
+  if (k >= SIM_CONTACT_HALF_CAPACITY * u.particle_count) return;
+  uint w = halfEntries() + 5u * k;
+  uvec4 bits = floatBitsToUint(h.h);
+  contact_lists[w] = bits.x;
+  contact_lists[w + 1u] = bits.y;
+  contact_lists[w + 2u] = bits.z;
+  contact_lists[w + 3u] = bits.w;
+  contact_lists[w + 4u] = floatBitsToUint(h.slack);
+}
+
 // The half-spaces pair q sets its particles' steps in (slideConstraint; `edge`: two edges; x0..x3
 // where they started the substep, c their nearest points): each step's excess beyond them summed
 // into its particle's sums (NEAR_EXCESS), or the share of the step less that excess's mean that
-// keeps them lowering its share (NEAR_SHARE)
+// keeps them lowering its share (NEAR_SHARE), or listed by particle (NEAR_HALF_*)
 void slidePair(uvec4 q, vec3 x0, vec3 x1, vec3 x2, vec3 x3, ContactPair c, bool edge, uint only) {
   vec3 frame = contactFrameNow();
   for (uint j = 0u; j < 4u; ++j) {
     SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, u.contact.x, u.contact.y, j);
     if (h.h.w < 0.0f) continue;
     uint i = j == 0u ? q.x : (j == 1u ? q.y : (j == 2u ? q.z : q.w));
+    if (only >= NEAR_HALF_COUNT) {
+      listHalf(i, h, only);
+      continue;
+    }
     vec3 step = vec3(SIM_POSITION(i)) - (vec3(contact_particles[i].start) + frame);
     if (only == NEAR_EXCESS) {
       vec3 e = slideExcess(h, step);
@@ -629,10 +670,22 @@ VerletState contactSlideStep(uint i, VerletState st, uint s) {
 }
 
 // What the floor pass leaves for the half-spaces' passes: particle i's sums cleared for the
-// excess and its share whole
+// excess and its share whole; with the settle on, its half-spaces' count and fill cleared
 void contactSlideClear(uint i) {
   contact_particles[i].sum = uvec4(0u);
   contact_particles[i].state.z = floatBitsToUint(1.0f);
+  if (u.contact_check.y == 0u) return;
+  scratch[halfStarts() + i] = 0u;
+  scratch[halfFills() + i] = 0u;
+  if (i == 0u) scratch[halfStarts() + u.particle_count] = 0u;
 }
+
+// The settle stage (settle_bodies.h) reads where each particle started the substep, its push and
+// ball, its half-spaces (above) and the substep's frame
+vec3 settleStart(uint i) { return vec3(contact_particles[i].start); }
+vec3 settlePush(uint i) { return vec3(contact_particles[i].push); }
+float settleBound(uint i) { return contact_particles[i].start.w; }
+vec3 settleFrame() { return contactFrameNow(); }
+#include "settle_bodies.h"
 
 #endif

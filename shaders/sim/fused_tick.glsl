@@ -91,6 +91,26 @@ void contactSlideSubstep(uint s, uint n) {
   sync();
 }
 
+// The settle stage (as contact_half_count, scan, contact_half_fill and contact_settle): the pairs'
+// half-spaces counted by particle, scanned and listed, then the sweeps over the colours with
+// structural edges
+void contactSettleSubstep(uint s) {
+  uint lid = gl_LocalInvocationID.x;
+  uint queries = u.particle_count + contactEdgeCount();
+  for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_HALF_COUNT);
+  sync();
+  scanWorkgroup(SIM_SCAN_SCRATCH, halfStarts(), u.particle_count + 1u, compactSlots());
+  for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_HALF_FILL);
+  sync();
+  for (uint sweep = 0u; sweep < u.contact_check.y; ++sweep)
+    for (uint c = 0u; c < u.color_count; ++c) {
+      uvec2 range = color_range[c];
+      if (range.y == 0u || !shortensColour(constraints[range.x].kind_id)) continue;
+      for (uint t = lid; t < range.y; t += kInvocations) settleConstraint(constraints[range.x + t], s);
+      sync();
+    }
+}
+
 // Contact (as the contact_* passes, contact.glsl): each particle's step bound and push for substep
 // s, from where it starts it.
 void contactSubstep(uint s, uint n) {
@@ -158,6 +178,7 @@ void main() {
   uint crease_pass = stageFirstPass(SIM_STAGE_crease, u.iterations, u.color_count, collision);
   uint collide_pass = stageFirstPass(SIM_STAGE_collide, u.iterations, u.color_count, collision);
   uint floor_pass = stageFirstPass(SIM_STAGE_floor, u.iterations, u.color_count, collision);
+  uint settle_pass = stageFirstPass(SIM_STAGE_settle, u.iterations, u.color_count, collision);
   uint tear_pass = stageFirstPass(SIM_STAGE_tear, u.iterations, u.color_count, collision);
   for (uint s = p.first_substep; s < end; ++s) {
     uint first_pass = s * per_substep;
@@ -309,7 +330,15 @@ void main() {
       storePositions(n);
       return;
     }
-    // 8. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
+#ifdef SIM_FUSED_CONTACT
+    // 8. The settle stage, with contact and its sweeps on
+    if (u.contact.x > 0.0f && u.contact_check.y > 0u) contactSettleSubstep(s);
+#endif
+    if (stopsAfter(first_pass + settle_pass)) {
+      storePositions(n);
+      return;
+    }
+    // 9. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
     // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
     // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
     // substep it tore in removed it), and kinds that cannot tear skip the position loads.

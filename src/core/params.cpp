@@ -174,6 +174,8 @@ const std::vector<Param>& params() {
       floatParam("collision_stiffness", &SimParams::collision_stiffness, 0.0f, 1.0f, "repulsion strength"),
       floatParam("contact_factor", &SimParams::contact_factor, 0.0f, 10.0f,
                  "penetration-free contact radius as a multiple of spacing (0: off)"),
+      uintParam("contact_settle", &SimParams::contact_settle, 0, SIM_SETTLE_MAX_SWEEPS,
+                "sweeps a substep that shorten edges the contact held past the stretch limit (0: none)"),
       floatParam("floor_y", &SimParams::floor_y, -1e4f, 1e4f, "ground height"),
       floatParam("restitution", &SimParams::restitution, 0.0f, 1.0f, "bounce off the ground"),
       floatParam("friction", &SimParams::friction, 0.0f, 1.0f, "ground friction"),

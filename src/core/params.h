@@ -73,6 +73,9 @@ struct SimParams {
   float collision_stiffness = 1.0f;
   /// Contact radius of the penetration-free self-contact (contact.h) as a multiple of spacing; 0: off
   float contact_factor = 0.0f;
+  /// With contact and the stretch limit on: the settle stage's sweeps over the structural edges
+  /// the contact's cut left longer than the limit (settle_bodies.h); 0: none
+  uint32_t contact_settle = 0;
   // Ground
   float floor_y = -6.0f;
   float restitution = 0.2f;

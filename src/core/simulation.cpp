@@ -288,7 +288,9 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   // starts (a new sheet, a reset, the key turned on) and once every SIM_CONTACT_AUDIT_TICKS ticks;
   // otherwise those already crossing (crossingChecked in contact.h)
   const bool audit = !contact_on_last_ || physics_ticks_ % SIM_CONTACT_AUDIT_TICKS == 0;
-  if (u.contact.x > 0.0f) u.contact_check = glm::uvec4(audit ? SIM_CONTACT_CHECK_ALL : 0u, 0u, 0u, 0u);
+  // The settle's sweeps, with the stretch limit on
+  if (u.contact.x > 0.0f)
+    u.contact_check = glm::uvec4(audit ? SIM_CONTACT_CHECK_ALL : 0u, u.limit.x > 0.0f ? p.contact_settle : 0u, 0u, 0u);
   return u;
 }
 

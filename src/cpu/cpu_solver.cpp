@@ -295,14 +295,13 @@ void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
       prev_[i] = st.previous;
     }
   });
-  if (options_.contact_settle == 0 || !(u.limit.x > 0.0f)) return;
-  contact_.listHalfSpaces(start_, u);
-  settlePass(u, s, frame);
 }
 
 // The settle sweeps, after the contact's cut and push (settle_bodies.h): over the structural edges
-// of each colour, `contact_settle` times.
-void CpuSolver::settlePass(const SimUniforms& u, uint32_t s, vec3 frame) {
+// of each colour, contact_check.y times.
+void CpuSolver::settlePass(const SimUniforms& u, uint32_t s) {
+  if (!(u.contact.x > 0.0f) || u.contact_check.y == 0) return;
+  contact_.listHalfSpaces(start_, u);
   const uint32_t colors = uint32_t(colors_.size());
   const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
   const float* rest = con_rest_.data();
@@ -315,14 +314,13 @@ void CpuSolver::settlePass(const SimUniforms& u, uint32_t s, vec3 frame) {
                    contact_.halfStart().data(),
                    contact_.halfSpaces().data(),
                    contact_.halfSlack().data(),
-                   frame,
-                   s};
-  for (uint32_t sweep = 0; sweep < options_.contact_settle; ++sweep)
+                   contact_.frame()};
+  for (uint32_t sweep = 0; sweep < u.contact_check.y; ++sweep)
     for (uint32_t c = 0; c < colors; ++c) {
       if (edges[c] == 0) continue;
       pool_->parallelFor(edges[c], grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
         for (uint32_t k = colors_[c].first + begin; k < colors_[c].first + end; ++k)
-          e.settleConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]});
+          e.settleConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]}, s);
       });
     }
 }
@@ -487,6 +485,9 @@ void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint3
     break;
   case PassKind::floor:
     floorPass(u, s); // the ground contact; bound the steps
+    break;
+  case PassKind::settle:
+    settlePass(u, s); // over-long edges shortened within the steps' bounds
     break;
   case PassKind::tear:
     // Tear, let go of what stood on the triangles lost, compact the colours and triangles

@@ -35,11 +35,6 @@ struct CpuOptions {
   /// Repair the contact's pair lists where a few particles travelled too far (CpuContact: their
   /// pairs looked for again) instead of building them whole. The results are the same either way.
   bool contact_repairs = true;
-  /// Sweeps of the settle stage after the contact's cut (settlePass; 0: none): over-long edges
-  /// shortened within what the contact lets each end move, so that contact and the stretch limit
-  /// run together (bench/README, Contact: 16 sweeps). It changes the results and has no GPU
-  /// counterpart yet, so no key turns it on.
-  uint32_t contact_settle = 0;
   /// Run the SIMD kernels (simd_kernels.h: SSE, and AVX where the CPU has it) for the projection,
   /// the tear test and the collision gather; off runs the scalar reference alone. The results are
   /// bitwise the same either way.
@@ -110,8 +105,9 @@ public:
   /// The ground contact; with contact on (SimUniforms::contact),
   /// no free particle ends farther from where it started the substep than its bound (contact.h).
   void floorPass(const shaderio::SimUniforms& u, uint32_t substep);
-  /// With contact and the stretch limit on: the settle sweeps after the contact's cut (CpuOptions::contact_settle).
-  void settlePass(const shaderio::SimUniforms& u, uint32_t s, glm::vec3 frame);
+  /// The settle stage, with contact and its sweeps on (SimUniforms::contact_check.y): the
+  /// half-spaces listed by particle, then the sweeps over the structural edges of each colour.
+  void settlePass(const shaderio::SimUniforms& u, uint32_t s);
   /// How many structural edges each colour holds at its head (the shorten and settle stages visit those).
   const std::vector<uint32_t>& countColourEdges();
   /// Marks constraints beyond the tear threshold; returns how many tore.

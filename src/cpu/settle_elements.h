@@ -5,18 +5,25 @@
 
 namespace shaderio {
 
-/// The arrays the settle body reads and writes.
+/// The arrays the settle body reads and writes, and its accessors of them.
 struct SettleElements {
   const SimUniforms& u;
   vec4* pos;
-  const vec4* settle_start;
-  const vec4* settle_push;
-  const float* settle_bound;
+  const vec4* start;
+  const vec4* push;
+  const float* bound;
   const uint* half_start;
   const vec4* half_spaces;
   const float* half_slack;
-  vec3 settle_frame;
-  uint settle_substep;
+  vec3 frame;
+
+  vec3 settleStart(uint i) const { return vec3(start[i]); }
+  vec3 settlePush(uint i) const { return vec3(push[i]); }
+  float settleBound(uint i) const { return bound[i]; }
+  uint halfFirst(uint i) const { return half_start[i]; }
+  uint halfEnd(uint i) const { return half_start[i + 1u]; }
+  SlideHalf halfSpace(uint k) const { return SlideHalf{half_spaces[k], half_slack[k]}; }
+  vec3 settleFrame() const { return frame; }
 
 #include "settle_bodies.h"
 #undef SIM_POSITION

@@ -239,6 +239,7 @@ void GpuBatch::flush() {
                                  "needs it set when its sheets are made");
       u.contact_grid =
           glm::uvec4(sizes_.contact_buckets / 2 - 1, sizes_.contact_counts, sizes_.contact_fill, sizes_.contact_edges);
+      u.contact_check.z = sizes_.contact_half;
       u.contact_check.w = SIM_CONTACT_LIST_CAPACITY;
     }
     ticked_ = true;
@@ -263,6 +264,7 @@ void GpuBatch::flush() {
     plan.contact = plan.contact || u.contact.x > 0.0f;
     plan.limit = plan.limit || u.limit.x > 0.0f;
     plan.shorten = plan.shorten || limitShortens(u.limit.x, u.grab_index, u.flags);
+    if (u.contact.x > 0.0f) plan.sweeps = std::max(plan.sweeps, u.contact_check.y);
   }
   if (fused.empty() && passes.empty()) return;
   last_dispatches_ = 0;
@@ -359,7 +361,8 @@ void GpuBatch::flush() {
                                    creasing(u.hinge.y, u.crease.y),
                                    u.contact.x > 0.0f,
                                    u.limit.x > 0.0f,
-                                   limitShortens(u.limit.x, u.grab_index, u.flags)};
+                                   limitShortens(u.limit.x, u.grab_index, u.flags),
+                                   u.contact.x > 0.0f ? u.contact_check.y : 0u};
       for (uint32_t s = 0; s < substepCount(u.substeps); ++s)
         recordSubstep(*this, sheet_passes_, topo_, sizes_, sheet_plan, s, count);
     }

@@ -78,8 +78,8 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
     }
   } else {
     uint32_t pass = 0;
-    const SubstepPlan plan{key.iterations, key.collision, key.air,   key.stop,
-                           key.crease,     key.contact,   key.limit, key.shorten};
+    const SubstepPlan plan{key.iterations, key.collision, key.air,     key.stop,  key.crease,
+                           key.contact,    key.limit,     key.shorten, key.sweeps};
     recording_ = &flight;
     for (uint32_t s = 0; s < key.substeps; ++s)
       if (recordSubstep(*this, pipes_, topo_, layout_sizes_, plan, s, pass)) break;

@@ -152,6 +152,7 @@ void GpuSolver::tick(const SimUniforms& u) {
   if (contact) {
     gpu_u.contact_grid = glm::uvec4(layout_sizes_.contact_buckets / 2 - 1, layout_sizes_.contact_counts,
                                     layout_sizes_.contact_fill, layout_sizes_.contact_edges);
+    gpu_u.contact_check.z = layout_sizes_.contact_half;
     gpu_u.contact_check.w = contact_list_capacity_;
   }
   std::memcpy(static_cast<char*>(buf_[SIM_BIND_UNIFORMS].mapped) + index * uniform_stride_, &gpu_u, sizeof(gpu_u));
@@ -170,7 +171,8 @@ void GpuSolver::tick(const SimUniforms& u) {
                 creasing(u.hinge.y, u.crease.y),
                 contact,
                 u.limit.x > 0.0f,
-                limitShortens(u.limit.x, u.grab_index, u.flags)};
+                limitShortens(u.limit.x, u.grab_index, u.flags),
+                contact ? u.contact_check.y : 0u};
   stop_after_ = SIM_NONE;
   if (flight.recorded != key) recordTick(flight, index, key);
   ctx_.submit(flight.tick, flight.fence);

@@ -146,6 +146,7 @@ private:
     bool contact = false;     ///< the contact passes run (SimUniforms::contact)
     bool limit = false;       ///< the stretch limit runs after the projection (SimUniforms::limit)
     bool shorten = false;     ///< the limit shortens edges first (limitShortens)
+    uint32_t sweeps = 0;      ///< the settle stage's sweeps (SimUniforms::contact_check.y)
     bool operator==(const RecordKey&) const = default;
   };
   struct InFlight {

@@ -130,11 +130,15 @@ SheetLayout SheetLayout::of(const SheetTopology& topo, VkDeviceSize max_range, b
     const uint32_t queries = topo.particleCount() + l.contact_edges;
     l.contact_active = l.contact_sums + scanSumsSize(l.contact_buckets + 1);
     l.contact_active_sums = l.contact_active + queries + 1;
+    l.contact_half = l.contact_active_sums + scanSumsSize(queries + 1);
+    l.contact_half_sums = l.contact_half + 2 * topo.particleCount() + 1;
     // The header, the entries, the boxes and the active queries (contact.glsl)
     l.contact_words = SIM_CONTACT_HEADER + uint64_t(SIM_CONTACT_CELLS_PER_BOX + 6) * boxes + queries;
-    // The edges, then the lists' header, where each particle was, each query's count and pairs
+    // The edges, then the lists' header, where each particle was, each query's count and pairs,
+    // then the settle's half-spaces (five words each)
     l.contact_list_words = 4ull * l.contact_edges + SIM_CONTACT_LIST_HEADER + 4ull * topo.particleCount() +
-                           uint64_t(1 + SIM_CONTACT_LIST_CAPACITY) * (topo.particleCount() + l.contact_edges);
+                           uint64_t(1 + SIM_CONTACT_LIST_CAPACITY) * (topo.particleCount() + l.contact_edges) +
+                           5ull * SIM_CONTACT_HALF_CAPACITY * topo.particleCount();
   }
   return l;
 }
@@ -145,10 +149,8 @@ std::vector<BindingSpec> sheetBindings(const SheetTopology& topo, const SheetLay
   const uint32_t cells = topo.hash_size;
   // The fused tick's scans meet their per-invocation totals in the SIM_WG_FUSED_MAX slots after the
   // compaction slots (the per-colour passes' block sums, unused on that path).
-  const uint32_t scratch = std::max(
-      {layout.hash_sums + scanSumsSize(cells), layout.tear_slots + SIM_WG_FUSED_MAX,
-       layout.contact ? layout.contact_active_sums + scanSumsSize(layout.contact_active_sums - layout.contact_active)
-                      : 0u});
+  const uint32_t scratch = std::max({layout.hash_sums + scanSumsSize(cells), layout.tear_slots + SIM_WG_FUSED_MAX,
+                                     layout.contact ? layout.contact_half_sums + scanSumsSize(n + 1) : 0u});
   const VkDeviceSize list_bytes = layout.candidates_fit ? 4ull * SIM_CANDIDATE_STRIDE * n : 16,
                      list_base = layout.candidates_fit ? 16ull * n : 16;
 

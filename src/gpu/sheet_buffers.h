@@ -27,6 +27,9 @@ struct SheetLayout {
   bool contact = false;
   uint32_t contact_edges = 0, contact_buckets = 0, contact_counts = 0, contact_fill = 0, contact_sums = 0;
   uint32_t contact_active = 0, contact_active_sums = 0;
+  /// The settle stage's scratch: the particles' half-space counts (then starts, particles + 1),
+  /// their fills (particles) and the counts' scan sums
+  uint32_t contact_half = 0, contact_half_sums = 0;
   uint64_t contact_words = 0, contact_list_words = 0;
   /// The layout of a topology on a device that binds at most `max_range` bytes, with the contact's
   /// buffers sized or not.

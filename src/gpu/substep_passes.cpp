@@ -87,10 +87,12 @@ enum class Elements : uint8_t {
   CONTACT_QUERIES,
   CONTACT_ACTIVE,
   CONTACT_ACTIVE_CELLS,
-  CONTACT_CELLS
+  CONTACT_CELLS,
+  CONTACT_HALF_CELLS,
+  SWEEPS
 };
 /// When a sheet records a dispatch (SIM_DISPATCHES' needs column).
-enum class Needs : uint8_t { ALWAYS, AIR, CREASE, LIMIT, SHORTEN, CONSTRAINTS, CONTACT };
+enum class Needs : uint8_t { ALWAYS, AIR, CREASE, LIMIT, SHORTEN, CONSTRAINTS, CONTACT, SETTLE };
 
 /// One row of SIM_DISPATCHES.
 struct Dispatch {
@@ -141,7 +143,7 @@ void recordScan(PassSink& sink, const SimPipelines& pipes, uint32_t mode, uint32
 
 /// Records one row of SIM_DISPATCHES for pass `k` of its stage, then a barrier.
 void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,
-                    const Dispatch& d, uint32_t s, uint32_t k) {
+                    const Dispatch& d, uint32_t s, uint32_t k, uint32_t sweeps = 0) {
   const ComputePipeline& p = pipes.*d.kernel;
   const uint32_t n = topo.particleCount(), m = topo.constraintCount();
   switch (d.elements) {
@@ -225,6 +227,19 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
     recordScan(sink, pipes, SIM_SCAN_SCRATCH, sizes.contact_active, n + sizes.contact_edges + 1,
                sizes.contact_active_sums, d.grid, s, d.gate);
     return;
+  case Elements::CONTACT_HALF_CELLS:
+    recordScan(sink, pipes, SIM_SCAN_SCRATCH, sizes.contact_half, n + 1, sizes.contact_half_sums, d.grid, s, d.gate);
+    return;
+  case Elements::SWEEPS:
+    // Each sweep, the colours with structural edges (shortensColour), a barrier after each
+    for (uint32_t sweep = 0; sweep < sweeps; ++sweep)
+      for (uint32_t c = 0; c < topo.colorCount(); ++c) {
+        const ColorRange& range = topo.colors[c];
+        if (range.count == 0 || !shortensColour(topo.constraints[range.first].kind_id)) continue;
+        record(sink, p, d.grid, range.count, SimPush{sweep, range.count, s, c}, s, d.gate);
+        sink.barrier();
+      }
+    return;
   }
   sink.barrier();
 }
@@ -258,8 +273,9 @@ bool recordSubstep(PassSink& sink, const SimPipelines& pipes, const SheetTopolog
                             (d.needs == Needs::CREASE && plan.crease && topo.hingeCount() > 0) ||
                             (d.needs == Needs::LIMIT && plan.limit) || (d.needs == Needs::SHORTEN && plan.shorten) ||
                             (d.needs == Needs::CONSTRAINTS && has_constraints) ||
-                            (d.needs == Needs::CONTACT && plan.contact);
-        if (needed) recordDispatch(sink, pipes, topo, sizes, d, s, k);
+                            (d.needs == Needs::CONTACT && plan.contact) ||
+                            (d.needs == Needs::SETTLE && plan.contact && plan.sweeps > 0);
+        if (needed) recordDispatch(sink, pipes, topo, sizes, d, s, k, plan.sweeps);
         if (k + 1 == passes && closesCategory(row)) sink.mark(d.category);
       }
       if (pass++ == plan.stop) return true;

@@ -108,6 +108,7 @@ struct SubstepPlan {
   bool contact = false;     ///< the contact passes run (SimUniforms::contact)
   bool limit = false;       ///< the stretch limit runs (SimUniforms::limit)
   bool shorten = false;     ///< the limit shortens edges first (limitShortens)
+  uint32_t sweeps = 0;      ///< the settle stage's sweeps (SimUniforms::contact_check.y; 0: it does not run)
 };
 
 /// Timestamps a substep of the per-colour path records (one where each category ends).

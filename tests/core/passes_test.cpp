@@ -20,7 +20,7 @@ shaderio::SimUniforms uniforms(uint32_t substeps, uint32_t iterations, uint32_t 
 
 TEST(Passes, OrderOfOneSubstep) {
   const shaderio::SimUniforms u = uniforms(3, 2, 5, true);
-  ASSERT_EQ(passesPerTick(u), 3u * (1u + 10u + 10u + 1u + 1u + 1u + 1u + 1u));
+  ASSERT_EQ(passesPerTick(u), 3u * (1u + 10u + 10u + 1u + 1u + 1u + 1u + 1u + 1u));
   EXPECT_EQ(passAt(u, 0), (PassPoint{0, PassKind::integrate}));
   EXPECT_EQ(passAt(u, 1), (PassPoint{0, PassKind::collide}));
   EXPECT_EQ(passAt(u, 2), (PassPoint{0, PassKind::project, 0, 0}));
@@ -31,12 +31,14 @@ TEST(Passes, OrderOfOneSubstep) {
   EXPECT_EQ(passAt(u, 22), (PassPoint{0, PassKind::limit}));
   EXPECT_EQ(passAt(u, 23), (PassPoint{0, PassKind::crease}));
   EXPECT_EQ(passAt(u, 24), (PassPoint{0, PassKind::floor}));
-  EXPECT_EQ(passAt(u, 25), (PassPoint{0, PassKind::tear}));
-  EXPECT_EQ(passAt(u, 26), (PassPoint{1, PassKind::integrate}));
-  EXPECT_EQ(describePass(passAt(u, 34)), "substep 1, project (iteration 1, colour 1)");
-  EXPECT_EQ(describePass(passAt(u, 46)), "substep 1, shorten (iteration 1, colour 3)");
-  EXPECT_EQ(describePass(passAt(u, 48)), "substep 1, limit");
-  EXPECT_EQ(describePass(passAt(u, 49)), "substep 1, crease");
+  EXPECT_EQ(passAt(u, 25), (PassPoint{0, PassKind::settle}));
+  EXPECT_EQ(passAt(u, 26), (PassPoint{0, PassKind::tear}));
+  EXPECT_EQ(passAt(u, 27), (PassPoint{1, PassKind::integrate}));
+  EXPECT_EQ(describePass(passAt(u, 35)), "substep 1, project (iteration 1, colour 1)");
+  EXPECT_EQ(describePass(passAt(u, 47)), "substep 1, shorten (iteration 1, colour 3)");
+  EXPECT_EQ(describePass(passAt(u, 49)), "substep 1, limit");
+  EXPECT_EQ(describePass(passAt(u, 50)), "substep 1, crease");
+  EXPECT_EQ(describePass(passAt(u, 52)), "substep 1, settle");
 }
 
 TEST(Passes, IndexIsTheInverseOfPassAt) {
@@ -46,7 +48,7 @@ TEST(Passes, IndexIsTheInverseOfPassAt) {
       for (uint32_t k = 0; k < n; ++k) EXPECT_EQ(passIndex(u, passAt(u, k)), k);
     }
   shaderio::SimUniforms u = uniforms(2, 2, 3, false);
-  EXPECT_EQ(passesPerTick(u), 2u * 17u);
+  EXPECT_EQ(passesPerTick(u), 2u * 18u);
   EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::collide}));
   EXPECT_FALSE(passIndex(u, PassPoint{2, PassKind::floor}));
   EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::project, 2, 0}));

@@ -76,9 +76,15 @@ TEST_F(GpuBatchTest, OneDispatchRunsEveryQueuedSheetsTick) {
 }
 
 /// `sheets` with contact on in every other sheet from the second (the first has none, so the fleet
-/// sizes its contact buffers when the second is made).
+/// sizes its contact buffers when the second is made), from the fourth with the stretch limit and
+/// the settle's sweeps.
 std::vector<FleetSheet> withContact(std::vector<FleetSheet> sheets) {
-  for (size_t i = 1; i < sheets.size(); i += 2) sheets[i].params.contact_factor = 0.5f;
+  for (size_t i = 1; i < sheets.size(); i += 2) {
+    sheets[i].params.contact_factor = 0.5f;
+    if (i < 3) continue;
+    sheets[i].params.stretch_limit = 1.01f;
+    sheets[i].params.contact_settle = 3;
+  }
   return sheets;
 }
 

@@ -411,6 +411,54 @@ TEST_F(Parity, ContactListsStandWhileTheGpuPathsTakeTurns) {
   EXPECT_TRUE(sameState(cpu_end, run(g, 0))) << "the fused tick and the per-colour passes by turns";
 }
 
+TEST_F(Parity, TheSettleIsTheSameOnTheGpu) {
+  // The hand's fist closing on a small sheet with contact on and the settle's sweeps (the
+  // contact_settle key): the edges the contact holds past the stretch limit are shortened within the
+  // steps' bounds with the CPU's bits on the per-colour passes and in the fused tick (whose
+  // workgroup runs the settle after the contact's bodies there, a GPU's way, or after the contact
+  // passes, a CPU device's). The sweeps do their work here: the sheet ends elsewhere and less
+  // stretched than without them.
+  const SimParams p = preset("crumple", {"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9",
+                                         "contact_factor=0.5", "collision=off", "contact_settle=4"});
+  const std::string text = "0 grab particle 102\n1 move 0 -8.8 -1.2\n4 squeeze 0.5\n12 squeeze 1\n";
+  constexpr int kTicks = 14;
+  auto cpuRun = [&](const SimParams& q) {
+    CpuSolver cpu;
+    Simulation a(q, cpu);
+    a.setScript(script(text.c_str()));
+    float most = 0.0f;
+    SimState s;
+    for (int t = 0; t < kTicks; ++t) {
+      s = run(a, 1);
+      most = std::max(most, computeStats(s, q.substepDt()).max_stretch);
+    }
+    return std::make_pair(s, most);
+  };
+  SimParams none = p;
+  none.contact_settle = 0;
+  const auto [cpu_end, settled] = cpuRun(p);
+  const auto [cut_end, cut] = cpuRun(none);
+  std::printf("the fist with contact: most stretch %.4f with the cut alone, %.4f with 4 settle sweeps\n", double(cut),
+              double(settled));
+  EXPECT_LT(settled, cut);
+  EXPECT_FALSE(sameState(cpu_end, cut_end));
+  EXPECT_EQ(intersectingPairs(cpu_end.pos, cpu_end.triangles, cpu_end.triangle_count).pairs, 0u);
+  struct Way {
+    const char* name;
+    bool fused;
+    int contact; // FusedShape::contact
+  };
+  for (const Way way : {Way{"per-colour passes", false, 1}, Way{"fused tick", true, 1}}) {
+    gpu::GpuSolver gpu(ctx(), gpu::FusedShape{0, 0, 0.0f, way.contact});
+    gpu.setFusedPath(way.fused);
+    Simulation g(p, gpu);
+    g.setScript(script(text.c_str()));
+    const SimState gpu_end = run(g, kTicks);
+    EXPECT_EQ(gpu.usesFusedPath(g.lastUniforms()), way.fused) << way.name;
+    EXPECT_TRUE(sameState(cpu_end, gpu_end)) << way.name;
+  }
+}
+
 TEST_F(Parity, ScriptedYankTearsTheSameConstraints) {
   // Grab the bottom-right corner and pull it far away fast.
   SimParams p = preset("tender", {"wind=off"});

@@ -85,7 +85,7 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   const SimPipelines pipes = fakePipelines();
   RecordingSink sink(pipes);
   uint32_t pass = 0;
-  const SubstepPlan plan{2, true, true, SIM_NONE, true, true, true, true};
+  const SubstepPlan plan{2, true, true, SIM_NONE, true, true, true, true, 2};
   EXPECT_FALSE(recordSubstep(sink, pipes, topo, sizes, plan, 0, pass));
   EXPECT_EQ(pass, shaderio::passesPerSubstep(2, topo.colorCount(), true));
   EXPECT_EQ(sink.barriers_due, 0u); // every pass is followed by a barrier
@@ -123,9 +123,16 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   expected.push_back("limit");
   expected.push_back("crease");
   // The floor, then the steps cut to their pairs' half-spaces
-  for (const char* k : {"floor", "contact_excess", "contact_share", "contact_step", "tear_mark", "tear_unsupported",
-                        "tear_flags", "scan", "tear_compact"})
-    expected.push_back(k);
+  for (const char* k : {"floor", "contact_excess", "contact_share", "contact_step"}) expected.push_back(k);
+  // The settle: the half-spaces counted by particle, scanned (one block here) and listed, then in
+  // each sweep every colour that holds edges
+  ASSERT_LE(topo.particleCount() + 1, SIM_SCAN_BLOCK);
+  for (const char* k : {"contact_half_count", "scan", "contact_half_fill"}) expected.push_back(k);
+  for (uint32_t sweep = 0; sweep < 2; ++sweep)
+    for (const ColorRange& range : topo.colors)
+      if (range.count > 0 && constraintKind(topo.constraints[range.first]) == SIM_KIND_STRUCTURAL)
+        expected.push_back("contact_settle");
+  for (const char* k : {"tear_mark", "tear_unsupported", "tear_flags", "scan", "tear_compact"}) expected.push_back(k);
   EXPECT_EQ(kernels(sink.passes), expected);
   for (size_t k = 0, project = 0, shorten = 0; k < sink.passes.size(); ++k)
     if (sink.passes[k].kernel == "project") {
@@ -136,7 +143,7 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
       EXPECT_EQ(sink.passes[k].gate_arg, shorten_iterations[shorten++]);
     }
   EXPECT_EQ(sink.marks, (std::vector<PassCategory>{kContact, kIntegrate, kHash, kCollide, kProject, kProject, kProject,
-                                                   kProject, kFloor, kTear}));
+                                                   kProject, kFloor, kFloor, kTear}));
   EXPECT_EQ(marksPerSubstep(), sink.marks.size());
 }
 
@@ -166,6 +173,7 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
     case PassKind::collide:
       return "repel";
     case PassKind::floor:
+    case PassKind::settle: // without contact the settle records nothing
       return "floor";
     case PassKind::tear:
       return "tear_compact";
