@@ -23,12 +23,27 @@
 /// Particle i's step in the substep less the frame and its push: what its half-spaces and ball hold.
 SIM_INLINE vec3 settleStep(uint i) { return vec3(SIM_POSITION(i)) - (settleStart(i) + settleFrame()) - settlePush(i); }
 
-/// True when the settle may move particle i in substep s: a free particle the contact bounds (a
-/// grab the hand places stays where the hand has it) whose half-spaces are all listed.
-SIM_INLINE bool settleMovable(uint i, uint s) {
+/// True when particle i is free in substep s and the contact bounds it (a grab the hand places
+/// stays where the hand has it).
+SIM_INLINE bool settleFree(uint i, uint s) {
   vec4 p = SIM_POSITION(i);
-  return p.w > 0.0f && contactBounded(p.w, i == u.grab_index, u.grab_target[s].w) &&
-         halfEnd(i) <= SIM_CONTACT_HALF_CAPACITY * u.particle_count;
+  return p.w > 0.0f && contactBounded(p.w, i == u.grab_index, u.grab_target[s].w);
+}
+
+/// True when the settle may move particle i in substep s: free, and its half-spaces all listed.
+SIM_INLINE bool settleMovable(uint i, uint s) {
+  return settleFree(i, s) && halfEnd(i) <= SIM_CONTACT_HALF_CAPACITY * u.particle_count;
+}
+
+/// True when constraint c is a structural edge longer than the stretch limit, short of its tear
+/// length, with a free end: the edges the settle may work on in substep s (before the half-spaces
+/// are listed: without any, the stage moves nothing and is skipped).
+SIM_INLINE bool settleOver(Constraint c, uint s) {
+  if ((c.kind_id & SIM_KIND_MASK) != SIM_KIND_STRUCTURAL) return false;
+  vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b);
+  if (shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return false;
+  vec3 d = vec3(pb) - vec3(pa);
+  return dot3(d, d) > u.limit.x * u.limit.x && (settleFree(c.a, s) || settleFree(c.b, s));
 }
 
 /// Moves particle i by up to `want` along the unit `dir`, as far as its ball and half-spaces let
@@ -54,31 +69,33 @@ SIM_INLINE float settleBack(uint i, vec3 dir, float want) {
   return rate * l;
 }
 
-/// The settle on constraint c in substep s, in the colour order of the projection (no two of a colour share a
-/// particle): a structural edge longer than the stretch limit (and short of its tear length) is
-/// shortened by each end's move along it (half each, what one cannot take offered to the other),
-/// then by the ends' steps taken back.
-SIM_INLINE void settleConstraint(Constraint c, uint s) {
-  if ((c.kind_id & SIM_KIND_MASK) != SIM_KIND_STRUCTURAL) return;
+/// The settle on constraint c in substep s, in the colour order of the projection (no two of a
+/// colour share a particle): a structural edge longer than the stretch limit (and short of its
+/// tear length) is shortened by each end's move along it (half each, what one cannot take offered
+/// to the other), then by the ends' steps taken back. False when it left the edge alone (nothing
+/// moved): a sweep in which every edge is left alone is the last that moves anything.
+SIM_INLINE bool settleConstraint(Constraint c, uint s) {
+  if ((c.kind_id & SIM_KIND_MASK) != SIM_KIND_STRUCTURAL) return false;
   vec4 limit = u.limit;
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b);
-  if (shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return;
+  if (shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return false;
   vec3 d = vec3(pb) - vec3(pa);
   float len2 = dot3(d, d);
-  if (!(len2 > limit.x * limit.x)) return;
+  if (!(len2 > limit.x * limit.x)) return false;
   bool ma = settleMovable(c.a, s), mb = settleMovable(c.b, s);
-  if (!ma && !mb) return;
+  if (!ma && !mb) return false;
   float len = simSqrt(len2), over = len - limit.x;
   vec3 e = d * simDiv(1.0f, len);
   float got_a = ma ? settleMove(c.a, e, mb ? 0.5f * over : over) : 0.0f;
   float got_b = mb ? settleMove(c.b, -e, over - got_a) : 0.0f;
   float got_a2 = ma ? settleMove(c.a, e, over - got_a - got_b) : 0.0f;
   float left = over - got_a - got_b - got_a2;
-  if (!(left > 0.0f)) return;
+  if (!(left > 0.0f)) return true;
   float back_a = ma ? settleBack(c.a, e, mb ? 0.5f * left : left) : 0.0f;
   left -= back_a;
   float back_b = mb ? settleBack(c.b, -e, left) : 0.0f;
   left -= back_b;
   if (ma) settleBack(c.a, e, left);
+  return true;
 }
 #endif

@@ -273,10 +273,11 @@
 // list overflowed in this substep's build; from word 8 what contact_clear gathers: contactFrame's
 // lo and hi as orderedBits and the bits of `lowest`, the box of the particles' travel since the
 // lists were built as orderedBits, and the frame that contact_bound works out from what was
-// gathered), and
+// gathered; from word 24 the settle's: 1 when an edge is over the limit as it starts, then per
+// sweep 1 when the sweep worked on an edge), and
 // the cells a box spans at most (cells as wide as the longest edge and the contact diameter, with
 // room to spare for rounding: two a side)
-#define SIM_CONTACT_HEADER 24u
+#define SIM_CONTACT_HEADER (25u + SIM_SETTLE_MAX_SWEEPS)
 #define SIM_CONTACT_CELLS_PER_BOX 8u
 #define SIM_CONTACT_CELL_ROOM 1.01f
 

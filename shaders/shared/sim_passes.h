@@ -55,6 +55,7 @@
   X(contact_excess, SIM, 1, 0)                                                                                         \
   X(contact_share, SIM, 1, 0)                                                                                          \
   X(contact_step, SIM, 1, 0)                                                                                           \
+  X(contact_settle_check, SIM, 1, 0)                                                                                   \
   X(contact_half_count, SIM, 1, 0)                                                                                     \
   X(contact_half_fill, SIM, 1, 0)                                                                                      \
   X(contact_settle, SIM, 1, 0)                                                                                         \
@@ -151,6 +152,7 @@
   X(floor, contact_excess, CONTACT_QUERIES, Threads, TICK, CONTACT, Floor)                                             \
   X(floor, contact_share, CONTACT_QUERIES, Threads, TICK, CONTACT, Floor)                                              \
   X(floor, contact_step, PARTICLES, Threads, TICK, CONTACT, Floor)                                                     \
+  X(settle, contact_settle_check, CONSTRAINTS, Threads, TICK, SETTLE, Floor)                                           \
   X(settle, contact_half_count, CONTACT_QUERIES, Threads, TICK, SETTLE, Floor)                                         \
   X(settle, scan, CONTACT_HALF_CELLS, Threads, TICK, SETTLE, Floor)                                                    \
   X(settle, contact_half_fill, CONTACT_QUERIES, Threads, TICK, SETTLE, Floor)                                          \

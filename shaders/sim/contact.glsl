@@ -38,6 +38,10 @@
 #define CONTACT_TRAVEL_HI 18u
 // The substep's frame (3 words, float bits): contact_bound works it out once for the floor's steps
 #define CONTACT_FRAME 21u
+// The settle's: 1 when an edge is over the limit as the stage starts (settleOver), then per sweep 1
+// when it worked on an edge (SIM_SETTLE_MAX_SWEEPS words)
+#define CONTACT_SETTLE_OVER 24u
+#define CONTACT_SETTLE_SWEPT 25u
 // Words of the lists' header (SIM_CONTACT_LIST_HEADER): the triangle count + 1 they were built for
 // (0: none stand), the bits of the radius, the builds so far
 #define LIST_KEY 0u
@@ -687,5 +691,22 @@ vec3 settlePush(uint i) { return vec3(contact_particles[i].push); }
 float settleBound(uint i) { return contact_particles[i].start.w; }
 vec3 settleFrame() { return contactFrameNow(); }
 #include "settle_bodies.h"
+
+// contact_settle_check: constraint slot k over the limit in substep s (settleOver; a torn one past
+// its colour's live count may say so too: that only runs a stage that moves nothing)
+void contactSettleCheck(uint k, uint s) {
+  if (u.contact_check.y > 0u && settleOver(constraints[k], s)) atomicOr(contact_words[CONTACT_SETTLE_OVER], 1u);
+}
+// True when an edge is over the limit as the stage starts: else it lists nothing and moves nothing
+bool settleStarts() { return contact_words[CONTACT_SETTLE_OVER] != 0u; }
+// True when sweep `sweep` runs: the first when the stage starts, a later one when the last worked
+// on an edge (a sweep that moved nothing leaves the next nothing to move: the bits are the same)
+bool settleSweeps(uint sweep) {
+  return sweep == 0u ? settleStarts() : contact_words[CONTACT_SETTLE_SWEPT + sweep - 1u] != 0u;
+}
+// contact_settle: constraint c in sweep `sweep` of substep s
+void contactSettle(Constraint c, uint sweep, uint s) {
+  if (settleConstraint(c, s)) atomicOr(contact_words[CONTACT_SETTLE_SWEPT + sweep], 1u);
+}
 
 #endif

@@ -1,7 +1,7 @@
 #version 460
 // The settle stage (settle_bodies.h): in sweep p.first, the structural edges of one colour (no two
 // share a particle, so no races) longer than the stretch limit shortened within what the contact
-// lets each end's step go.
+// lets each end's step go; none after a sweep that moved nothing (settleSweeps).
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PROJECT
 #define SIM_PUSH_TYPE SimPush
@@ -9,9 +9,9 @@
 #include "sim_common.glsl"
 
 void main() {
-  if (p.first >= u.contact_check.y) return; // the same branch for every invocation
+  if (p.first >= u.contact_check.y || !settleSweeps(p.first)) return; // the same branch for every invocation
   uint t = threadIndex();
   uvec2 range = color_range[p.color];
   if (t >= range.y) return; // beyond the live count of this colour
-  settleConstraint(constraints[range.x + t], p.substep);
+  contactSettle(constraints[range.x + t], p.first, p.substep);
 }

@@ -91,24 +91,32 @@ void contactSlideSubstep(uint s, uint n) {
   sync();
 }
 
-// The settle stage (as contact_half_count, scan, contact_half_fill and contact_settle): the pairs'
-// half-spaces counted by particle, scanned and listed, then the sweeps over the colours with
-// structural edges
+// The settle stage (as contact_settle_check, contact_half_count, scan, contact_half_fill and
+// contact_settle): with an edge over the limit, the pairs' half-spaces counted by particle, scanned
+// and listed, then the sweeps over the colours with structural edges until one moves nothing
 void contactSettleSubstep(uint s) {
   uint lid = gl_LocalInvocationID.x;
+  for (uint c = 0u; c < u.color_count; ++c) {
+    uvec2 range = color_range[c];
+    for (uint t = lid; t < range.y; t += kInvocations) contactSettleCheck(range.x + t, s);
+  }
+  sync();
+  if (!settleStarts()) return;
   uint queries = u.particle_count + contactEdgeCount();
   for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_HALF_COUNT);
   sync();
   scanWorkgroup(SIM_SCAN_SCRATCH, halfStarts(), u.particle_count + 1u, compactSlots());
   for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_HALF_FILL);
   sync();
-  for (uint sweep = 0u; sweep < u.contact_check.y; ++sweep)
+  for (uint sweep = 0u; sweep < u.contact_check.y; ++sweep) {
     for (uint c = 0u; c < u.color_count; ++c) {
       uvec2 range = color_range[c];
       if (range.y == 0u || !shortensColour(constraints[range.x].kind_id)) continue;
-      for (uint t = lid; t < range.y; t += kInvocations) settleConstraint(constraints[range.x + t], s);
+      for (uint t = lid; t < range.y; t += kInvocations) contactSettle(constraints[range.x + t], sweep, s);
       sync();
     }
+    if (!settleSweeps(sweep + 1u)) break; // moved nothing: nor would the next
+  }
 }
 
 // Contact (as the contact_* passes, contact.glsl): each particle's step bound and push for substep

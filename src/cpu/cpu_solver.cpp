@@ -298,31 +298,37 @@ void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
 }
 
 // The settle sweeps, after the contact's cut and push (settle_bodies.h): over the structural edges
-// of each colour, contact_check.y times.
+// of each colour, contact_check.y times; none when no edge is over the limit, and no more after a
+// sweep that moved nothing (the next would move nothing either: the bits are the same).
 void CpuSolver::settlePass(const SimUniforms& u, uint32_t s) {
   if (!(u.contact.x > 0.0f) || u.contact_check.y == 0) return;
-  contact_.listHalfSpaces(start_, u);
   const uint32_t colors = uint32_t(colors_.size());
   const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
   const float* rest = con_rest_.data();
   const std::vector<uint32_t>& edges = countColourEdges();
-  SettleElements e{u,
-                   pos_.data(),
-                   start_.data(),
-                   push_.data(),
-                   bound_.data(),
-                   contact_.halfStart().data(),
-                   contact_.halfSpaces().data(),
-                   contact_.halfSlack().data(),
-                   contact_.frame()};
-  for (uint32_t sweep = 0; sweep < u.contact_check.y; ++sweep)
+  auto at = [&](uint32_t k) { return Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]}; };
+  SettleElements e{u,       pos_.data(), start_.data(), push_.data(),    bound_.data(),
+                   nullptr, nullptr,     nullptr,       contact_.frame()};
+  // Sweeps the colours' edges with `body`; true when it returned true for one
+  auto sweep = [&](auto&& body) {
+    std::atomic<bool> any{false};
     for (uint32_t c = 0; c < colors; ++c) {
       if (edges[c] == 0) continue;
       pool_->parallelFor(edges[c], grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
-        for (uint32_t k = colors_[c].first + begin; k < colors_[c].first + end; ++k)
-          e.settleConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]}, s);
+        bool mine = false;
+        for (uint32_t k = colors_[c].first + begin; k < colors_[c].first + end; ++k) mine = body(at(k)) || mine;
+        if (mine) any.store(true, std::memory_order_relaxed);
       });
     }
+    return any.load();
+  };
+  if (!sweep([&](Constraint c) { return e.settleOver(c, s); })) return;
+  contact_.listHalfSpaces(start_, u);
+  e.half_start = contact_.halfStart().data();
+  e.half_spaces = contact_.halfSpaces().data();
+  e.half_slack = contact_.halfSlack().data();
+  for (uint32_t k = 0; k < u.contact_check.y; ++k)
+    if (!sweep([&](Constraint c) { return e.settleConstraint(c, s); })) break;
 }
 
 // Marks the live constraints among array slots [begin, end) of the split arrays that the shaders'

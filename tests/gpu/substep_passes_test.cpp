@@ -124,10 +124,11 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   expected.push_back("crease");
   // The floor, then the steps cut to their pairs' half-spaces
   for (const char* k : {"floor", "contact_excess", "contact_share", "contact_step"}) expected.push_back(k);
-  // The settle: the half-spaces counted by particle, scanned (one block here) and listed, then in
-  // each sweep every colour that holds edges
+  // The settle: whether an edge is over the limit, the half-spaces counted by particle, scanned (one
+  // block here) and listed, then in each sweep every colour that holds edges
   ASSERT_LE(topo.particleCount() + 1, SIM_SCAN_BLOCK);
-  for (const char* k : {"contact_half_count", "scan", "contact_half_fill"}) expected.push_back(k);
+  for (const char* k : {"contact_settle_check", "contact_half_count", "scan", "contact_half_fill"})
+    expected.push_back(k);
   for (uint32_t sweep = 0; sweep < 2; ++sweep)
     for (const ColorRange& range : topo.colors)
       if (range.count > 0 && constraintKind(topo.constraints[range.first]) == SIM_KIND_STRUCTURAL)
