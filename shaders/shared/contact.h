@@ -216,13 +216,23 @@ SIM_INLINE float orderedFloat(uint o) { return uintBitsToFloat((o & 0x80000000u)
 /// lies between 0 and every particle's last step, and a step cut to its bound ends between the frame
 /// and the particle's own step, so a particle that goes on moving with the sheet is carried no
 /// farther than its own step along any axis; while one particle rests the frame is none, and a
-/// sheet falling as a whole falls at least as fast as its slowest particle.
-SIM_INLINE vec3 contactFrame(vec3 lo, vec3 hi, float lowest) {
+/// sheet falling as a whole falls at least as fast as its slowest particle. `scale` carries the last
+/// substep's steps to this substep's length (contactFrameScale: a tick whose substeps are longer
+/// or shorter than the last tick's).
+SIM_INLINE vec3 contactFrame(vec3 lo, vec3 hi, float lowest, float scale) {
+  if (scale != 1.0f) {
+    lo = lo * scale;
+    hi = hi * scale;
+  }
   vec3 t = vec3(lo.x > 0.0f ? lo.x : (hi.x < 0.0f ? hi.x : 0.0f), lo.y > 0.0f ? lo.y : (hi.y < 0.0f ? hi.y : 0.0f),
                 lo.z > 0.0f ? lo.z : (hi.z < 0.0f ? hi.z : 0.0f));
   t.y = max(t.y, -lowest);
   return dot3(t, t) < 1e30f ? t : vec3(0.0f);
 }
+
+/// contactFrame's scale in substep s: the first substep's velocity rescale (SimUniforms::verlet.y,
+/// this substep's length over the last tick's, 0 when they are the same), else 1.
+SIM_INLINE float contactFrameScale(vec4 verlet, uint s) { return s == 0u && verlet.y > 0.0f ? verlet.y : 1.0f; }
 
 /// Where a particle that moved from x0 to x this substep ends when its step may not exceed
 /// `bound`: x, or the point `bound` from x0 towards x.

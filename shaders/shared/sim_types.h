@@ -84,7 +84,8 @@ struct SimUniforms {
   // The Verlet step: x the damping of the first substep, which also rescales the velocity its
   // previous position carries from the last tick's substeps to this tick's (damping x dt / the
   // last tick's dt, when the substeps key changed between them or the hand's pace asks for more,
-  // Simulation::tickParams); yzw unused
+  // Simulation::tickParams); y that rescale alone (dt / the last tick's dt; 0 when they are the
+  // same), which the contact's frame takes too (contactFrameScale); zw unused
   vec4 verlet;
 
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep

@@ -635,7 +635,7 @@ void contactWalk(uint j) {
 
 // contact_bound: particle i's step bound (stepBound; unbounded when free) and push
 // (contactAverage); the particles in contact counted; the substep's frame (contactFrame)
-void contactBound(uint i) {
+void contactBound(uint i, uint s) {
   float r = u.contact.x;
   if (i == 0u && listsRebuilt()) {
     // The lists stand for these triangles and this radius (none when the positions went wrong)
@@ -649,7 +649,7 @@ void contactBound(uint i) {
     bool none = contact_words[CONTACT_FRAME_LO] > contact_words[CONTACT_FRAME_HI]; // no particles
     vec3 t = none ? vec3(0.0f)
                   : contactFrame(gatheredCorner(CONTACT_FRAME_LO), gatheredCorner(CONTACT_FRAME_HI),
-                                 uintBitsToFloat(contact_words[CONTACT_LOWEST]));
+                                 uintBitsToFloat(contact_words[CONTACT_LOWEST]), contactFrameScale(u.verlet, s));
     contact_words[CONTACT_FRAME] = floatBitsToUint(t.x);
     contact_words[CONTACT_FRAME + 1u] = floatBitsToUint(t.y);
     contact_words[CONTACT_FRAME + 2u] = floatBitsToUint(t.z);

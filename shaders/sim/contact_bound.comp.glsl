@@ -9,5 +9,5 @@
 
 void main() {
   uint i = threadIndex();
-  if (i < p.count) contactBound(i);
+  if (i < p.count) contactBound(i, p.substep);
 }

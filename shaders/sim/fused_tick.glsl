@@ -143,7 +143,7 @@ void contactSubstep(uint s, uint n) {
   uint queries = u.particle_count + contactEdgeCount();
   for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_ALL);
   sync();
-  for (uint i = lid; i < n; i += kInvocations) contactBound(i);
+  for (uint i = lid; i < n; i += kInvocations) contactBound(i, s);
   sync();
 }
 

@@ -213,9 +213,9 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   // The first substep takes the velocity the last tick's substeps left over to this tick's (the
   // substeps key changed between them, or the hand's pace asks for more: tickParams)
   const float last_dt = last_uniforms_.dt;
-  u.verlet = glm::vec4(last_dt > 0.0f && last_dt != u.dt ? float(double(p.damping) * double(u.dt) / double(last_dt))
-                                                         : p.damping,
-                       0.0f, 0.0f, 0.0f);
+  const bool rescaled = last_dt > 0.0f && last_dt != u.dt;
+  u.verlet = glm::vec4(rescaled ? float(double(p.damping) * double(u.dt) / double(last_dt)) : p.damping,
+                       rescaled ? float(double(u.dt) / double(last_dt)) : 0.0f, 0.0f, 0.0f);
   u.gravity = p.gravity;
   u.floor_y = p.floor_y;
   u.restitution = p.restitution;

@@ -133,9 +133,9 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
     all.travel_hi = glm::max(all.travel_hi, g.travel_hi);
     all.lowest = std::min(all.lowest, g.lowest);
   });
-  frame_ = all.lo.x > all.hi.x
-               ? vec3(0.0f)
-               : contactFrame(orderedCorner(all.lo), orderedCorner(all.hi), std::bit_cast<float>(all.lowest));
+  frame_ = all.lo.x > all.hi.x ? vec3(0.0f)
+                               : contactFrame(orderedCorner(all.lo), orderedCorner(all.hi),
+                                              std::bit_cast<float>(all.lowest), contactFrameScale(u.verlet, s));
   if (edges_key_ != count) {
     edges_.clear();
     for (uint32_t t = 0; t < count; ++t) {
