@@ -58,7 +58,7 @@ struct SimUniforms {
   // radius, y its reach (0: open), z the part of a particle's way into the fist it is drawn per
   // substep, w the part of its velocity relative to the hand the grip takes per substep
   vec4 hand;
-  vec4 hand_motion; // xyz the hand's displacement per substep
+  vec4 hand_motion; // xyz the hand's displacement per substep, w the lowest the fist's centre goes (floor + x)
   // Penetration-free contact (contact.h): x the contact radius (0: off), y the part of its distance
   // to the nearest primitive a particle may move in a substep (below 1/2), z the thickness (closer
   // pairs are pushed apart), w the fixed-point units of a push per unit of length (contactFixed)

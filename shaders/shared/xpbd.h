@@ -68,14 +68,18 @@ SIM_INLINE vec3 handFinger(uint i) {
 /// the Verlet step took from `previous` to `position`: within the hand's reach of its centre (the
 /// grab target) the grip takes hand.w of the particle's velocity relative to the hand's motion,
 /// then the particle is drawn hand.z of its way toward the fist (a ball of radius hand.x around the
-/// centre, moved by handFinger(i) x hand.x). Returns the particle's new position.
+/// centre, moved by handFinger(i) x hand.x). The fist rests on the floor: its centre is never
+/// lower than motion.w (the floor plus the fist's radius), so a hand closing or pressing down near
+/// the floor forms its ball above it, with the grab at the ball's foot, instead of drawing the sheet
+/// into the floor. Returns the particle's new position.
 SIM_INLINE vec4 handPull(vec4 position, vec4 previous, uint i, vec3 centre, vec4 hand, vec4 motion) {
   if (!(hand.y > 0.0f) || !(position.w > 0.0f)) return position; // an open hand: nothing to do
   vec3 p = vec3(position);
   vec3 d = p - centre;
   if (dot3(d, d) < hand.y * hand.y) {
     p = p - (p - vec3(previous) - vec3(motion)) * hand.w;
-    d = p - (centre + handFinger(i) * hand.x);
+    vec3 fist = vec3(centre.x, max(centre.y, motion.w), centre.z);
+    d = p - (fist + handFinger(i) * hand.x);
     float dist = simSqrt(dot3(d, d));
     if (dist > hand.x) p = p - d * (simDiv(dist - hand.x, dist) * hand.z);
   }

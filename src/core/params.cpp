@@ -254,6 +254,8 @@ std::optional<SimParams> presetParams(const std::string& name) {
     p.crease_yield = kPaperCreaseYield;
     p.crease_hardening = kPaperCreaseHardening;
     p.stretch_limit = kPaperStretchLimit;
+    p.contact_factor = kPaperContactFactor;
+    p.contact_settle = kPaperSettleSweeps;
     p.cell_size = 0.375f; // 2.5 x spacing, as in `tender`
     p.floor_y = -10.0f;
     p.restitution = 0.3f;
@@ -282,6 +284,8 @@ std::optional<SimParams> presetParams(const std::string& name) {
     p.crease_yield = kPaperCreaseYield;
     p.crease_hardening = kPaperCreaseHardening;
     p.stretch_limit = kPaperStretchLimit;
+    p.contact_factor = kPaperContactFactor;
+    p.contact_settle = kPaperSettleSweeps;
     p.cell_size = 2.5f * p.spacing;
     p.restitution = 0.05f;
     p.friction = 0.6f;

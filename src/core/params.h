@@ -120,6 +120,12 @@ constexpr float kPaperCreaseHardening = 0.5f;
 /// Paper stretches well under 1 % before it tears; a sheet's edges are held within 1 % of rest
 /// (the stretch limit), which the projection then closes further.
 constexpr float kPaperStretchLimit = 1.01f;
+/// Paper's layers never pass through each other: contact (contact.h) within half a spacing, the
+/// sheet's own thickness at the presets' scales.
+constexpr float kPaperContactFactor = 0.5f;
+/// The settle stage's sweeps a substep (settle_bodies.h): the edges the contact's cut held past the
+/// stretch limit shortened within its bounds; they stop after one that moves nothing.
+constexpr uint32_t kPaperSettleSweeps = 16;
 
 /// Names of the presets, in the order `--help` lists them.
 std::vector<std::string> presetNames();

@@ -264,7 +264,7 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
     const float ball = std::min(p.handBallRadius(), p.hand_reach);
     u.hand = glm::vec4(p.hand_reach - (p.hand_reach - ball) * closure_, p.hand_reach,
                        float(-std::expm1(-dt / kHandPullSeconds)), float(-std::expm1(-dt / kHandGripSeconds)));
-    u.hand_motion = glm::vec4((grab_to_ - grab_from_) / float(p.substeps), 0.0f);
+    u.hand_motion = glm::vec4((grab_to_ - grab_from_) / float(p.substeps), p.floor_y + u.hand.x);
   }
   for (uint32_t s = 0; s < p.substeps; ++s) {
     WindSample w = amp > 0.0f ? windAt(p.wind_kind, t0 + double(s + 1) * dts, amp) : WindSample{};

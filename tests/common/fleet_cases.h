@@ -88,6 +88,7 @@ inline std::vector<FleetSheet> paperFleet(uint32_t count, bool receipt = false) 
                                                       : "1.01"),
         "crease_hardening=" + std::to_string(0.25 * (i % 3)),
         "iterations=" + std::to_string(3 + i % 2),
+        "contact_factor=0", // (fleets with contact: ContactSheetsMatchTheirRunsAloneAndTheCpu)
     };
     if (receipt) {
       sets.push_back(std::string("air=") + (i % 5 == 4 ? "off" : "on"));

@@ -399,8 +399,9 @@ TEST(Stretch, TheHandDragsFoldsAndCrumplesPaperWithinThreePercent) {
                 double(most[2]));
     for (float m : most) EXPECT_LE(m, 1.03f) << name;
   }
-  // Without it the projection's iterations leave a quarter of the drag's stretch
-  SimParams loose = flatSheet("crumple", {"stretch_limit=0"});
+  // Without it (and without the contact, whose cut holds edges back) the projection's iterations
+  // leave a quarter of the drag's stretch
+  SimParams loose = flatSheet("crumple", {"stretch_limit=0", "contact_factor=0"});
   const auto [drag, drag_ticks] = dragScript(loose);
   const float most = mostStretch(loose, drag, drag_ticks);
   std::printf("crumple without the limit: most stretch drag %.4f\n", double(most));
