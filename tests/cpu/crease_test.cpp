@@ -215,7 +215,9 @@ FoldResult foldAndUnfold(const SimParams& p, double rest_s = 5.0, double carry_s
 }
 
 TEST(Crease, AFoldLeavesACreaseInPaper) {
-  const SimParams crumple = flatSheet("crumple", {"cols=20", "rows=30"});
+  // (The crease tests and the limit's scenes below name contact off: their subject is the hinges
+  // and the rings; contact's own tests and the stretch test run the presets' contact.)
+  const SimParams crumple = flatSheet("crumple", {"cols=20", "rows=30", "contact_factor=0"});
   const FoldResult r = foldAndUnfold(crumple);
   EXPECT_EQ(r.nans, 0u);
   EXPECT_GE(r.fold_line_deg, 20.0);
@@ -225,7 +227,7 @@ TEST(Crease, AFoldLeavesACreaseInPaper) {
   // The receipt: a fold held by its edge alone (nothing presses it) creases its hinges by some 30
   // degrees; on the floor its 15 cm halves, three times paper's elastic length (D / rho g)^(1/3) =
   // 5 cm, lie flat and open the crease to a few degrees.
-  const FoldResult receipt = foldAndUnfold(flatSheet("paper", {}));
+  const FoldResult receipt = foldAndUnfold(flatSheet("paper", {"contact_factor=0"}));
   EXPECT_EQ(receipt.nans, 0u);
   EXPECT_GE(receipt.crease_deg, 20.0);
   EXPECT_GE(receipt.fold_line_deg, 4.0);
@@ -248,8 +250,9 @@ TEST(Crease, CreasesDoNotDependOnTheIterationCount) {
   // stiffness, which shapes the fold a little
   FoldResult r[2];
   for (int k = 0; k < 2; ++k)
-    r[k] = foldAndUnfold(flatSheet("crumple", {"cols=20", "rows=30", k == 0 ? "iterations=4" : "iterations=16"}), 0.5,
-                         3.0);
+    r[k] = foldAndUnfold(
+        flatSheet("crumple", {"cols=20", "rows=30", k == 0 ? "iterations=4" : "iterations=16", "contact_factor=0"}),
+        0.5, 3.0);
   EXPECT_GE(r[0].crease_deg, 15.0);
   EXPECT_NEAR(r[0].crease_sum_deg, r[1].crease_sum_deg, 0.05 * r[1].crease_sum_deg);
   EXPECT_NEAR(r[0].crease_deg, r[1].crease_deg, 6.0);
@@ -258,7 +261,7 @@ TEST(Crease, CreasesDoNotDependOnTheIterationCount) {
 TEST(Crease, WindCreasesNothing) {
   // The crumple sheet hanging from its corners in ten seconds of strong wind
   CpuSolver solver;
-  const SimParams p = preset("crumple", {"cols=20", "rows=30", "wind=on", "wind_strength=3"});
+  const SimParams p = preset("crumple", {"cols=20", "rows=30", "wind=on", "wind_strength=3", "contact_factor=0"});
   Simulation sim(p, solver);
   const SimState s = run(sim, int(10 * p.tick_hz));
   const SheetStats st = computeStats(s, p.substepDt());
@@ -556,9 +559,9 @@ TEST(Stretch, ASheetHangingFromItsPinsHoldsTheLimitAtEachPin) {
   // three pins: the rings run from every pin, so the edges at each are held too (rings from the
   // sheet's middle left those at the pins to the projection alone: 1.54)
   for (const char* pins : {"pins=corners", "pins=top3"}) {
-    const SimParams base = preset("crumple", {});
+    const SimParams base = preset("crumple", {"contact_factor=0"});
     const float scale = float(base.cols - 1) / 127.0f;
-    SimParams p = preset("crumple", {"cols=128", "rows=192", pins});
+    SimParams p = preset("crumple", {"cols=128", "rows=192", pins, "contact_factor=0"});
     p.spacing = base.spacing * scale;
     p.cell_size = base.cell_size * scale;
     const float most = mostStretch(p, "", 30);
@@ -570,7 +573,7 @@ TEST(Stretch, ASheetHangingFromItsPinsHoldsTheLimitAtEachPin) {
 TEST(Stretch, AHeldSheetYankedTearsAndALyingOneIsLeftAlone) {
   // The sheet hanging from its corners, its bottom middle yanked down at 20 sheet lengths a second:
   // the limit draws the sheet after the hand, the pins hold their corners, and the paper tears
-  const SimParams p = preset("crumple", {"cols=12", "rows=16", "wind=off"});
+  const SimParams p = preset("crumple", {"cols=12", "rows=16", "wind=off", "contact_factor=0"});
   const uint32_t bottom = (p.rows - 1) * p.cols + p.cols / 2;
   CpuSolver solver;
   Simulation sim(p, solver);
@@ -589,7 +592,8 @@ TEST(Stretch, AHeldSheetYankedTearsAndALyingOneIsLeftAlone) {
   // A sheet lying on its floor stretches no edge past the limit: the limit leaves every bit alone
   uint64_t hash[2] = {};
   for (int k = 0; k < 2; ++k) {
-    const SimParams q = flatSheet("crumple", {"cols=12", "rows=16", k == 0 ? "stretch_limit=0" : "stretch_limit=1.01"});
+    const SimParams q = flatSheet(
+        "crumple", {"cols=12", "rows=16", k == 0 ? "stretch_limit=0" : "stretch_limit=1.01", "contact_factor=0"});
     CpuSolver cpu;
     Simulation rest(q, cpu);
     hash[k] = computeStats(run(rest, 60), q.substepDt()).state_hash;
