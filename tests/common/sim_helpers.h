@@ -12,6 +12,23 @@
 #include "core/script.h"
 #include "core/simulation.h"
 
+/// Marks a test whose scenes run the CPU solver on one thread (CpuOptions' default) and nothing
+/// else concurrently. ThreadSanitizer reports races between threads, so there it has nothing to
+/// find, and at its tenfold cost the physics repeats the ci and ASan builds' runs; the tsan build
+/// skips such a test, saying why. Every other build runs it.
+#if defined(__SANITIZE_THREAD__) // GCC; Clang says so through __has_feature
+#define TENDER_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define TENDER_TSAN 1
+#endif
+#endif
+#if defined(TENDER_TSAN)
+#define TENDER_ONE_THREAD_TEST() GTEST_SKIP() << "one thread: no race for ThreadSanitizer to find"
+#else
+#define TENDER_ONE_THREAD_TEST() static_cast<void>(0)
+#endif
+
 namespace tender::test {
 
 /// Parameters of a preset with overrides (which must be valid).

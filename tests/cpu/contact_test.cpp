@@ -410,6 +410,7 @@ TEST(Contact, TheHandCrumplesItIntoABallWithoutPassingItThroughItself) {
 }
 
 TEST(Contact, ASheetForcedThroughItselfUntangles) {
+  TENDER_ONE_THREAD_TEST();
   // The hanging sheet's bottom middle dragged forward, up and back through the sheet with the
   // particle repulsion alone, then contact turned on and the sheet let go: where it crosses itself
   // nothing holds it, and it comes apart within a second

@@ -215,6 +215,7 @@ FoldResult foldAndUnfold(const SimParams& p, double rest_s = 5.0, double carry_s
 }
 
 TEST(Crease, AFoldLeavesACreaseInPaper) {
+  TENDER_ONE_THREAD_TEST();
   // (The crease tests and the limit's scenes below name contact off: their subject is the hinges
   // and the rings; contact's own tests and the stretch test run the presets' contact.)
   const SimParams crumple = flatSheet("crumple", {"cols=20", "rows=30", "contact_factor=0"});
@@ -234,6 +235,7 @@ TEST(Crease, AFoldLeavesACreaseInPaper) {
 }
 
 TEST(Crease, AnElasticSheetIsFlatAgain) {
+  TENDER_ONE_THREAD_TEST();
   // The tender preset's skip-one bending, and its hinges without creases
   for (const char* bending : {"dihedral=off", "dihedral=on"}) {
     const SimParams p = flatSheet("tender", {"cols=16", "rows=24", bending, "crease_yield=0"});
@@ -245,6 +247,7 @@ TEST(Crease, AnElasticSheetIsFlatAgain) {
 }
 
 TEST(Crease, CreasesDoNotDependOnTheIterationCount) {
+  TENDER_ONE_THREAD_TEST();
   // The return map runs once per substep and the hinges' stiffness is a compliance, so a fold makes
   // the same crease with 4 and with 16 iterations; what differs is the structural constraints'
   // stiffness, which shapes the fold a little
@@ -259,6 +262,7 @@ TEST(Crease, CreasesDoNotDependOnTheIterationCount) {
 }
 
 TEST(Crease, WindCreasesNothing) {
+  TENDER_ONE_THREAD_TEST();
   // The crumple sheet hanging from its corners in ten seconds of strong wind
   CpuSolver solver;
   const SimParams p = preset("crumple", {"cols=20", "rows=30", "wind=on", "wind_strength=3", "contact_factor=0"});
@@ -323,6 +327,7 @@ std::pair<std::string, int> crumpleScript(const SimParams& p, glm::vec3 middle) 
 }
 
 TEST(Hand, ACrumpledBallKeepsItsSizeAndItsFolds) {
+  TENDER_ONE_THREAD_TEST();
   // Crumpled by the hand and let go on the floor, the ball springs back a little as the hand lets
   // go of its layers (the first second), then keeps its size and its folds for five seconds.
   const SimParams p = flatSheet("crumple", {"cols=20", "rows=30"});
@@ -387,6 +392,7 @@ std::pair<std::string, int> dragScript(const SimParams& p) {
 }
 
 TEST(Stretch, TheHandDragsFoldsAndCrumplesPaperWithinThreePercent) {
+  TENDER_ONE_THREAD_TEST();
   // At the presets' defaults, flat on their floors: a drag, a fold in half and back, and the hand's
   // crumple, each at a hand's pace; the stretch limit holds every structural edge within 1 %
   for (const char* name : {"crumple", "paper"}) {
@@ -555,6 +561,7 @@ TEST(Stretch, RingsFromSeveralRootsVisitEveryParticleOnceAfterItsParents) {
 }
 
 TEST(Stretch, ASheetHangingFromItsPinsHoldsTheLimitAtEachPin) {
+  TENDER_ONE_THREAD_TEST();
   // The bench's sheet (the crumple preset scaled to 128 x 192), hanging from its corners and from
   // three pins: the rings run from every pin, so the edges at each are held too (rings from the
   // sheet's middle left those at the pins to the projection alone: 1.54)

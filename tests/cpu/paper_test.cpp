@@ -31,6 +31,7 @@ Extent extentOf(Solver& solver, float dt) {
 }
 
 TEST(Paper, AReceiptLetGoOneMetreUpGlidesAndLandsNearlyFlat) {
+  TENDER_ONE_THREAD_TEST();
   const SimParams p = preset("paper");
   CpuSolver solver;
   Simulation sim(p, solver);
@@ -73,6 +74,7 @@ TEST(Paper, AReceiptLetGoOneMetreUpGlidesAndLandsNearlyFlat) {
 }
 
 TEST(Paper, AFlatSheetFallsAtTheTerminalSpeedOfQuadraticDrag) {
+  TENDER_ONE_THREAD_TEST();
   // Flat and level, it falls straight down; drag rho C v^2 / 2 per area balances its weight
   // sigma g at v = sqrt(2 sigma g / (rho C)).
   const SimParams p = preset("paper", {"tilt=90", "floor_y=-100", "collision=off", "skin_friction=0"});

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/sim_helpers.h"
 #include "common/solver_cases.h"
 #include "core/stats.h"
 #include "cpu/cpu_solver.h"
@@ -40,6 +41,7 @@ INSTANTIATE_TYPED_TEST_SUITE_P(Cpu, SolverCase, CpuBackends, BackendName);
 } // namespace tender::test
 
 TEST(Verlet, ChangingTheSubstepsKeepsTheVelocity) {
+  TENDER_ONE_THREAD_TEST();
   // A sheet falling freely (no air, no damping, no floor in reach), its substeps doubled or halved
   // mid-fall by a `set` event: Verlet keeps the velocity as the step of the last substep, so the
   // first substep after the change rescales it to the new substep's length; the fall goes on at

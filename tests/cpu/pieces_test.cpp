@@ -72,6 +72,7 @@ TEST(Pieces, ATearAcrossTheSheetLeavesTwoPiecesThatFallApart) {
 }
 
 TEST(Pieces, FoldingTearsNothing) {
+  TENDER_ONE_THREAD_TEST();
   for (const char* name : {"tender", "crumple"}) {
     const SimParams p = preset(name, {"wind=off", "cols=16", "rows=24"});
     CpuSolver solver;
