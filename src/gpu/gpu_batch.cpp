@@ -42,6 +42,7 @@ public:
   void readback(SimState& out) override { batch_.readSheet(index_, out); }
   void finish() override { batch_.finish(); }
   uint32_t dispatchesPerTick() const override { return batch_.last_dispatches_; }
+  int64_t contacts() const override { return batch_.sheetContacts(index_); }
   uint64_t memoryBytes() const override { return batch_.memoryBytes() / std::max<uint32_t>(batch_.size(), 1); }
   Arithmetic arithmetic() const override { return arithmeticOf(batch_.float_rules_, batch_.math_); }
   void stopNextTickAfter(uint32_t last_pass) override {
@@ -243,6 +244,8 @@ void GpuBatch::flush() {
       u.contact_check.w = SIM_CONTACT_LIST_CAPACITY;
     }
     ticked_ = true;
+    if (contact_on_.size() < size()) contact_on_.resize(size(), false);
+    contact_on_[i] = u.contact.x > 0.0f;
     if (keepsCandidateLists(sizes_, candidates_allowed_)) u.flags |= SIM_FLAG_CANDIDATES; // as the solver does
     std::memcpy(inputs + uniforms_at + stride_[SIM_BIND_UNIFORMS] * i, &u, sizeof(u));
     const uint32_t substeps = u.reset_active ? 0u : substepCount(u.substeps);

@@ -76,6 +76,8 @@ private:
   void readSheet(uint32_t i, SimState& out);
   glm::vec4 readParticle(uint32_t i, uint32_t particle);
   std::vector<glm::vec4> readSheetPositions(uint32_t i);
+  /// Sheet i's particles in contact in its last tick (Solver::contacts; -1: contact was off).
+  int64_t sheetContacts(uint32_t i);
   void readSheetDeltas(uint32_t i, std::vector<glm::vec4>& out);
   /// Where sheet i's bindings live: its slices.
   SheetPlace place(uint32_t i) const;
@@ -111,8 +113,9 @@ private:
   SheetTopology topo_; ///< the topology every sheet shares
   SheetLayout sizes_;
   bool allocated_ = false;
-  bool ticked_ = false;        ///< a sheet has ticked
-  std::vector<bool> uploaded_; ///< the sheets uploaded
+  bool ticked_ = false;          ///< a sheet has ticked
+  std::vector<bool> uploaded_;   ///< the sheets uploaded
+  std::vector<bool> contact_on_; ///< the sheets whose last tick had contact on
   /// Frees every slice (allocate makes them again).
   void releaseSlices();
   std::array<Buffer, SIM_BATCH_ENTRIES> buf_{};          ///< per binding: a slice per sheet; the queue

@@ -103,6 +103,14 @@ if "$T" devices >/dev/null 2>&1; then
   cmp -s <(lines "$tmp/gpu" | sed 's/"arithmetic": {[^}]*}, "backend": "[a-z]*", //') \
     <(lines "$tmp/tear" | sed 's/"arithmetic": {[^}]*}, "backend": "[a-z]*", //') ||
     fail "gpu and cpu sweeps differ"
+  # With the crumple preset's contact: the same stats, its count of particles in contact included
+  paper=(--preset crumple --set cols=8 --set rows=12 --script "$tmp/yank.txt" --vary damping=0.98,0.99 --ticks 20)
+  sweep --backend gpu "${paper[@]}" --batch 2 --out "$tmp/gpu_contact"
+  sweep --backend cpu "${paper[@]}" --out "$tmp/cpu_contact"
+  grep -q '"contacts":[1-9]' "$tmp/cpu_contact/sheets.jsonl" || fail "no contact in the crumple sweep"
+  cmp -s <(lines "$tmp/gpu_contact" | sed 's/"arithmetic": {[^}]*}, "backend": "[a-z]*", //') \
+    <(lines "$tmp/cpu_contact" | sed 's/"arithmetic": {[^}]*}, "backend": "[a-z]*", //') ||
+    fail "gpu and cpu sweeps with contact differ"
   # Sheets too large for the fused tick run the per-colour passes batched, with the same results
   big=(--set cols=64 --set rows=96 --vary damping=0.98,0.99 --ticks 4)
   sweep --backend gpu "${big[@]}" --out "$tmp/gpu_big"

@@ -134,6 +134,7 @@ inline uint32_t expectFleetMatchesAlone(SheetBatch& batch, Solver& alone, const 
     EXPECT_EQ(a.pos.size(), n) << "sheet " << i;
     EXPECT_FALSE(a.prev.empty() || a.constraints.empty()) << "sheet " << i;
     EXPECT_EQ(fleet.sim(i).grabCount(), sim.grabCount()) << "sheet " << i;
+    EXPECT_EQ(fleet.sim(i).solver().contacts(), alone.contacts()) << "sheet " << i;
     EXPECT_TRUE(sameBytes(a.pos, b.pos)) << "sheet " << i;
     EXPECT_TRUE(sameBytes(a.prev, b.prev)) << "sheet " << i;
     EXPECT_TRUE(sameBytes(a.constraints, b.constraints)) << "sheet " << i;
