@@ -122,6 +122,7 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
 
   sheets_.reserve(sheets);
   queued_.reserve(sheets);
+  contact_on_.assign(sheets, false);
   for (uint32_t i = 0; i < sheets; ++i) {
     sheets_.push_back(std::make_unique<Sheet>(*this, i));
     queued_.push_back(std::make_unique<QueuedSolver>(*this, *sheets_.back()));
@@ -244,7 +245,6 @@ void GpuBatch::flush() {
       u.contact_check.w = SIM_CONTACT_LIST_CAPACITY;
     }
     ticked_ = true;
-    if (contact_on_.size() < size()) contact_on_.resize(size(), false);
     contact_on_[i] = u.contact.x > 0.0f;
     if (keepsCandidateLists(sizes_, candidates_allowed_)) u.flags |= SIM_FLAG_CANDIDATES; // as the solver does
     std::memcpy(inputs + uniforms_at + stride_[SIM_BIND_UNIFORMS] * i, &u, sizeof(u));

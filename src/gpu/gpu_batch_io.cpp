@@ -72,12 +72,9 @@ glm::vec4 GpuBatch::readParticle(uint32_t i, uint32_t particle) {
 }
 
 int64_t GpuBatch::sheetContacts(uint32_t i) {
-  if (i >= contact_on_.size() || !contact_on_[i] || !sizes_.contact) return -1;
+  if (!contact_on_[i] || !sizes_.contact) return -1;
   finish();
-  // The header of its contact grid, as GpuSolver::contacts reads a sheet's own
-  uint32_t header[SIM_CONTACT_HEADER];
-  ctx_.download(buf_[SIM_BIND_CONTACT_GRID], header, sizeof(header), sliceOffset(SIM_BIND_CONTACT_GRID, i));
-  return header[2];
+  return readContactCount(ctx_, buf_[SIM_BIND_CONTACT_GRID], sliceOffset(SIM_BIND_CONTACT_GRID, i));
 }
 
 std::vector<glm::vec4> GpuBatch::readSheetPositions(uint32_t i) {

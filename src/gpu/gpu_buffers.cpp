@@ -147,9 +147,7 @@ void GpuSolver::sizeContact() {
 int64_t GpuSolver::contacts() const {
   if (!last_contact_ || !layout_sizes_.contact) return -1;
   const_cast<GpuSolver*>(this)->finish();
-  uint32_t header[SIM_CONTACT_HEADER];
-  ctx_.download(buf_[SIM_BIND_CONTACT_GRID], header, sizeof(header));
-  return header[2];
+  return readContactCount(ctx_, buf_[SIM_BIND_CONTACT_GRID], 0);
 }
 
 uint32_t GpuSolver::contactListBuilds() {

@@ -122,4 +122,8 @@ void beginSheetReset(VulkanContext& ctx, const SheetPlace& place, const SheetTop
 void readSheetState(VulkanContext& ctx, const SheetPlace& place, const SheetTopology& topo, const SheetLayout& sizes,
                     SimState& out);
 
+/// The particles in contact in a sheet's last substep (Solver::contacts): the count contact_bound
+/// keeps in its contact grid's header, `grid` from `offset` (a sheet alone: 0; a fleet's: its slice).
+int64_t readContactCount(VulkanContext& ctx, const Buffer& grid, VkDeviceSize offset);
+
 } // namespace tender::gpu
