@@ -114,10 +114,16 @@
 #define SIM_BATCH_ARGS 34
 // Entries of the fleet's table
 #define SIM_BATCH_ENTRIES 35
+// Contact's passes alike: the full grids of its grid's passes, then per substep the live ones of
+// its grid's passes (contact_arm raises them to the full grid's x when a sheet builds its grid),
+// of contact_walk and of contact_cross (each sheet raises them to its own grid's x and y)
 #define SIM_BATCH_ARGS_FULL_COMPACT SIM_HASH_DISPATCHES
 #define SIM_BATCH_ARGS_LIVE_HASH (SIM_BATCH_ARGS_FULL_COMPACT + 1u)
 #define SIM_BATCH_ARGS_LIVE_COMPACT (SIM_BATCH_ARGS_LIVE_HASH + SIM_MAX_SUBSTEPS * SIM_HASH_DISPATCHES)
-#define SIM_BATCH_ARGS_COUNT (SIM_BATCH_ARGS_LIVE_COMPACT + SIM_MAX_SUBSTEPS)
+#define SIM_BATCH_ARGS_FULL_CONTACT (SIM_BATCH_ARGS_LIVE_COMPACT + SIM_MAX_SUBSTEPS)
+#define SIM_BATCH_CONTACT_SLOTS (SIM_CONTACT_GRID_DISPATCHES + 2u)
+#define SIM_BATCH_ARGS_LIVE_CONTACT (SIM_BATCH_ARGS_FULL_CONTACT + SIM_CONTACT_GRID_DISPATCHES)
+#define SIM_BATCH_ARGS_COUNT (SIM_BATCH_ARGS_LIVE_CONTACT + SIM_MAX_SUBSTEPS * SIM_BATCH_CONTACT_SLOTS)
 // Which sheets of a batch a per-colour pass runs for (BatchArgs.gate). The batch records the
 // passes of its most substeps and iterations, with air and collision when any sheet has them; a
 // sheet runs a pass exactly when the same sheet ticking alone records or dispatches it. Every
@@ -145,6 +151,17 @@
 // SIM_GATE_SHORTEN: the sheet's limit shortens edges (limitShortens) and it has iteration
 // BatchArgs.gate_arg (shorten)
 #define SIM_GATE_SHORTEN 9u
+// SIM_GATE_CONTACT: the sheet has contact (contact's passes of every substep)
+#define SIM_GATE_CONTACT 10u
+// SIM_GATE_CONTACT_GRID: the sheet has contact and builds its grid this substep (contact_arm
+// armed its grid's passes: they alone run the grid the batch's live arguments give them)
+#define SIM_GATE_CONTACT_GRID 11u
+// SIM_GATE_CONTACT_WALK, SIM_GATE_CONTACT_CROSS: the sheet has contact and its own arguments of
+// contact_walk (contact_cross) have workgroups this substep
+#define SIM_GATE_CONTACT_WALK 12u
+#define SIM_GATE_CONTACT_CROSS 13u
+// SIM_GATE_SETTLE: the sheet has contact and settle sweep BatchArgs.gate_arg (the settle stage)
+#define SIM_GATE_SETTLE 14u
 // Sheets per hardware thread that one dispatch of a fleet takes on a CPU device, which runs a
 // substep per dispatch: each thread keeps its sheet's arrays (under 1 MiB for 32 x 48) in its
 // cache through every substep before the next sheets start (lavapipe, 2 threads, 64 sheets of
@@ -278,6 +295,8 @@
 // the cells a box spans at most (cells as wide as the longest edge and the contact diameter, with
 // room to spare for rounding: two a side)
 #define SIM_CONTACT_HEADER (25u + SIM_SETTLE_MAX_SWEEPS)
+// The header's word that says the grid is built in this substep (a fleet's gates read it)
+#define SIM_CONTACT_WORD_GRID 4u
 #define SIM_CONTACT_CELLS_PER_BOX 8u
 #define SIM_CONTACT_CELL_ROOM 1.01f
 

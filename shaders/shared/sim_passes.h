@@ -23,18 +23,18 @@
 //   per_invocation  elements one invocation covers
 //   batched         1: a fleet runs it once for the whole batch (built again with SIM_BATCH_PASS)
 #define SIM_KERNELS(X)                                                                                                 \
-  X(contact_begin, SIM, 1, 0)                                                                                          \
-  X(contact_clear, SIM, 1, 0)                                                                                          \
-  X(contact_arm, SIM, 1, 0)                                                                                            \
-  X(contact_grid_clear, SIM, 1, 0)                                                                                     \
-  X(contact_count, SIM, 1, 0)                                                                                          \
-  X(contact_scatter, SIM, 1, 0)                                                                                        \
-  X(contact_cross, SIM, 1, 0)                                                                                          \
-  X(contact_near, SIM, 1, 0)                                                                                           \
-  X(contact_active, SIM, 1, 0)                                                                                         \
-  X(contact_emit, SIM, 1, 0)                                                                                           \
-  X(contact_walk, SIM, 1, 0)                                                                                           \
-  X(contact_bound, SIM, 1, 0)                                                                                          \
+  X(contact_begin, SIM, 1, 1)                                                                                          \
+  X(contact_clear, SIM, 1, 1)                                                                                          \
+  X(contact_arm, SIM, 1, 1)                                                                                            \
+  X(contact_grid_clear, SIM, 1, 1)                                                                                     \
+  X(contact_count, SIM, 1, 1)                                                                                          \
+  X(contact_scatter, SIM, 1, 1)                                                                                        \
+  X(contact_cross, SIM, 1, 1)                                                                                          \
+  X(contact_near, SIM, 1, 1)                                                                                           \
+  X(contact_active, SIM, 1, 1)                                                                                         \
+  X(contact_emit, SIM, 1, 1)                                                                                           \
+  X(contact_walk, SIM, 1, 1)                                                                                           \
+  X(contact_bound, SIM, 1, 1)                                                                                          \
   X(air, SIM, 1, 1)                                                                                                    \
   X(integrate, SIM, 1, 1)                                                                                              \
   X(candidates_check, SIM, 1, 1)                                                                                       \
@@ -52,13 +52,13 @@
   X(limit, SIM, 1, 1)                                                                                                  \
   X(crease, SIM, 1, 1)                                                                                                 \
   X(floor, SIM, 1, 1)                                                                                                  \
-  X(contact_excess, SIM, 1, 0)                                                                                         \
-  X(contact_share, SIM, 1, 0)                                                                                          \
-  X(contact_step, SIM, 1, 0)                                                                                           \
-  X(contact_settle_check, SIM, 1, 0)                                                                                   \
-  X(contact_half_count, SIM, 1, 0)                                                                                     \
-  X(contact_half_fill, SIM, 1, 0)                                                                                      \
-  X(contact_settle, SIM, 1, 0)                                                                                         \
+  X(contact_excess, SIM, 1, 1)                                                                                         \
+  X(contact_share, SIM, 1, 1)                                                                                          \
+  X(contact_step, SIM, 1, 1)                                                                                           \
+  X(contact_settle_check, SIM, 1, 1)                                                                                   \
+  X(contact_half_count, SIM, 1, 1)                                                                                     \
+  X(contact_half_fill, SIM, 1, 1)                                                                                      \
+  X(contact_settle, SIM, 1, 1)                                                                                         \
   X(tear_mark, SIM, 1, 1)                                                                                              \
   X(tear_unsupported, NONE, 1, 1)                                                                                      \
   X(tear_flags, NONE, 1, 1)                                                                                            \
@@ -115,24 +115,24 @@
 //   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases), LIMIT
 //             (the sheet has a stretch limit), SHORTEN (the limit shortens edges: limitShortens),
 //             CONSTRAINTS (the sheet has constraints), CONTACT (contact is on: a sheet alone,
-//             or a fleet's sheet recorded on its own) or SETTLE (contact is on with the settle's
+//             or any sheet of a fleet) or SETTLE (contact is on with the settle's
 //             sweeps: SubstepPlan::sweeps)
 //   category  its timestamp category (gpu::PassCategory k<category>)
 #define SIM_DISPATCHES(X)                                                                                              \
-  X(integrate, contact_begin, ONE, Threads, TICK, CONTACT, Contact)                                                    \
-  X(integrate, contact_clear, CONTACT_SLOTS, Threads, TICK, CONTACT, Contact)                                          \
-  X(integrate, contact_arm, ONE, Threads, TICK, CONTACT, Contact)                                                      \
-  X(integrate, contact_grid_clear, CONTACT_BUCKETS, Contact, TICK, CONTACT, Contact)                                   \
-  X(integrate, contact_count, CONTACT_BOXES, Contact, TICK, CONTACT, Contact)                                          \
-  X(integrate, scan, CONTACT_CELLS, Contact, TICK, CONTACT, Contact)                                                   \
-  X(integrate, contact_scatter, CONTACT_BOXES, Contact, TICK, CONTACT, Contact)                                        \
-  X(integrate, contact_cross, TRIANGLES, Cross, TICK, CONTACT, Contact)                                                \
-  X(integrate, contact_near, CONTACT_QUERIES, Contact, TICK, CONTACT, Contact)                                         \
-  X(integrate, contact_active, CONTACT_ACTIVE, Contact, TICK, CONTACT, Contact)                                        \
-  X(integrate, scan, CONTACT_ACTIVE_CELLS, Contact, TICK, CONTACT, Contact)                                            \
-  X(integrate, contact_emit, CONTACT_ACTIVE, Contact, TICK, CONTACT, Contact)                                          \
-  X(integrate, contact_walk, CONTACT_QUERIES, Walk, TICK, CONTACT, Contact)                                            \
-  X(integrate, contact_bound, PARTICLES, Threads, TICK, CONTACT, Contact)                                              \
+  X(integrate, contact_begin, ONE, Threads, CONTACT, CONTACT, Contact)                                                 \
+  X(integrate, contact_clear, CONTACT_SLOTS, Threads, CONTACT, CONTACT, Contact)                                       \
+  X(integrate, contact_arm, ONE, Threads, CONTACT, CONTACT, Contact)                                                   \
+  X(integrate, contact_grid_clear, CONTACT_BUCKETS, Contact, CONTACT_GRID, CONTACT, Contact)                           \
+  X(integrate, contact_count, CONTACT_BOXES, Contact, CONTACT_GRID, CONTACT, Contact)                                  \
+  X(integrate, scan, CONTACT_CELLS, Contact, CONTACT_GRID, CONTACT, Contact)                                           \
+  X(integrate, contact_scatter, CONTACT_BOXES, Contact, CONTACT_GRID, CONTACT, Contact)                                \
+  X(integrate, contact_cross, TRIANGLES, Cross, CONTACT_CROSS, CONTACT, Contact)                                       \
+  X(integrate, contact_near, CONTACT_QUERIES, Contact, CONTACT_GRID, CONTACT, Contact)                                 \
+  X(integrate, contact_active, CONTACT_ACTIVE, Contact, CONTACT_GRID, CONTACT, Contact)                                \
+  X(integrate, scan, CONTACT_ACTIVE_CELLS, Contact, CONTACT_GRID, CONTACT, Contact)                                    \
+  X(integrate, contact_emit, CONTACT_ACTIVE, Contact, CONTACT_GRID, CONTACT, Contact)                                  \
+  X(integrate, contact_walk, CONTACT_QUERIES, Walk, CONTACT_WALK, CONTACT, Contact)                                    \
+  X(integrate, contact_bound, PARTICLES, Threads, CONTACT, CONTACT, Contact)                                           \
   X(integrate, air, PARTICLES, Threads, AIR, AIR, Integrate)                                                           \
   X(integrate, integrate, PARTICLES, Threads, TICK, ALWAYS, Integrate)                                                 \
   X(collide, candidates_check, PARTICLES, Threads, COLLISION, ALWAYS, Hash)                                            \
@@ -149,14 +149,14 @@
   X(limit, limit, RINGS, Threads, LIMIT, LIMIT, Project)                                                               \
   X(crease, crease, HINGES, Threads, CREASE, CREASE, Project)                                                          \
   X(floor, floor, PARTICLES, Threads, TICK, ALWAYS, Floor)                                                             \
-  X(floor, contact_excess, CONTACT_QUERIES, Threads, TICK, CONTACT, Floor)                                             \
-  X(floor, contact_share, CONTACT_QUERIES, Threads, TICK, CONTACT, Floor)                                              \
-  X(floor, contact_step, PARTICLES, Threads, TICK, CONTACT, Floor)                                                     \
-  X(settle, contact_settle_check, CONSTRAINTS, Threads, TICK, SETTLE, Floor)                                           \
-  X(settle, contact_half_count, CONTACT_QUERIES, Threads, TICK, SETTLE, Floor)                                         \
-  X(settle, scan, CONTACT_HALF_CELLS, Threads, TICK, SETTLE, Floor)                                                    \
-  X(settle, contact_half_fill, CONTACT_QUERIES, Threads, TICK, SETTLE, Floor)                                          \
-  X(settle, contact_settle, SWEEPS, Threads, TICK, SETTLE, Floor)                                                      \
+  X(floor, contact_excess, CONTACT_QUERIES, Threads, CONTACT, CONTACT, Floor)                                          \
+  X(floor, contact_share, CONTACT_QUERIES, Threads, CONTACT, CONTACT, Floor)                                           \
+  X(floor, contact_step, PARTICLES, Threads, CONTACT, CONTACT, Floor)                                                  \
+  X(settle, contact_settle_check, CONSTRAINTS, Threads, SETTLE, SETTLE, Floor)                                         \
+  X(settle, contact_half_count, CONTACT_QUERIES, Threads, SETTLE, SETTLE, Floor)                                       \
+  X(settle, scan, CONTACT_HALF_CELLS, Threads, SETTLE, SETTLE, Floor)                                                  \
+  X(settle, contact_half_fill, CONTACT_QUERIES, Threads, SETTLE, SETTLE, Floor)                                        \
+  X(settle, contact_settle, SWEEPS, Threads, SETTLE, SETTLE, Floor)                                                    \
   X(tear, tear_mark, CONSTRAINTS, Threads, TICK, CONSTRAINTS, Tear)                                                    \
   X(tear, tear_unsupported, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                       \
   X(tear, tear_flags, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                             \

@@ -25,7 +25,7 @@
 #define CONTACT_TANGLED 1u
 #define CONTACT_COUNT 2u
 #define CONTACT_REBUILD 3u
-#define CONTACT_GRID 4u
+#define CONTACT_GRID SIM_CONTACT_WORD_GRID
 #define CONTACT_OVERFLOW 5u
 // contactFrame's inputs, gathered by contact_clear: every particle's last step, lowest (3 words)
 // and highest (3 words) as orderedBits, and the bits of their lowest start above the floor
@@ -370,6 +370,22 @@ void contactArm() {
   hash_args[SIM_CONTACT_CROSS_ARGS] =
       built ? uvec4(groupGrid((u.triangle_count + SIM_WG_PARTICLES - 1u) / SIM_WG_PARTICLES), 1u, 0u)
             : uvec4(0u, 1u, 1u, 0u);
+#ifdef SIM_BATCH_PASS
+  // A fleet: the batch's live arguments of this substep cover this sheet's (the gates keep the
+  // other sheets out of the passes this one alone needs)
+  uint live = SIM_BATCH_ARGS_LIVE_CONTACT + batch.substep * SIM_BATCH_CONTACT_SLOTS;
+  if (built)
+    for (uint k = 0u; k < SIM_CONTACT_GRID_DISPATCHES; ++k) batchArmArgs(live + k, SIM_BATCH_ARGS_FULL_CONTACT + k);
+  UintRef args = UintRef(batchSlice(SIM_BATCH_ARGS, 0u));
+  for (uint k = 0u; k < 2u; ++k) {
+    uvec4 own = hash_args[k == 0u ? SIM_CONTACT_WALK_ARGS : SIM_CONTACT_CROSS_ARGS];
+    uint slot = 4u * (live + SIM_CONTACT_GRID_DISPATCHES + k);
+    if (own.x != 0u) {
+      atomicMax(args.v[slot], own.x);
+      atomicMax(args.v[slot + 1u], own.y);
+    }
+  }
+#endif
 }
 
 // contact_grid_clear: bucket k cleared when the grid is built (dispatched only then: contact_arm)
@@ -668,9 +684,12 @@ void contactBound(uint i, uint s) {
 // the share), then to its bound, then pushed (slideStep)
 VerletState contactSlideStep(uint i, VerletState st, uint s) {
   if (!contactBounded(st.position.w, i == u.grab_index, u.grab_target[s].w)) return st;
-  return slideStep(st, vec3(contact_particles[i].start), vec3(contact_particles[i].push),
+  // start and bound in one load: a fleet's lavapipe build reads a component loaded apart from its
+  // vector as the vector's first (SpirvRules.NoSimShaderLoadsAVectorAndOneOfItsComponentsByDeviceAddress)
+  vec4 start = contact_particles[i].start;
+  return slideStep(st, vec3(start), vec3(contact_particles[i].push),
                    contactAverage(ivec4(contact_particles[i].sum), u.contact.w),
-                   uintBitsToFloat(contact_particles[i].state.z), contact_particles[i].start.w, contactFrameNow());
+                   uintBitsToFloat(contact_particles[i].state.z), start.w, contactFrameNow());
 }
 
 // What the floor pass leaves for the half-spaces' passes: particle i's sums cleared for the
@@ -688,7 +707,10 @@ void contactSlideClear(uint i) {
 // ball, its half-spaces (above) and the substep's frame
 vec3 settleStart(uint i) { return vec3(contact_particles[i].start); }
 vec3 settlePush(uint i) { return vec3(contact_particles[i].push); }
-float settleBound(uint i) { return contact_particles[i].start.w; }
+float settleBound(uint i) {
+  vec4 start = contact_particles[i].start; // whole, as settleStart reads it (see contactSlideStep)
+  return start.w;
+}
 vec3 settleFrame() { return contactFrameNow(); }
 #include "settle_bodies.h"
 

@@ -267,6 +267,18 @@ bool batchGateTakes() {
     return u.limit.x > 0.0f;
   case SIM_GATE_SHORTEN:
     return limitShortens(u.limit.x, u.grab_index, u.flags) && batch.gate_arg < u.iterations;
+  // Contact's passes: those a sheet alone records, and of its indirect ones those its own
+  // arguments give workgroups (contact_arm set them; they stand through the substep)
+  case SIM_GATE_CONTACT:
+    return u.contact.x > 0.0f;
+  case SIM_GATE_CONTACT_GRID:
+    return u.contact.x > 0.0f && contact_words[SIM_CONTACT_WORD_GRID] != 0u;
+  case SIM_GATE_CONTACT_WALK:
+    return u.contact.x > 0.0f && hash_args[SIM_CONTACT_WALK_ARGS].x != 0u;
+  case SIM_GATE_CONTACT_CROSS:
+    return u.contact.x > 0.0f && hash_args[SIM_CONTACT_CROSS_ARGS].x != 0u;
+  case SIM_GATE_SETTLE:
+    return u.contact.x > 0.0f && batch.gate_arg < u.contact_check.y;
   default:
     return true;
   }

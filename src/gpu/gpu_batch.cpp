@@ -94,9 +94,7 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
   sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
   per_sheet_ = passes == BatchPasses::PerSheet || (passes == BatchPasses::Auto && cpu_device);
   {
-    // The layouts of one sheet's passes at a time (per_sheet_, and sheets with contact, whose
-    // passes run sheet by sheet so far); a batched fleet makes their pipelines when it first needs
-    // them
+    // The layouts of one sheet's passes at a time (per_sheet_)
     sheet_set_layout_ = createSheetSetLayout(dev);
     VkPushConstantRange sheet_range{VK_SHADER_STAGE_COMPUTE_BIT, 0, uint32_t(sizeof(SimPush))};
     pli.setLayoutCount = 1;
@@ -196,7 +194,7 @@ void GpuBatch::allocate(const SheetTopology& topo) {
                              ctx_.info().name + " (try a smaller --batch)");
   }
   ctx_.submitOnce([&](VkCommandBuffer cmd) { vkCmdUpdateBuffer(cmd, table_.buffer, 0, sizeof(entries), &entries); });
-  if (per_sheet_ || sizes_.contact) {
+  if (per_sheet_) {
     // Each sheet's descriptor set over its slices
     VkDevice dev = ctx_.device();
     sheet_pool_ = createSheetSetPool(dev, sheets);
@@ -290,11 +288,11 @@ void GpuBatch::flush() {
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BIND_UNIFORMS].buffer, uint32_t(regions.size()), regions.data());
   VkBufferCopy queue_region{0, 0, 4ull * queue.size()};
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_QUEUE].buffer, 1, &queue_region);
-  const bool sheet_by_sheet = per_sheet_ || plan.contact;
-  if (plan.contact && !sheet_passes_.integrate.pipeline)
-    sheet_passes_ = makePassPipelines(ctx_, sheet_layout_, float_rules_, math_, false, owned_pipelines_);
-  if (plan.contact)
+  const bool sheet_by_sheet = per_sheet_;
+  if (plan.contact && per_sheet_)
     addContactPipelines(ctx_, sheet_layout_, float_rules_, math_, std::nullopt, sheet_passes_, owned_pipelines_);
+  else if (plan.contact)
+    addContactPipelines(ctx_, layout_, float_rules_, math_, std::nullopt, passes_, owned_pipelines_, true);
   if (!passes.empty() && sheet_by_sheet) {
     // Each sheet's full grids of the hash passes and of contact's grid passes, which its
     // candidates_decide and contact_arm copy to the live ones
@@ -394,10 +392,18 @@ void GpuBatch::flush() {
     const uint32_t compact_groups = (sizes_.tear_slots + SIM_WG_TEAR - 1) / SIM_WG_TEAR;
     args[SIM_BATCH_ARGS_FULL_COMPACT] = glm::uvec4(groupGrid(compact_groups), pass_sheets_, 0);
     for (uint32_t k = 0; k < hash_grids_.grids().size(); ++k) args[k] = hash_grids_.grids()[k];
+    for (uint32_t k = 0; k < hash_grids_.contactGrids().size(); ++k)
+      args[SIM_BATCH_ARGS_FULL_CONTACT + k] = hash_grids_.contactGrids()[k];
     for (uint32_t s = 0; s < SIM_MAX_SUBSTEPS; ++s) {
       for (uint32_t k = 0; k < SIM_HASH_DISPATCHES; ++k)
         args[SIM_BATCH_ARGS_LIVE_HASH + s * SIM_HASH_DISPATCHES + k] = glm::uvec4(0, args[k].y, pass_sheets_, 0);
       args[SIM_BATCH_ARGS_LIVE_COMPACT + s] = glm::uvec4(0, args[SIM_BATCH_ARGS_FULL_COMPACT].y, pass_sheets_, 0);
+      // Contact's grid passes, then contact_walk's and contact_cross's (each sheet raises x and y)
+      const uint32_t live = SIM_BATCH_ARGS_LIVE_CONTACT + s * SIM_BATCH_CONTACT_SLOTS;
+      for (uint32_t k = 0; k < SIM_CONTACT_GRID_DISPATCHES; ++k)
+        args[live + k] = glm::uvec4(0, args[SIM_BATCH_ARGS_FULL_CONTACT + k].y, pass_sheets_, 0);
+      args[live + SIM_CONTACT_GRID_DISPATCHES] = args[live + SIM_CONTACT_GRID_DISPATCHES + 1] =
+          glm::uvec4(0, 0, pass_sheets_, 0);
     }
     std::memcpy(inputs + args_at, args, sizeof(args));
   }
@@ -416,10 +422,11 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
   if (push_size > sizeof(SimPush) || p.push_size != sizeof(BatchPassPush))
     vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
   // The grid a sheet alone gets, with a workgroup z per sheet: from the element count; the hash
-  // passes and the compaction from the batch's live arguments, which the sheets that need them
-  // arm (the gates skip the other sheets).
-  if ((grid == Grid::Threads || grid == Grid::Hash) && count == 0) return;
-  const glm::uvec4 full = fullGrid(p, grid == Grid::Threads || grid == Grid::Hash ? count : 1u, pass_sheets_);
+  // passes, the compaction and contact's indirect passes from the batch's live arguments, which
+  // the sheets that need them arm (the gates skip the other sheets).
+  const bool counted = grid == Grid::Threads || grid == Grid::Hash || grid == Grid::Contact;
+  if ((counted || grid == Grid::Walk || grid == Grid::Cross) && count == 0) return;
+  const glm::uvec4 full = fullGrid(p, counted ? count : 1u, pass_sheets_);
   const uint32_t hash_dispatch = hash_grids_.record(grid, full);
   BatchPassPush bp{};
   if (push_size) std::memcpy(&bp.pass, push, push_size);
@@ -450,9 +457,15 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
     break;
   case Grid::Contact:
   case Grid::Walk:
-  case Grid::Cross:
-    // A sheet with contact runs its passes on its own (passOfSheet)
-    vkCheckFailed(VK_ERROR_UNKNOWN, "contact in a batched pass", __FILE__, __LINE__);
+  case Grid::Cross: {
+    // Contact's: its grid's pass k (hash_dispatch names the sheet's own slot), contact_walk, contact_cross
+    const uint32_t slot = grid == Grid::Contact ? hash_dispatch - SIM_CONTACT_GRID_ARGS
+                          : grid == Grid::Walk  ? SIM_CONTACT_GRID_DISPATCHES
+                                                : SIM_CONTACT_GRID_DISPATCHES + 1;
+    vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer,
+                          16ull * (SIM_BATCH_ARGS_LIVE_CONTACT + substep * SIM_BATCH_CONTACT_SLOTS + slot));
+    break;
+  }
   }
   ++last_dispatches_;
 }

@@ -157,12 +157,14 @@ SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, cons
 }
 
 void addContactPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
-                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, PipelineSet& owned) {
+                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, PipelineSet& owned,
+                         bool batched) {
   using namespace shaderio;
   for (const PipelineSpec& spec : kPasses)
     if (isContactKernel(spec) && !(pipes.*spec.member).pipeline)
-      pipes.*spec.member = makeComputePipeline(ctx, spec.key, layout, rules, math, spec.push_size, spec.per_invocation,
-                                               std::nullopt, false, owned);
+      pipes.*spec.member = makeComputePipeline(
+          ctx, batched ? std::string(spec.key) + ".batch" : std::string(spec.key), layout, rules, math,
+          batched ? uint32_t(sizeof(BatchPassPush)) : spec.push_size, spec.per_invocation, std::nullopt, false, owned);
   if (fused_workgroup && !pipes.tick_fused_contact.pipeline)
     pipes.tick_fused_contact = makeComputePipeline(ctx, "tick_fused_contact.comp", layout, rules, math,
                                                    sizeof(FusedPush), 1, *fused_workgroup, true, owned);

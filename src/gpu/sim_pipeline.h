@@ -77,11 +77,13 @@ uint32_t limitWorkgroup(const VulkanContext& ctx);
 SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
                                bool batched, PipelineSet& owned);
 
-/// Adds the contact's kernels (contact_*) to `pipes`, a sheet's own passes on `layout`, and, with
-/// `fused_workgroup` set, the fused tick with contact (tick_fused_contact): made when a sheet first
-/// has contact on, so that a solver without it does not compile them. Nothing when they are made.
+/// Adds the contact's kernels (contact_*) to `pipes`, passes on `layout` as makePassPipelines
+/// makes them (`batched`: a fleet's), and, with `fused_workgroup` set, the fused tick with contact
+/// (tick_fused_contact): made when a sheet first has contact on, so that a solver without it does
+/// not compile them. Nothing when they are made.
 void addContactPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
-                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, PipelineSet& owned);
+                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, PipelineSet& owned,
+                         bool batched = false);
 
 /// One input of the device math check and its results (bits of floats).
 struct MathCase {

@@ -236,7 +236,7 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
       for (uint32_t c = 0; c < topo.colorCount(); ++c) {
         const ColorRange& range = topo.colors[c];
         if (range.count == 0 || !shortensColour(topo.constraints[range.first].kind_id)) continue;
-        record(sink, p, d.grid, range.count, SimPush{sweep, range.count, s, c}, s, d.gate);
+        record(sink, p, d.grid, range.count, SimPush{sweep, range.count, s, c}, s, d.gate, sweep);
         sink.barrier();
       }
     return;

@@ -144,7 +144,7 @@ TEST_P(GpuBatchPasses, ThePerColourFleetMatchesTheCpuReference) {
 }
 
 TEST_P(GpuBatchPasses, LargeContactSheetsMatchTheirRunsAlone) {
-  // Sheet 1 has contact on: its passes run sheet by sheet, in either mode
+  // Sheet 1 has contact on, sheet 0 not: batched, the contact passes' gates take sheet 1 alone
   const std::vector<FleetSheet> sheets = withContact(mixedFleet(2, 40, 52));
   gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
   CpuSolver alone;
@@ -187,6 +187,34 @@ INSTANTIATE_TEST_SUITE_P(Fleet, GpuBatchPasses, testing::Values(gpu::BatchPasses
 TEST_F(GpuBatchTest, ACpuDeviceRunsThePerColourPassesSheetBySheet) {
   gpu::GpuBatch batch(ctx(), 2);
   EXPECT_EQ(batch.passesPerSheet(), ctx().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
+}
+
+TEST_F(GpuBatchTest, BatchedContactSheetsRecordTheDispatchesOfOneSheet) {
+  // Four crumpled sheets with contact, each its own yank (their lists and grids are built in
+  // different substeps): batched, the passes one sheet alone records, each sheet's contact
+  // passes armed by its own arguments (sheet by sheet: LargeContactSheetsMatchTheirRunsAlone and
+  // LargeSheetsRecordTheDispatchesOfOneSheetPerPassOrPerSheet). The same bits as alone.
+  const SimParams p = preset("crumple", {"cols=16", "rows=24"});
+  std::vector<FleetSheet> sheets;
+  for (uint32_t i = 0; i < 4; ++i)
+    sheets.push_back({p, script(("0 grab particle " + std::to_string(383 - 5 * i) + "\n1 move " +
+                                 std::to_string(1 + i) + " -2 3\n5 release\n")
+                                    .c_str())});
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), gpu::BatchPasses::Batched);
+  gpu::GpuSolver alone(ctx());
+  alone.setFusedPath(false);
+  {
+    Fleet fleet(batch, std::vector<FleetSheet>(4, FleetSheet{p, {}}));
+    Simulation sim(p, alone);
+    for (int t = 0; t < 2; ++t) {
+      fleet.tick();
+      sim.tick();
+    }
+    EXPECT_GT(alone.dispatchesPerTick(), 100u);
+    EXPECT_EQ(batch.dispatchesPerFlush(), alone.dispatchesPerTick());
+  }
+  gpu::GpuBatch again(ctx(), uint32_t(sheets.size()), gpu::BatchPasses::Batched);
+  expectFleetMatchesAlone(again, alone, sheets, 8);
 }
 
 } // namespace

@@ -143,6 +143,38 @@ std::string spirvVal() {
 }
 } // namespace
 
+// A fleet's kernels reach a sheet's buffers by device address (PhysicalStorageBuffer). Mesa's
+// lavapipe (22.3) reads a component of a vector, loaded apart from the whole vector at the same
+// address, as the vector's first: `vec4 a = v[i].start; float b = v[i].start.w;` gave b = a.x (a
+// batched contact step that never cut a step). So no kernel loads both a vector and one of its
+// components other than the first through the same chain: it loads the vector once and takes the
+// component from it.
+TEST(SpirvRules, NoSimShaderLoadsAVectorAndOneOfItsComponentsByDeviceAddress) {
+  uint32_t chains = 0;
+  for (std::string_view key : simShaderKeys()) {
+    std::unordered_map<uint32_t, uint32_t> pointer_class;
+    std::unordered_map<uint32_t, std::vector<uint32_t>> chain; // access chain -> base and indices
+    std::set<std::vector<uint32_t>> loaded;                    // the chains loaded
+    std::unordered_map<uint32_t, uint32_t> constant;
+    for (const Instruction& in : instructions(simShader(key))) {
+      if (in.op == 43 /*Constant*/ && in.words.size() == 4) constant[in.words[2]] = in.words[3];
+      if (in.op == 32 /*TypePointer*/) pointer_class[in.words[1]] = in.words[2];
+      if ((in.op == 65 || in.op == 66) && pointer_class[in.words[1]] == 5349 /*PhysicalStorageBuffer*/)
+        chain[in.words[2]].assign(in.words.begin() + 3, in.words.end());
+      if (in.op == 61 /*Load*/ && chain.count(in.words[3])) loaded.insert(chain[in.words[3]]);
+    }
+    chains += uint32_t(loaded.size());
+    for (const std::vector<uint32_t>& c : loaded) {
+      // The chain one index shorter, loaded too: the vector whose component c is
+      if (c.size() < 3 || constant[c.back()] == 0) continue;
+      const std::vector<uint32_t> whole(c.begin(), c.end() - 1);
+      EXPECT_FALSE(loaded.count(whole)) << key << ": loads a vector (base %" << c[0] << ", " << c.size() - 2
+                                        << " indices) and its component " << constant[c.back()] << " apart";
+    }
+  }
+  EXPECT_GT(chains, 100u); // the fleet's kernels load through buffer references
+}
+
 TEST(SpirvRules, TheValidatorAcceptsEveryRewrittenShader) {
   const std::string spirv_val = spirvVal();
   if (spirv_val.empty()) GTEST_SKIP() << "spirv-val not found at configure time";
