@@ -26,8 +26,8 @@ SIM_INLINE vec3 settleStep(uint i) { return vec3(SIM_POSITION(i)) - (settleStart
 /// True when particle i is free in substep s and the contact bounds it (a grab the hand places
 /// stays where the hand has it).
 SIM_INLINE bool settleFree(uint i, uint s) {
-  vec4 p = SIM_POSITION(i);
-  return p.w > 0.0f && contactBounded(p.w, i == u.grab_index, u.grab_target[s].w);
+  vec4 p = SIM_POSITION(i), target = u.grab_target[s]; // whole (contactSlideStep says why)
+  return p.w > 0.0f && contactBounded(p.w, i == u.grab_index, target.w);
 }
 
 /// True when the settle may move particle i in substep s: free, and its half-spaces all listed.

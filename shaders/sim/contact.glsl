@@ -683,9 +683,11 @@ void contactBound(uint i, uint s) {
 // step less the frame cut to its pairs' half-spaces (the excess's mean taken out, the rest cut to
 // the share), then to its bound, then pushed (slideStep)
 VerletState contactSlideStep(uint i, VerletState st, uint s) {
-  if (!contactBounded(st.position.w, i == u.grab_index, u.grab_target[s].w)) return st;
-  // start and bound in one load: a fleet's lavapipe build reads a component loaded apart from its
-  // vector as the vector's first (SpirvRules.NoSimShaderLoadsAVectorAndOneOfItsComponentsByDeviceAddress)
+  // The grab's target, start and bound each in one load: a fleet's lavapipe build reads a component
+  // loaded apart from its vector as the vector's first
+  // (SpirvRules.NoSimShaderLoadsAVectorAndOneOfItsComponentsByDeviceAddress)
+  vec4 target = u.grab_target[s];
+  if (!contactBounded(st.position.w, i == u.grab_index, target.w)) return st;
   vec4 start = contact_particles[i].start;
   return slideStep(st, vec3(start), vec3(contact_particles[i].push),
                    contactAverage(ivec4(contact_particles[i].sum), u.contact.w),

@@ -1,13 +1,18 @@
 // Build step of the simulation's shaders (shaders/CMakeLists.txt):
 //   tender-spirv-rules IN.spv OUT.spv     NoContraction on every float operation (before spirv-opt,
 //                                         which would otherwise fuse a * b + c into Fma)
-//   tender-spirv-rules --embed IN.spv OUT the words as a C array initialiser
+//   tender-spirv-rules --embed IN.spv OUT the words deflated (zlib), as the initialiser of a C array
+//                                         of words: the SPIR-V's word count, the deflated bytes'
+//                                         count, then those bytes four to a word (little-endian);
+//                                         the embedded shaders' registry inflates them
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <string>
 #include <vector>
+
+#include <zlib.h>
 
 #include "spirv_rules.h"
 
@@ -35,7 +40,17 @@ int main(int argc, char** argv) {
   const std::string tmp_path = std::string(out_path) + ".tmp";
   std::ofstream out(tmp_path, std::ios::binary | std::ios::trunc);
   if (embed) {
-    for (size_t i = 0; i < words.size(); ++i) out << words[i] << (i % 8 == 7 ? ",\n" : ",");
+    uLongf packed_size = compressBound(uLong(bytes.size()));
+    std::vector<uint32_t> packed(2 + (packed_size + 3) / 4, 0u);
+    if (compress2(reinterpret_cast<Bytef*>(packed.data() + 2), &packed_size,
+                  reinterpret_cast<const Bytef*>(bytes.data()), uLong(bytes.size()), Z_BEST_COMPRESSION) != Z_OK) {
+      std::fprintf(stderr, "tender-spirv-rules: error: cannot deflate %s\n", in_path);
+      return 2;
+    }
+    packed[0] = uint32_t(words.size());
+    packed[1] = uint32_t(packed_size);
+    packed.resize(2 + (packed_size + 3) / 4);
+    for (size_t i = 0; i < packed.size(); ++i) out << packed[i] << (i % 8 == 7 ? ",\n" : ",");
     out << "\n";
   } else {
     const std::vector<uint32_t> ruled = tender::gpu::applyFloatRules(words, {false, tender::gpu::Denormals::AsWritten});
