@@ -288,12 +288,11 @@ void GpuBatch::flush() {
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BIND_UNIFORMS].buffer, uint32_t(regions.size()), regions.data());
   VkBufferCopy queue_region{0, 0, 4ull * queue.size()};
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_QUEUE].buffer, 1, &queue_region);
-  const bool sheet_by_sheet = per_sheet_;
   if (plan.contact && per_sheet_)
     addContactPipelines(ctx_, sheet_layout_, float_rules_, math_, std::nullopt, sheet_passes_, owned_pipelines_);
   else if (plan.contact)
     addContactPipelines(ctx_, layout_, float_rules_, math_, std::nullopt, passes_, owned_pipelines_, true);
-  if (!passes.empty() && sheet_by_sheet) {
+  if (!passes.empty() && per_sheet_) {
     // Each sheet's full grids of the hash passes and of contact's grid passes, which its
     // candidates_decide and contact_arm copy to the live ones
     std::vector<VkBufferCopy> grid_regions;
@@ -339,7 +338,7 @@ void GpuBatch::flush() {
       }
     last_dispatches_ += dispatched;
   }
-  if (!passes.empty() && sheet_by_sheet) {
+  if (!passes.empty() && per_sheet_) {
     // Each sheet's per-colour passes, on its own descriptor set, as it records them alone
     const uint32_t n = topo_.particleCount();
     hash_grids_.clear();
