@@ -53,9 +53,9 @@
 // The entries of the grid, after the header: an entry k is live triangle slot k
 // (k < u.triangle_count) or edge k - u.triangle_count
 uint contactEntries() { return SIM_CONTACT_HEADER; }
-uint contactCounts() { return u.contact_grid.y; }
-uint contactFill() { return u.contact_grid.z; }
-uint contactEdgeCount() { return u.contact_grid.w; }
+uint contactCounts() { return contactGrid().y; }
+uint contactFill() { return contactGrid().z; }
+uint contactEdgeCount() { return contactGrid().w; }
 
 // True when triangle id `id` is live (its two edge constraints stand, as the compaction keeps it)
 bool contactTriangleLive(uint id) {
@@ -98,7 +98,7 @@ bool gridBuilt() { return contact_words[CONTACT_GRID] != 0u; }
 // contact diameter, whichever is longer
 float contactInvCell() {
   float longest = simSqrt(uintBitsToFloat(contact_words[CONTACT_LONGEST]));
-  return simDiv(1.0f, SIM_CONTACT_CELL_ROOM * max(longest, 2.0f * u.contact.x));
+  return simDiv(1.0f, SIM_CONTACT_CELL_ROOM * max(longest, 2.0f * contactKeys().x));
 }
 
 // True when grid entry k is a live triangle slot or a live edge
@@ -156,7 +156,7 @@ bool boxesMeet(vec3 lo, vec3 hi, vec3 elo, vec3 ehi) {
 // The bucket of a cell: the triangles' in the first half of the table, the edges' in the second, so
 // that a look-up reads only the kind it looks for
 uint contactBucket(ivec3 cell, bool edge) {
-  return hashCell(cell, u.contact_grid.x) + (edge ? u.contact_grid.x + 1u : 0u);
+  return hashCell(cell, contactGrid().x) + (edge ? contactGrid().x + 1u : 0u);
 }
 
 // The buckets of the cells a box of grid entry k spans, each once (two cells of a box may share a
@@ -200,7 +200,7 @@ bool contactFree(uint i) { return (contact_particles[i].state.y & 1u) != 0u; }
 // thickness pushes them apart (contactPush, in fixed point)
 // Adds a push to particle i's sum in fixed point (contactFixed) and counts it
 void addPush(uint i, vec3 push) {
-  ivec3 f = contactFixed(push, u.contact.w);
+  ivec3 f = contactFixed(push, contactKeys().w);
   // Two's complement: unsigned sums have the bits of the signed ones
   atomicAdd(contact_particles[i].sum.x, uint(f.x));
   atomicAdd(contact_particles[i].sum.y, uint(f.y));
@@ -209,7 +209,7 @@ void addPush(uint i, vec3 push) {
 }
 
 void contactPair(uvec4 q, ContactPair c) {
-  float r = u.contact.x, thickness = u.contact.z;
+  float r = contactKeys().x, thickness = contactKeys().z;
   if (!(c.d2 < r * r)) return;
   lowerNearest(q.x, c.d2);
   lowerNearest(q.y, c.d2);
@@ -226,12 +226,12 @@ void contactPair(uvec4 q, ContactPair c) {
 // A pair of query `list` found by a build: kept when within contactReach (in the first
 // u.contact_check.w of its slots; the count goes on past them)
 void listPair(uint list, float d2, uint other) {
-  float reach = contactReach(u.contact.x);
+  float reach = contactReach(contactKeys().x);
   if (!(d2 < reach * reach)) return;
   uint c = contact_lists[list];
-  if (c < u.contact_check.w)
+  if (c < contactChecks().w)
     contact_lists[list + 1u + c] = other;
-  else if (c == u.contact_check.w)
+  else if (c == contactChecks().w)
     contact_words[CONTACT_OVERFLOW] = 1u;
   contact_lists[list] = c + 1u;
 }
@@ -249,7 +249,7 @@ void visitCrossing(uint t, uint o) {
   for (uint k = 0u; k < 6u; ++k) {
     uint i = k < 3u ? a[k] : b[k - 3u];
     atomicOr(contact_particles[i].state.y, 1u);
-    vec3 push = untanglePush(x[0], x[1], x[2], x[3], x[4], x[5], u.contact.z, k);
+    vec3 push = untanglePush(x[0], x[1], x[2], x[3], x[4], x[5], contactKeys().z, k);
     if (push != vec3(0.0f)) addPush(i, push);
   }
   atomicOr(contact_words[CONTACT_TANGLED], 1u);
@@ -286,9 +286,9 @@ void contactBegin(uint s, bool passes) {
     contact_words[CONTACT_TRAVEL_LO + c] = 0xFFFFFFFFu;
   }
   contact_words[CONTACT_LOWEST] = 0x7F800000u;
-  bool audit = s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u;
+  bool audit = s == 0u && (contactChecks().x & SIM_CONTACT_CHECK_ALL) != 0u;
   bool stand = contact_lists[listHeader() + LIST_KEY] == counters.triangle_count + 1u &&
-               contact_lists[listHeader() + LIST_RADIUS] == floatBitsToUint(u.contact.x) && !audit;
+               contact_lists[listHeader() + LIST_RADIUS] == floatBitsToUint(contactKeys().x) && !audit;
   // The passes walk the queries contact_emit named: lists the fused tick built are built again
   if (passes) stand = stand && contact_lists[listHeader() + LIST_NAMED] == contact_lists[listHeader() + LIST_BUILDS];
   if (!stand) contact_words[CONTACT_REBUILD] = 1u;
@@ -304,7 +304,7 @@ vec3 gatheredCorner(uint w0) {
 // One invocation after contact_clear: the lists (and the grid) are built in this substep when the
 // particles' travel since the last build outgrew them (listsOutgrown)
 void contactTravelled() {
-  if (listsOutgrown(gatheredCorner(CONTACT_TRAVEL_LO), gatheredCorner(CONTACT_TRAVEL_HI), u.contact.x)) {
+  if (listsOutgrown(gatheredCorner(CONTACT_TRAVEL_LO), gatheredCorner(CONTACT_TRAVEL_HI), contactKeys().x)) {
     contact_words[CONTACT_REBUILD] = 1u;
     contact_words[CONTACT_GRID] = 1u;
   }
@@ -320,14 +320,14 @@ vec3 contactFrameNow() {
 // Elements contact_clear covers: the particles, the edges
 uint contactSlots() { return max(u.particle_count, contactEdgeCount()); }
 // Elements contact_grid_clear covers: the buckets and their end
-uint contactBucketSlots() { return 2u * (u.contact_grid.x + 1u) + 1u; }
+uint contactBucketSlots() { return 2u * (contactGrid().x + 1u) + 1u; }
 
 // contact_clear: particle k's start of the substep, its travel since the lists were built into the
 // box contactTravelled looks at, and its last step and height above the floor into the frame's
 // inputs; edge k's squared length raises the longest
 void contactClear(uint k) {
   if (k < u.particle_count) {
-    float r = u.contact.x;
+    float r = contactKeys().x;
     vec4 x = SIM_POSITION(k);
     vec3 step = vec3(x) - vec3(prev[k]);
     for (uint c = 0u; c < 3u; ++c) {
@@ -391,7 +391,7 @@ void contactArm() {
 // contact_grid_clear: bucket k cleared when the grid is built (dispatched only then: contact_arm)
 void contactGridClear(uint k) {
   if (!gridBuilt()) return;
-  uint buckets = 2u * (u.contact_grid.x + 1u); // the triangles' and the edges'
+  uint buckets = 2u * (contactGrid().x + 1u); // the triangles' and the edges'
   if (k <= buckets) scratch[contactCounts() + k] = 0u;
   if (k < buckets) scratch[contactFill() + k] = 0u;
 }
@@ -405,7 +405,7 @@ void contactCross(uint t, uint s) {
   if (!gridBuilt()) return;
   uvec4 tri = triangles[t];
   uint was = contact_particles[tri.x].state.y | contact_particles[tri.y].state.y | contact_particles[tri.z].state.y;
-  bool all = s == 0u && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u;
+  bool all = s == 0u && (contactChecks().x & SIM_CONTACT_CHECK_ALL) != 0u;
   if (!crossingChecked(all, (was & 2u) != 0u)) return;
   loadBox(t, lo, hi);
   float inv = contactInvCell();
@@ -447,8 +447,8 @@ vec4 nearPosition(uint j, uint only) { return only >= NEAR_EXCESS ? contact_part
 // u.contact_check.z: particle i's count, then (their exclusive scan) where its list starts
 // (particles + 1 words), then its fill (particles words); the lists themselves (SlideHalf: five
 // words each, SIM_CONTACT_HALF_CAPACITY a particle) after the queries' pair lists
-uint halfStarts() { return u.contact_check.z; }
-uint halfFills() { return u.contact_check.z + u.particle_count + 1u; }
+uint halfStarts() { return contactChecks().z; }
+uint halfFills() { return contactChecks().z + u.particle_count + 1u; }
 uint halfEntries() { return listOf(u.particle_count + contactEdgeCount()); }
 uint halfFirst(uint i) { return scratch[halfStarts() + i]; }
 uint halfEnd(uint i) { return scratch[halfStarts() + i + 1u]; }
@@ -483,7 +483,7 @@ void listHalf(uint i, SlideHalf h, uint only) {
 void slidePair(uvec4 q, vec3 x0, vec3 x1, vec3 x2, vec3 x3, ContactPair c, bool edge, uint only) {
   vec3 frame = contactFrameNow();
   for (uint j = 0u; j < 4u; ++j) {
-    SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, u.contact.x, u.contact.y, j);
+    SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, contactKeys().x, contactKeys().y, j);
     if (h.h.w < 0.0f) continue;
     uint i = j == 0u ? q.x : (j == 1u ? q.y : (j == 2u ? q.z : q.w));
     if (only >= NEAR_HALF_COUNT) {
@@ -495,7 +495,7 @@ void slidePair(uvec4 q, vec3 x0, vec3 x1, vec3 x2, vec3 x3, ContactPair c, bool 
       vec3 e = slideExcess(h, step);
       if (e != vec3(0.0f)) addPush(i, e);
     } else {
-      float share = slideShare(h, step + contactAverage(ivec4(contact_particles[i].sum), u.contact.w));
+      float share = slideShare(h, step + contactAverage(ivec4(contact_particles[i].sum), contactKeys().w));
       if (share < 1.0f) atomicMin(contact_particles[i].state.z, floatBitsToUint(share));
     }
   }
@@ -516,7 +516,7 @@ void contactNearOf(uint k, uint only, bool particle) {
   bool build = only < NEAR_WALK && listsRebuilt();
   uint count = build ? 0u : contact_lists[list];
   // Through its list (which holds only live primitives: a tear builds the lists again)
-  bool walk = only == NEAR_WALK || (!build && count <= u.contact_check.w);
+  bool walk = only == NEAR_WALK || (!build && count <= contactChecks().w);
   if (walk && count == 0u) return;
   if (only == NEAR_SEARCH && walk) return;
   if (particle && !build && contactFree(k)) return;
@@ -543,7 +543,7 @@ void contactNearOf(uint k, uint only, bool particle) {
       contact_lists[w + 2u] = floatBitsToUint(lo.z);
     }
   }
-  float reach = build ? 1.01f * contactReach(u.contact.x) : 1.01f * u.contact.x;
+  float reach = build ? 1.01f * contactReach(contactKeys().x) : 1.01f * contactKeys().x;
   lo -= vec3(reach);
   hi += vec3(reach);
   float inv = contactInvCell();
@@ -620,7 +620,7 @@ uint activeWord() { return contactBoxWord(u.triangle_count + contactEdgeCount())
 // True when query k has pairs in its list, all in its slots (contact_walk walks it until the next build)
 bool contactActive(uint k) {
   uint count = contact_lists[listOf(k)];
-  return count > 0u && count <= u.contact_check.w;
+  return count > 0u && count <= contactChecks().w;
 }
 
 // contact_active: query k's flag, 1 when it walks its list (the end, k = queries: 0), at scratch
@@ -652,7 +652,7 @@ void contactWalk(uint j) {
 // contact_bound: particle i's step bound (stepBound; unbounded when free) and push
 // (contactAverage); the particles in contact counted; the substep's frame (contactFrame)
 void contactBound(uint i, uint s) {
-  float r = u.contact.x;
+  float r = contactKeys().x;
   if (i == 0u && listsRebuilt()) {
     // The lists stand for these triangles and this radius (none when the positions went wrong)
     contact_lists[listHeader() + LIST_KEY] = contactGoneWrong() ? 0u : counters.triangle_count + 1u;
@@ -673,10 +673,10 @@ void contactBound(uint i, uint s) {
   uint nearest = contactGoneWrong() ? 0u : contact_particles[i].state.x;
   if (nearest < floatBitsToUint(r * r)) atomicAdd(contact_words[CONTACT_COUNT], 1u);
   contact_particles[i].start.w =
-      contactFree(i) ? uintBitsToFloat(0x7F800000u) : slideBound(uintBitsToFloat(nearest), r, u.contact.y);
-  contact_particles[i].push =
-      vec4(contactPushWithin(contactAverage(ivec4(contact_particles[i].sum), u.contact.w), uintBitsToFloat(nearest), r),
-           0.0f);
+      contactFree(i) ? uintBitsToFloat(0x7F800000u) : slideBound(uintBitsToFloat(nearest), r, contactKeys().y);
+  contact_particles[i].push = vec4(
+      contactPushWithin(contactAverage(ivec4(contact_particles[i].sum), contactKeys().w), uintBitsToFloat(nearest), r),
+      0.0f);
 }
 
 // The floor's step with contact (after floor.comp, contact_excess and contact_share): particle i's
@@ -690,7 +690,7 @@ VerletState contactSlideStep(uint i, VerletState st, uint s) {
   if (!contactBounded(st.position.w, i == u.grab_index, target.w)) return st;
   vec4 start = contact_particles[i].start;
   return slideStep(st, vec3(start), vec3(contact_particles[i].push),
-                   contactAverage(ivec4(contact_particles[i].sum), u.contact.w),
+                   contactAverage(ivec4(contact_particles[i].sum), contactKeys().w),
                    uintBitsToFloat(contact_particles[i].state.z), start.w, contactFrameNow());
 }
 
@@ -699,7 +699,7 @@ VerletState contactSlideStep(uint i, VerletState st, uint s) {
 void contactSlideClear(uint i) {
   contact_particles[i].sum = uvec4(0u);
   contact_particles[i].state.z = floatBitsToUint(1.0f);
-  if (u.contact_check.y == 0u) return;
+  if (contactChecks().y == 0u) return;
   scratch[halfStarts() + i] = 0u;
   scratch[halfFills() + i] = 0u;
   if (i == 0u) scratch[halfStarts() + u.particle_count] = 0u;
@@ -719,7 +719,7 @@ vec3 settleFrame() { return contactFrameNow(); }
 // contact_settle_check: constraint slot k over the limit in substep s (settleOver; a torn one past
 // its colour's live count may say so too: that only runs a stage that moves nothing)
 void contactSettleCheck(uint k, uint s) {
-  if (u.contact_check.y > 0u && settleOver(constraints[k], s)) atomicOr(contact_words[CONTACT_SETTLE_OVER], 1u);
+  if (contactChecks().y > 0u && settleOver(constraints[k], s)) atomicOr(contact_words[CONTACT_SETTLE_OVER], 1u);
 }
 // True when an edge is over the limit as the stage starts: else it lists nothing and moves nothing
 bool settleStarts() { return contact_words[CONTACT_SETTLE_OVER] != 0u; }

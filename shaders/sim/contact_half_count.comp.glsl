@@ -9,5 +9,5 @@
 
 void main() {
   uint k = threadIndex();
-  if (k < p.count && u.contact_check.y > 0u && settleStarts()) contactNear(k, NEAR_HALF_COUNT);
+  if (k < p.count && contactChecks().y > 0u && settleStarts()) contactNear(k, NEAR_HALF_COUNT);
 }

@@ -10,5 +10,5 @@
 
 void main() {
   uint k = threadIndex();
-  if (k < p.count && u.contact_check.y > 0u && settleStarts()) contactNear(k, NEAR_HALF_FILL);
+  if (k < p.count && contactChecks().y > 0u && settleStarts()) contactNear(k, NEAR_HALF_FILL);
 }

@@ -9,7 +9,7 @@
 #include "sim_common.glsl"
 
 void main() {
-  if (p.first >= u.contact_check.y || !settleSweeps(p.first)) return; // the same branch for every invocation
+  if (p.first >= contactChecks().y || !settleSweeps(p.first)) return; // the same branch for every invocation
   uint t = threadIndex();
   uvec2 range = color_range[p.color];
   if (t >= range.y) return; // beyond the live count of this colour

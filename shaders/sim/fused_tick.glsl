@@ -108,7 +108,7 @@ void contactSettleSubstep(uint s) {
   scanWorkgroup(SIM_SCAN_SCRATCH, halfStarts(), u.particle_count + 1u, compactSlots());
   for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_HALF_FILL);
   sync();
-  for (uint sweep = 0u; sweep < u.contact_check.y; ++sweep) {
+  for (uint sweep = 0u; sweep < contactChecks().y; ++sweep) {
     for (uint c = 0u; c < u.color_count; ++c) {
       uvec2 range = color_range[c];
       if (range.y == 0u || !shortensColour(constraints[range.x].kind_id)) continue;
@@ -135,7 +135,7 @@ void contactSubstep(uint s, uint n) {
   sync();
   for (uint k = lid; k < boxes; k += kInvocations) contactInsert(k, false);
   sync();
-  scanWorkgroup(SIM_SCAN_SCRATCH, contactCounts(), 2u * (u.contact_grid.x + 1u) + 1u, compactSlots());
+  scanWorkgroup(SIM_SCAN_SCRATCH, contactCounts(), 2u * (contactGrid().x + 1u) + 1u, compactSlots());
   for (uint k = lid; k < boxes; k += kInvocations) contactInsert(k, true);
   sync();
   for (uint t = lid; t < u.triangle_count; t += kInvocations) contactCross(t, s);
@@ -193,7 +193,7 @@ void main() {
     // 1. Contact's bounds (with contact on), the air (as air.comp), then Verlet integration (as
     // integrate.comp)
 #ifdef SIM_FUSED_CONTACT
-    if (u.contact.x > 0.0f && (u.flags & SIM_FLAG_CONTACT_PASSES) == 0u) contactSubstep(s, n);
+    if (contactKeys().x > 0.0f && (u.flags & SIM_FLAG_CONTACT_PASSES) == 0u) contactSubstep(s, n);
 #endif
     if ((u.flags & SIM_FLAG_AIR) != 0u) {
       sync(); // the air reads the positions of other invocations' particles (loaded or moved)
@@ -323,7 +323,7 @@ void main() {
     for (uint i = lid; i < n; i += kInvocations) {
       VerletState st = floorContact(s_pos[i], prev[i], u.floor_y, u.restitution, u.friction);
 #ifdef SIM_FUSED_CONTACT
-      if (u.contact.x > 0.0f) contactSlideClear(i);
+      if (contactKeys().x > 0.0f) contactSlideClear(i);
 #endif
       s_pos[i] = st.position;
       prev[i] = st.previous;
@@ -332,7 +332,7 @@ void main() {
 #ifdef SIM_FUSED_CONTACT
     // With contact, the steps cut to their pairs' half-spaces and their bounds (as contact_excess,
     // contact_share and contact_step)
-    if (u.contact.x > 0.0f) contactSlideSubstep(s, n);
+    if (contactKeys().x > 0.0f) contactSlideSubstep(s, n);
 #endif
     if (stopsAfter(first_pass + floor_pass)) {
       storePositions(n);
@@ -340,7 +340,7 @@ void main() {
     }
 #ifdef SIM_FUSED_CONTACT
     // 8. The settle stage, with contact and its sweeps on
-    if (u.contact.x > 0.0f && u.contact_check.y > 0u) contactSettleSubstep(s);
+    if (contactKeys().x > 0.0f && contactChecks().y > 0u) contactSettleSubstep(s);
 #endif
     if (stopsAfter(first_pass + settle_pass)) {
       storePositions(n);

@@ -202,6 +202,12 @@ layout(std430, set = 0, binding = SIM_BIND_CONTACT_GRID) SIM_COHERENT buffer Con
 
 #endif
 
+// The contact's keys (SimUniforms::contact), checks and grid, each read whole: a fleet's lavapipe
+// build (device addresses, Mesa 22.3) misreads components of these vectors loaded apart
+vec4 contactKeys() { return u.contact; }
+uvec4 contactChecks() { return u.contact_check; }
+uvec4 contactGrid() { return u.contact_grid; }
+
 // Linear index of this invocation; grids wider than SIM_MAX_GROUPS_X spill into Y.
 uint threadIndex() {
   return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
@@ -270,15 +276,15 @@ bool batchGateTakes() {
   // Contact's passes: those a sheet alone records, and of its indirect ones those its own
   // arguments give workgroups (contact_arm set them; they stand through the substep)
   case SIM_GATE_CONTACT:
-    return u.contact.x > 0.0f;
+    return contactKeys().x > 0.0f;
   case SIM_GATE_CONTACT_GRID:
-    return u.contact.x > 0.0f && contact_words[SIM_CONTACT_WORD_GRID] != 0u;
+    return contactKeys().x > 0.0f && contact_words[SIM_CONTACT_WORD_GRID] != 0u;
   case SIM_GATE_CONTACT_WALK:
-    return u.contact.x > 0.0f && hash_args[SIM_CONTACT_WALK_ARGS].x != 0u;
+    return contactKeys().x > 0.0f && hash_args[SIM_CONTACT_WALK_ARGS].x != 0u;
   case SIM_GATE_CONTACT_CROSS:
-    return u.contact.x > 0.0f && hash_args[SIM_CONTACT_CROSS_ARGS].x != 0u;
+    return contactKeys().x > 0.0f && hash_args[SIM_CONTACT_CROSS_ARGS].x != 0u;
   case SIM_GATE_SETTLE:
-    return u.contact.x > 0.0f && batch.gate_arg < u.contact_check.y;
+    return contactKeys().x > 0.0f && batch.gate_arg < contactChecks().y;
   default:
     return true;
   }

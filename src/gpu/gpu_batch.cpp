@@ -90,6 +90,8 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
   const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   const FusedShape shape = resolveFusedShape(ctx_, fused, true);
   substeps_per_dispatch_ = shape.substeps_per_dispatch;
+  fused_workgroup_ = shape.workgroup;
+  fused_contact_ = shape.contact > 0;
   fused_max_cell_spacings_ = shape.max_cell_spacings;
   sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
   per_sheet_ = passes == BatchPasses::PerSheet || (passes == BatchPasses::Auto && cpu_device);
@@ -219,7 +221,7 @@ void GpuBatch::flush() {
   // The queued sheets, their uniforms into the host buffer (the last flush has finished reading it).
   // Each takes the path it takes alone: the fused tick or the per-colour passes.
   finish();
-  std::vector<uint32_t> fused, passes;
+  std::vector<uint32_t> fused, fused_contact, passes;
   std::vector<SimUniforms> pass_uniforms;
   uint32_t fused_substeps = 0, pass_substeps = 0;
   SubstepPlan plan;
@@ -247,10 +249,12 @@ void GpuBatch::flush() {
     if (keepsCandidateLists(sizes_, candidates_allowed_)) u.flags |= SIM_FLAG_CANDIDATES; // as the solver does
     std::memcpy(inputs + uniforms_at + stride_[SIM_BIND_UNIFORMS] * i, &u, sizeof(u));
     const uint32_t substeps = u.reset_active ? 0u : substepCount(u.substeps);
-    // A sheet with contact runs the per-colour passes (the fleet's fused tick has no contact yet)
-    if (fits_fused && u.contact.x <= 0.0f && fusedTickTakes(u, spacing_, fused_max_cell_spacings_)) {
+    // A sheet with contact takes the fused tick with contact's bodies where the device's shape runs
+    // them in the workgroup (FusedShape::contact), the per-colour passes elsewhere
+    const bool contact = u.contact.x > 0.0f;
+    if (fits_fused && (!contact || fused_contact_) && fusedTickTakes(u, spacing_, fused_max_cell_spacings_)) {
       fused_substeps = std::max(fused_substeps, std::max(substeps, 1u));
-      fused.push_back(i);
+      (contact ? fused_contact : fused).push_back(i);
       continue;
     }
     passes.push_back(i);
@@ -267,11 +271,15 @@ void GpuBatch::flush() {
     plan.shorten = plan.shorten || limitShortens(u.limit.x, u.grab_index, u.flags);
     if (u.contact.x > 0.0f) plan.sweeps = std::max(plan.sweeps, u.contact_check.y);
   }
-  if (fused.empty() && passes.empty()) return;
+  if (fused.empty() && fused_contact.empty() && passes.empty()) return;
   last_dispatches_ = 0;
-  // The queue: the fused sheets, then the others
+  // The queue: the fused sheets without contact, those with, then the others
   std::vector<uint32_t> queue = fused;
+  queue.insert(queue.end(), fused_contact.begin(), fused_contact.end());
   queue.insert(queue.end(), passes.begin(), passes.end());
+  if (!fused_contact.empty() && !tick_batch_contact_.pipeline)
+    tick_batch_contact_ = makeComputePipeline(ctx_, "tick_batch_contact.comp", layout_, float_rules_, math_,
+                                              sizeof(BatchPush), 1, fused_workgroup_, true, owned_pipelines_);
   std::memcpy(inputs, queue.data(), 4 * queue.size());
   const VkDeviceSize args_at = uniforms_at + stride_[SIM_BIND_UNIFORMS] * size();
 
@@ -317,27 +325,29 @@ void GpuBatch::flush() {
                     VK_ACCESS_2_UNIFORM_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   bound_ = VK_NULL_HANDLE;
   const VkDeviceAddress table = table_address_;
-  if (!fused.empty()) {
-    // On a GPU one dispatch runs every fused sheet's whole tick. A CPU device runs a substep per
-    // dispatch (SIM_FUSED_SUBSTEPS_CPU): it takes the sheets a few at a time, each few through every
-    // substep, so that their arrays stay in the cache from one substep to the next.
-    vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, tick_batch_.pipeline);
-    bound_ = tick_batch_.pipeline;
-    const uint32_t count = uint32_t(fused.size());
+  // On a GPU one dispatch runs every fused sheet's whole tick (one more for the sheets with
+  // contact). A CPU device runs a substep per dispatch (SIM_FUSED_SUBSTEPS_CPU): it takes the sheets
+  // a few at a time, each few through every substep, so that their arrays stay in the cache from one
+  // substep to the next.
+  auto fusedTicks = [&](const ComputePipeline& pipe, uint32_t queue_first, uint32_t count) {
+    if (count == 0) return;
+    vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
+    bound_ = pipe.pipeline;
     const uint32_t per_group = substeps_per_dispatch_ >= fused_substeps ? count : sheets_per_group_;
-    uint32_t dispatched = 0;
     for (uint32_t first_sheet = 0; first_sheet < count; first_sheet += per_group)
       for (uint32_t first = 0; first < fused_substeps; first += substeps_per_dispatch_) {
-        if (dispatched++ > 0) computeToCompute(cmd_);
+        if (first > 0) computeToCompute(cmd_);
         BatchPush push{};
         push.fused = {topo_.particleCount(), first, substeps_per_dispatch_, SIM_NONE};
         push.batch.table = glm::uvec2(uint32_t(table), uint32_t(table >> 32));
-        push.batch.first = first_sheet;
+        push.batch.first = queue_first + first_sheet;
         vkCmdPushConstants(cmd_, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
         vkCmdDispatch(cmd_, std::min(per_group, count - first_sheet), 1, 1);
+        ++last_dispatches_;
       }
-    last_dispatches_ += dispatched;
-  }
+  };
+  fusedTicks(tick_batch_, 0, uint32_t(fused.size()));
+  fusedTicks(tick_batch_contact_, uint32_t(fused.size()), uint32_t(fused_contact.size()));
   if (!passes.empty() && per_sheet_) {
     // Each sheet's per-colour passes, on its own descriptor set, as it records them alone
     const uint32_t n = topo_.particleCount();
@@ -374,7 +384,7 @@ void GpuBatch::flush() {
   } else if (!passes.empty()) {
     // The per-colour passes of the most substeps and iterations, each for every sheet; a sheet
     // runs those it runs alone (the gates). They touch other sheets' slices than the fused tick.
-    pass_first_ = uint32_t(fused.size());
+    pass_first_ = uint32_t(fused.size() + fused_contact.size());
     pass_sheets_ = uint32_t(passes.size());
     const uint32_t n = topo_.particleCount();
     if (resets) {

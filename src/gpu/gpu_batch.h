@@ -90,10 +90,13 @@ private:
 
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   PipelineSet owned_pipelines_;
-  ComputePipeline tick_batch_;     ///< the fused tick of a batch (null: the device has too little shared memory)
-  SimPipelines passes_;            ///< the per-colour passes of a batch (SIM_BATCH_PASS)
-  bool per_sheet_ = false;         ///< BatchPasses::PerSheet
-  bool candidates_allowed_ = true; ///< setCandidateLists
+  ComputePipeline tick_batch_;         ///< the fused tick of a batch (null: the device has too little shared memory)
+  ComputePipeline tick_batch_contact_; ///< ... with contact's bodies (made when a sheet first takes it)
+  uint32_t fused_workgroup_ = 0;       ///< the fused tick's workgroup (FusedShape)
+  bool fused_contact_ = false;         ///< sheets with contact take the fused tick (FusedShape::contact)
+  SimPipelines passes_;                ///< the per-colour passes of a batch (SIM_BATCH_PASS)
+  bool per_sheet_ = false;             ///< BatchPasses::PerSheet
+  bool candidates_allowed_ = true;     ///< setCandidateLists
   VkDescriptorSetLayout sheet_set_layout_ = VK_NULL_HANDLE; ///< PerSheet: a sheet's set, as the solver's
   VkPipelineLayout sheet_layout_ = VK_NULL_HANDLE;
   VkDescriptorPool sheet_pool_ = VK_NULL_HANDLE;

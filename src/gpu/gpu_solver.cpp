@@ -292,7 +292,9 @@ FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested, boo
   shape.max_cell_spacings = requested.max_cell_spacings != 0.0f ? requested.max_cell_spacings
                             : cpu_device                        ? SIM_FUSED_CPU_MAX_CELL_SPACINGS
                                                                 : -1.0f;
-  shape.contact = requested.contact ? requested.contact : cpu_device ? -1 : 1;
+  // A fleet's sheets run their workgroups side by side on a CPU device's threads: contact in each
+  // sheet's workgroup; a sheet alone leaves a CPU device's other threads to contact's passes
+  shape.contact = requested.contact ? requested.contact : cpu_device && !fleet ? -1 : 1;
   return shape;
 }
 

@@ -27,10 +27,11 @@ struct FusedShape {
   float max_cell_spacings = 0.0f;     ///< largest hash cell (in grid spacings) with collision on; < 0: any
   /// With contact on: 1, the fused tick's workgroup runs contact's bodies too; -1, the contact
   /// passes run before each substep of the fused tick (one substep a dispatch), which leaves them
-  /// out (SIM_FLAG_CONTACT_PASSES); 0: the device's kind decides. A CPU device takes the passes:
-  /// it runs the one workgroup on one thread, the passes on all (lavapipe, 2 threads, the crumple
-  /// sheet at 32 x 48 falling: 32.4 ms a tick, against 37.5 on the per-colour passes alone and
-  /// 44-48 with contact in the workgroup).
+  /// out (SIM_FLAG_CONTACT_PASSES); 0: the device's kind decides. A CPU device takes the passes
+  /// for a sheet alone: it runs the one workgroup on one thread, the passes on all (lavapipe, 2
+  /// threads, the crumple sheet at 32 x 48 falling: 32.4 ms a tick, against 37.5 on the per-colour
+  /// passes alone and 44-48 with contact in the workgroup); a fleet's sheets fill its threads with
+  /// their workgroups, so a fleet takes contact in the workgroup on every device.
   int contact = 0;
 };
 

@@ -89,9 +89,23 @@ std::vector<FleetSheet> withContact(std::vector<FleetSheet> sheets) {
 }
 
 TEST_F(GpuBatchTest, ContactSheetsMatchTheirRunsAloneAndTheCpu) {
-  // The fused tick's contact, each sheet as alone on the GPU solver and on the CPU reference
+  // Sheets 1 and 3 with contact. With contact's bodies in the fleet's fused tick (a GPU's shape;
+  // asked for here on any device): one dispatch of tick_batch for the sheets without contact, one
+  // of tick_batch_contact for those with (a CPU device: one each a substep and group of sheets).
+  // Each sheet as alone on the GPU solver (its contact in its own fused tick, or on a CPU device
+  // in passes before it) and, with the device's own shape, on the CPU reference.
   const std::vector<FleetSheet> sheets = withContact(mixedFleet(4));
-  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()));
+  gpu::FusedShape contact_in_workgroup;
+  contact_in_workgroup.contact = 1;
+  {
+    gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), gpu::BatchPasses::Auto, contact_in_workgroup);
+    Fleet fleet(batch, sheets);
+    fleet.tick();
+    const bool cpu_device = ctx().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    const uint32_t group = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
+    EXPECT_EQ(batch.dispatchesPerFlush(), cpu_device ? 2 * ((2 + group - 1) / group) * 8 : 2u);
+  }
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), gpu::BatchPasses::Auto, contact_in_workgroup);
   gpu::GpuSolver alone(ctx());
   expectFleetMatchesAlone(batch, alone, sheets, 20);
   gpu::GpuBatch again(ctx(), uint32_t(sheets.size()));
@@ -200,7 +214,9 @@ TEST_F(GpuBatchTest, BatchedContactSheetsRecordTheDispatchesOfOneSheet) {
     sheets.push_back({p, script(("0 grab particle " + std::to_string(383 - 5 * i) + "\n1 move " +
                                  std::to_string(1 + i) + " -2 3\n5 release\n")
                                     .c_str())});
-  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), gpu::BatchPasses::Batched);
+  gpu::FusedShape passes; // contact in passes, not in the fleet's fused tick
+  passes.contact = -1;
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), gpu::BatchPasses::Batched, passes);
   gpu::GpuSolver alone(ctx());
   alone.setFusedPath(false);
   {
@@ -213,7 +229,7 @@ TEST_F(GpuBatchTest, BatchedContactSheetsRecordTheDispatchesOfOneSheet) {
     EXPECT_GT(alone.dispatchesPerTick(), 100u);
     EXPECT_EQ(batch.dispatchesPerFlush(), alone.dispatchesPerTick());
   }
-  gpu::GpuBatch again(ctx(), uint32_t(sheets.size()), gpu::BatchPasses::Batched);
+  gpu::GpuBatch again(ctx(), uint32_t(sheets.size()), gpu::BatchPasses::Batched, passes);
   expectFleetMatchesAlone(again, alone, sheets, 8);
 }
 
