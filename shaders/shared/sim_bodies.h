@@ -19,7 +19,8 @@
 SIM_INLINE void projectHinge(uint k) {
   uvec4 q = gridHinge(k, u.cols, u.rows);
   vec4 pu = SIM_POSITION(q.x), pv = SIM_POSITION(q.y), pa = SIM_POSITION(q.z), pb = SIM_POSITION(q.w);
-  float alpha = hingeIsDiagonal(k, u.cols, u.rows) ? 0.5f * u.crease.x : u.crease.x;
+  vec4 crease = u.crease; // uniform vectors whole (SpirvRules: a fleet's kernels read them by address)
+  float alpha = hingeIsDiagonal(k, u.cols, u.rows) ? 0.5f * crease.x : crease.x;
   HingeDelta d = solveHinge(pu, pv, pa, pb, hinges[k].x, alpha, 0.0f);
   SIM_POSITION(q.x) = pu + vec4(d.du, 0.0f);
   SIM_POSITION(q.y) = pv + vec4(d.dv, 0.0f);
@@ -33,7 +34,8 @@ SIM_INLINE void projectHinge(uint k) {
 SIM_INLINE void projectConstraint(Constraint c, uint iteration) {
   if (!projectsInIteration(c.kind_id, iteration)) return;
   if ((c.kind_id & SIM_KIND_MASK) == SIM_KIND_HINGE) {
-    projectHinge((c.kind_id >> SIM_KIND_BITS) - u.hinge.x);
+    uvec4 hinge = u.hinge;
+    projectHinge((c.kind_id >> SIM_KIND_BITS) - hinge.x);
     return;
   }
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b); // a != b: each end is read once
@@ -45,11 +47,13 @@ SIM_INLINE void projectConstraint(Constraint c, uint iteration) {
 /// The crease of hinge k after the substep's projection (creaseReturn), unless it is torn or
 /// degenerate.
 SIM_INLINE void creaseHinge(uint k) {
-  if (torn[u.hinge.x + k] != 0u) return;
+  uvec4 hinge = u.hinge;
+  if (torn[hinge.x + k] != 0u) return;
   uvec4 q = gridHinge(k, u.cols, u.rows);
   HingeAngle h = hingeAngle(vec3(SIM_POSITION(q.x)), vec3(SIM_POSITION(q.y)), vec3(SIM_POSITION(q.z)),
                             vec3(SIM_POSITION(q.w)), false);
-  if (h.valid) hinges[k] = creaseReturn(hinges[k], h.angle, u.crease.y, u.crease.z);
+  vec4 crease = u.crease;
+  if (h.valid) hinges[k] = creaseReturn(hinges[k], h.angle, crease.y, crease.z);
 }
 
 /// True when triangle t (original id) has lost an edge.
@@ -154,7 +158,8 @@ SIM_INLINE void markUnsupported(Constraint c) {
     uint mid = (c.a + c.b) / 2u; // a bend spans two structural edges of a row or a column
     cut = edgeCut(c.a, mid) || edgeCut(mid, c.b);
   } else {
-    uvec2 t = kind == SIM_KIND_HINGE ? hingeTriangles(id - u.hinge.x, u.cols, u.rows)
+    uvec4 hinge = u.hinge;
+    uvec2 t = kind == SIM_KIND_HINGE ? hingeTriangles(id - hinge.x, u.cols, u.rows)
                                      : supportTriangles(c.a, c.b, kind, u.cols);
     cut = unsupported(c.a, c.b, kind, u.cols, triangleGone(t.x), triangleGone(t.y));
   }

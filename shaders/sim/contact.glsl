@@ -59,7 +59,9 @@ uint contactEdgeCount() { return contactGrid().w; }
 
 // True when triangle id `id` is live (its two edge constraints stand, as the compaction keeps it)
 bool contactTriangleLive(uint id) {
-  return id != SIM_NONE && torn[tri_edges[id].x] == 0u && torn[tri_edges[id].y] == 0u;
+  if (id == SIM_NONE) return false;
+  uvec2 e = tri_edges[id];
+  return torn[e.x] == 0u && torn[e.y] == 0u;
 }
 
 // Edge e of SIM_BIND_CONTACT_LISTS: its particles, the triangles that hold it
@@ -194,7 +196,8 @@ void contactInsert(uint k, bool scatter) {
 
 // The particle's step bound and nearest distance (ContactParticle.state)
 void lowerNearest(uint i, float d2) { atomicMin(contact_particles[i].state.x, floatBitsToUint(d2)); }
-bool contactFree(uint i) { return (contact_particles[i].state.y & 1u) != 0u; }
+bool contactFreeState(uvec4 state) { return (state.y & 1u) != 0u; }
+bool contactFree(uint i) { return contactFreeState(contact_particles[i].state); }
 
 // A pair closer than the contact radius lowers its four particles' bounds; one closer than the
 // thickness pushes them apart (contactPush, in fixed point)
@@ -646,7 +649,7 @@ void contactEmit(uint k, uint flags) {
 
 // contact_walk: the j-th query that walks its list
 void contactWalk(uint j) {
-  if (j < hash_args[SIM_CONTACT_WALK_ARGS].w) contactNear(contact_words[activeWord() + j], NEAR_WALK);
+  if (j < walkArgs().w) contactNear(contact_words[activeWord() + j], NEAR_WALK);
 }
 
 // contact_bound: particle i's step bound (stepBound; unbounded when free) and push
@@ -670,10 +673,11 @@ void contactBound(uint i, uint s) {
     contact_words[CONTACT_FRAME + 1u] = floatBitsToUint(t.y);
     contact_words[CONTACT_FRAME + 2u] = floatBitsToUint(t.z);
   }
-  uint nearest = contactGoneWrong() ? 0u : contact_particles[i].state.x;
+  uvec4 state = contact_particles[i].state;
+  uint nearest = contactGoneWrong() ? 0u : state.x;
   if (nearest < floatBitsToUint(r * r)) atomicAdd(contact_words[CONTACT_COUNT], 1u);
   contact_particles[i].start.w =
-      contactFree(i) ? uintBitsToFloat(0x7F800000u) : slideBound(uintBitsToFloat(nearest), r, contactKeys().y);
+      contactFreeState(state) ? uintBitsToFloat(0x7F800000u) : slideBound(uintBitsToFloat(nearest), r, contactKeys().y);
   contact_particles[i].push = vec4(
       contactPushWithin(contactAverage(ivec4(contact_particles[i].sum), contactKeys().w), uintBitsToFloat(nearest), r),
       0.0f);

@@ -234,7 +234,8 @@ void main() {
         if (far) atomicOr(counters.candidate_flags.x, 1u);
         sync();
       }
-      mode = collideModeOf(state, counters.candidate_flags.x != 0u);
+      uvec4 flags = counters.candidate_flags; // whole: no invocation sets one until the next sync
+      mode = collideModeOf(state, flags.x != 0u);
       if (mode != SIM_COLLIDE_CANDIDATES) {
         for (uint i = lid; i < n; i += kInvocations) hashCount(i, vec3(s_pos[i]));
         sync();
@@ -261,7 +262,10 @@ void main() {
         s_pos[i] = repelParticle(q, repel, u.flags);
       }
       sync();
-      if (lid == 0u) counters.candidate_state = candidatesNextStateOf(state, mode, counters.candidate_flags.y != 0u);
+      if (lid == 0u) {
+        uvec4 flags = counters.candidate_flags;
+        counters.candidate_state = candidatesNextStateOf(state, mode, flags.y != 0u);
+      }
       if (stopsAfter(first_pass + collide_pass)) {
         storePositions(n);
         return;
@@ -311,8 +315,8 @@ void main() {
       return;
     }
     // 6. The creases (as crease.comp)
-    if (creasing(u.hinge.y, u.crease.y)) {
-      for (uint k = lid; k < u.hinge.y; k += kInvocations) creaseHinge(k);
+    if (creasingNow()) {
+      for (uint k = lid; k < hingeKeys().y; k += kInvocations) creaseHinge(k);
       sync();
     }
     if (stopsAfter(first_pass + crease_pass)) {

@@ -202,11 +202,20 @@ layout(std430, set = 0, binding = SIM_BIND_CONTACT_GRID) SIM_COHERENT buffer Con
 
 #endif
 
-// The contact's keys (SimUniforms::contact), checks and grid, each read whole: a fleet's lavapipe
-// build (device addresses, Mesa 22.3) misreads components of these vectors loaded apart
+// The contact's keys (SimUniforms::contact), checks and grid, the hinges' range and the walk's and
+// crossing checks' arguments, each read whole: a fleet's lavapipe build (device addresses, Mesa
+// 22.3) misreads components of one vector loaded apart
+// (SpirvRules.NoSimShaderLoadsTwoComponentsOfAVectorApartByDeviceAddress)
 vec4 contactKeys() { return u.contact; }
 uvec4 contactChecks() { return u.contact_check; }
 uvec4 contactGrid() { return u.contact_grid; }
+uvec4 hingeKeys() { return u.hinge; }
+uvec4 walkArgs() { return hash_args[SIM_CONTACT_WALK_ARGS]; }
+uvec4 crossArgs() { return hash_args[SIM_CONTACT_CROSS_ARGS]; }
+bool creasingNow() {
+  vec4 crease = u.crease;
+  return creasing(hingeKeys().y, crease.y);
+}
 
 // Linear index of this invocation; grids wider than SIM_MAX_GROUPS_X spill into Y.
 uint threadIndex() {
@@ -268,7 +277,7 @@ bool batchGateTakes() {
   case SIM_GATE_COMPACTION:
     return counters.compact_dispatch.x != 0u;
   case SIM_GATE_CREASE:
-    return creasing(u.hinge.y, u.crease.y);
+    return creasingNow();
   case SIM_GATE_LIMIT:
     return u.limit.x > 0.0f;
   case SIM_GATE_SHORTEN:
@@ -280,9 +289,9 @@ bool batchGateTakes() {
   case SIM_GATE_CONTACT_GRID:
     return contactKeys().x > 0.0f && contact_words[SIM_CONTACT_WORD_GRID] != 0u;
   case SIM_GATE_CONTACT_WALK:
-    return contactKeys().x > 0.0f && hash_args[SIM_CONTACT_WALK_ARGS].x != 0u;
+    return contactKeys().x > 0.0f && walkArgs().x != 0u;
   case SIM_GATE_CONTACT_CROSS:
-    return contactKeys().x > 0.0f && hash_args[SIM_CONTACT_CROSS_ARGS].x != 0u;
+    return contactKeys().x > 0.0f && crossArgs().x != 0u;
   case SIM_GATE_SETTLE:
     return contactKeys().x > 0.0f && batch.gate_arg < contactChecks().y;
   default:
