@@ -230,8 +230,10 @@ float SimParams::handBallRadius() const {
 }
 
 std::optional<SimParams> presetParams(const std::string& name) {
-  SimParams p; // defaults are the `tender` preset
+  SimParams p; // defaults are the `tender` preset, without contact
   if (name == "tender" || name == "tender-low") {
+    // The seeds' cloth, its particle repulsion kept, with penetration-free contact
+    p.contact_factor = kPaperContactFactor;
     if (name == "tender-low") p.cols = 24, p.rows = 36, p.spacing = 0.18f * 31.0f / 23.0f;
   } else if (name == "crumple" || name == "crumple-low") {
     p.cols = 40;

@@ -33,6 +33,7 @@ inline std::vector<FleetSheet> mixedFleet(uint32_t count, uint32_t cols = 12, ui
     std::vector<std::string> sets = {
         "cols=" + std::to_string(cols),
         "rows=" + std::to_string(rows),
+        "contact_factor=0", // the seeds' cloth (fleets with contact: ContactSheetsMatchTheirRunsAloneAndTheCpu)
         "spacing=0.16",
         std::string("pins=") + kPins[i % 3],
         std::string("wind_kind=") + (i % 2 ? "noise" : "sinusoid"),

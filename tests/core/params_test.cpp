@@ -43,6 +43,9 @@ TEST(Params, PresetsCarryTheSpecValues) {
   EXPECT_EQ(r.pins, PinMode::None);
   EXPECT_FALSE(presetParams("origami"));
   for (auto& name : presetNames()) EXPECT_FALSE(validate(*presetParams(name))) << name;
+  // Penetration-free contact in every preset; the seeds' cloth keeps its particle repulsion beside it
+  for (auto& name : presetNames()) EXPECT_FLOAT_EQ(presetParams(name)->contact_factor, kPaperContactFactor) << name;
+  EXPECT_TRUE(t.collision);
 }
 
 TEST(Params, OverridesParseAndValidate) {
