@@ -57,9 +57,9 @@ expect_bad "${sim[@]}" --stats "$tmp"
 
 # A yank to the edge of the allowed coordinates keeps every position finite, torn or not: the
 # seeds' cloth for 200 ticks, then with the tender preset's contact (whose hand runs 32 substeps a
-# tick while it drags) for 20.
+# tick while it drags) for 4.
 printf '0 grab particle 1535\n1 move 999999 999999 -999999\n' >"$tmp/edge.txt"
-for case in "2.5 0 200" "0 0 200" "2.5 0.5 20" "0 0.5 20"; do
+for case in "2.5 0 200" "0 0 200" "2.5 0.5 4" "0 0.5 4"; do
   read -r tear contact ticks <<<"$case"
   "$T" sim --backend cpu --ticks "$ticks" --set tear_factor="$tear" --set contact_factor="$contact" --script "$tmp/edge.txt" \
     --stats "$tmp/edge.json" >/dev/null &&
@@ -93,9 +93,10 @@ else
   echo "FAIL: a killed run left a fragment ($size bytes)"; failures=$((failures + 1))
 fi
 
-# A good run writes stats and a PLY that matches them.
+# A good run writes stats and a PLY that matches them (the seeds' cloth: contact's stats are the
+# fast crumple's below).
 printf '# yank a corner\n0 grab particle 1535\n1 move 4 -4 6\n20 release\n' >"$tmp/yank.txt"
-if "$T" sim --backend cpu --ticks 30 --script "$tmp/yank.txt" --stats "$tmp/s.json" --out "$tmp/s.ply" >"$tmp/out"; then
+if "$T" sim --backend cpu --set contact_factor=0 --ticks 30 --script "$tmp/yank.txt" --stats "$tmp/s.json" --out "$tmp/s.ply" >"$tmp/out"; then
   python3 - "$tmp/s.json" "$tmp/s.ply" <<'PY' || failures=$((failures + 1))
 import json, sys
 s = json.load(open(sys.argv[1]))
