@@ -29,13 +29,15 @@
 // push is the mean of all its pairs' pushes, so it may carry the particle towards a primitive other
 // than the one a pair parts it from; the push's own margin keeps that from closing a pair substep
 // after substep: with 0.4 (d - m) + 0.1 (d - m/2) on either side a pair d >= m apart keeps 0.9 m,
-// one between m/2 and m moves 0.1 (d - m/2) a side at most and keeps 0.8 d + 0.1 m >= m/2, and
-// one closer than m/2 (only a sheet that starts so) does not move. No pair ends a substep closer
+// one between m/2 and m, whose half-spaces let no step towards the other (below), moves 0.1 (d - m/2)
+// a side at most and keeps 0.8 d + 0.1 m >= m/2, and one closer than m/2 (only a sheet that starts
+// so) is not pushed and does not close. No pair ends a substep closer
 // than the least of its distance at the start and m/2. (A push cut to 0.1 d alone let a pair
 // pressed below m close by a fifth each substep, towards touching.)
 // The bound need not hold along a pair, only across it (slideConstraint has why): a pair d < r
 // apart sets each of its particles a half-space, towards the other primitive along the pair's
-// normal by at most fraction x (d - m), and along the planes nothing; the ball of fraction x
+// normal by at most fraction x (d - m) (nothing within the margin), and along the planes nothing;
+// the ball of fraction x
 // (r - m) (slideBound) keeps the pairs farther than r apart. So a particle pressed on a layer
 // slides along it as fast as a free particle moves, where b(v) above held it to a fraction of its
 // distance in every direction. The steps are cut after the floor (slideStep): each step's excess
@@ -270,11 +272,10 @@ SIM_INLINE VerletState contactStepTo(VerletState st, vec3 target, vec3 x0, vec3 
 }
 
 /// The step bound of a particle whose nearest primitive is sqrt(nearest2) away, in every direction:
-/// stepBound of the radius (the pairs closer bound the step along their normals: slideConstraint),
-/// or none within the margin.
+/// stepBound of the radius (the pairs closer bound the step along their normals: slideConstraint,
+/// within the margin too), or none where it touches a primitive (no normal says which way is away).
 SIM_INLINE float slideBound(float nearest2, float radius, float fraction) {
-  float margin = SIM_CONTACT_MARGIN * radius;
-  return nearest2 > margin * margin ? stepBound(radius * radius, radius, fraction) : 0.0f;
+  return nearest2 > 0.0f ? stepBound(radius * radius, radius, fraction) : 0.0f;
 }
 
 /// The half-space a contact pair sets one of its particles' steps in: h.xyz the unit normal on the
@@ -287,8 +288,10 @@ struct SlideHalf {
 };
 
 /// The half-space contact pair c (x: its particles; `edge`: two edges, else a particle and a
-/// triangle) d < radius apart and beyond the margin m sets its particle k in: the normal from the
-/// other primitive towards k's, and fraction x (d - m).
+/// triangle) 0 < d < radius apart sets its particle k in: the normal from the other primitive
+/// towards k's, and fraction x (d - m), none within the margin m: a pair pressed closer than m may
+/// part and slide, not close (a bound of zero there held its particles in every direction, so
+/// a particle pressed on a layer stayed until its push parted it, a tenth of d - m/2 a substep).
 /// Why it holds: the primitives are convex, so every corner of k's lies beyond the plane through its
 /// nearest point normal to the pair's, and every corner of the other short of the plane through
 /// that one's; with no corner of either moving towards the other by more than fraction x (d - m),
@@ -301,11 +304,11 @@ SIM_INLINE SlideHalf slideConstraint(vec3 x0, vec3 x1, vec3 x2, vec3 x3, Contact
   r.h = vec4(0.0f, 0.0f, 0.0f, -1.0f);
   r.slack = 0.0f;
   float margin = SIM_CONTACT_MARGIN * radius;
-  if (!(c.d2 < radius * radius) || !(c.d2 > margin * margin)) return r;
+  if (!(c.d2 < radius * radius) || !(c.d2 > 0.0f)) return r;
   vec3 sep = x0 * c.w.x + x1 * c.w.y + x2 * c.w.z + x3 * c.w.w;
   vec3 big = max(max(abs(x0), abs(x1)), max(abs(x2), abs(x3)));
   float len = simSqrt(c.d2);
-  r.h = vec4(sep * simDiv(k == 0u || (edge && k == 1u) ? 1.0f : -1.0f, len), fraction * (len - margin));
+  r.h = vec4(sep * simDiv(k == 0u || (edge && k == 1u) ? 1.0f : -1.0f, len), fraction * max(len - margin, 0.0f));
   r.slack = SIM_CONTACT_SLACK * simDiv(max(big.x, max(big.y, big.z)) + 1.0f, len);
   return r;
 }

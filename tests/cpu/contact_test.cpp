@@ -135,6 +135,35 @@ TEST(ContactDistance, ABoundedStepGoesNoFartherThanItsBound) {
   }
 }
 
+TEST(ContactDistance, APairWithinTheMarginMayPartAndSlideButNotClose) {
+  // A particle a third of the margin above a triangle in the plane z = 0 (contact radius 1): it may
+  // not go down at all, it may go up and along as far as its ball, and it is not held where it is
+  // (within the margin the bound was once zero in every direction: a particle pressed there stayed
+  // until its push, a tenth of its distance less half the margin, parted it)
+  const float radius = 1.0f, m = SIM_CONTACT_MARGIN * radius, f = SIM_CONTACT_FRACTION;
+  const vec3 p(0.25f, 0.25f, m / 3.0f), a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  const ContactPair pair = shaderio::pointTriangle(p, a, b, c);
+  ASSERT_LT(pair.d2, m * m);
+  EXPECT_EQ(shaderio::slideBound(pair.d2, radius, f), shaderio::stepBound(radius * radius, radius, f));
+  const shaderio::SlideHalf up = shaderio::slideConstraint(p, a, b, c, pair, false, radius, f, 0);
+  EXPECT_EQ(up.h.w, 0.0f);
+  EXPECT_NEAR(up.h.z, 1.0f, 1e-6f);
+  const vec3 away(0.0f, 0.0f, 0.1f), towards(0.0f, 0.0f, -0.1f), along_up(0.1f, 0.0f, 0.01f);
+  EXPECT_EQ(shaderio::slideShare(up, away), 1.0f);
+  EXPECT_EQ(shaderio::slideExcess(up, away), vec3(0.0f));
+  EXPECT_EQ(shaderio::slideShare(up, along_up), 1.0f);
+  EXPECT_EQ(shaderio::slideShare(up, towards), 0.0f);
+  // The triangle's corners likewise: away from the particle, not towards it
+  const shaderio::SlideHalf down = shaderio::slideConstraint(p, a, b, c, pair, false, radius, f, 1);
+  EXPECT_EQ(down.h.w, 0.0f);
+  EXPECT_EQ(shaderio::slideShare(down, towards), 1.0f);
+  EXPECT_EQ(shaderio::slideShare(down, away), 0.0f);
+  // Two primitives that touch have no normal: nothing moves
+  const ContactPair touching = shaderio::pointTriangle(vec3(0.25f, 0.25f, 0.0f), a, b, c);
+  EXPECT_EQ(shaderio::slideBound(touching.d2, radius, f), 0.0f);
+  EXPECT_LT(shaderio::slideConstraint(vec3(0.25f, 0.25f, 0.0f), a, b, c, touching, false, radius, f, 0).h.w, 0.0f);
+}
+
 /// A sheet of the `crumple` preset lying flat on its floor, 20 x 30, with contact on (or off).
 SimParams flatCrumple(bool contact, std::vector<std::string> sets = {}) {
   sets.insert(sets.begin(), {"cols=20", "rows=30", "tilt=90", "pins=none", "wind=off",
