@@ -32,26 +32,39 @@ void lower(uint32_t& slot, float d2) {
   }
 }
 
+/// The cell of the contact grids that holds p: floor(p x inv_cell), clamped, with a floor of
+/// integer conversions (floorf is a call without SSE 4.1). Any cell function that rises with its
+/// point would do: which cells hold a box decides where the search looks, not what it finds.
+inline int gridCoordinate(float x) {
+  constexpr float kMost = 536870912.0f;
+  x = x > -kMost ? (x < kMost ? x : kMost) : -kMost; // NaN to the lowest
+  const int i = int(x);
+  return i - (x < float(i) ? 1 : 0);
+}
+inline ivec3 gridCell(vec3 p, float inv_cell) {
+  return ivec3(gridCoordinate(p.x * inv_cell), gridCoordinate(p.y * inv_cell), gridCoordinate(p.z * inv_cell));
+}
+
 /// Calls f(entry) once for each entry of `grid` from `first` on whose box overlaps the box [lo,
 /// hi]: in the cell that holds the lowest corner of the two boxes' overlap (both boxes are in that
-/// cell; a bucket holds an entry once, so no entry is met twice). A bucket's entries rise (Grid::
-/// build), so it is read from its end down to `first`.
+/// cell; a bucket holds an entry once, so no entry is met twice). That cell is the larger of the
+/// two lowest corners' cells, component by component (gridCell rises with its point). A bucket's
+/// entries rise (Grid::build), so it is read from its end down to `first`.
 template <typename Grid, typename F>
-void visitBox(const Grid& grid, const std::vector<vec3>& lows, const std::vector<vec3>& highs, vec3 lo, vec3 hi,
-              float inv_cell, uint32_t first, F&& f) {
-  const ivec3 a = cellOf(lo, inv_cell), b = cellOf(hi, inv_cell);
+void visitBox(const Grid& grid, vec3 lo, vec3 hi, float inv_cell, uint32_t first, F&& f) {
+  const ivec3 a = gridCell(lo, inv_cell), b = gridCell(hi, inv_cell);
   for (int z = a.z; z <= b.z; ++z)
     for (int y = a.y; y <= b.y; ++y)
       for (int x = a.x; x <= b.x; ++x) {
         const ivec3 cell(x, y, z);
         const uint32_t h = hashCell(cell, grid.mask);
         for (uint32_t k = grid.start[h + 1]; k-- > grid.start[h];) {
-          const uint32_t e = grid.entry[k];
-          if (e < first) break;
-          const vec3 elo = lows[e], ehi = highs[e];
+          const auto& slot = grid.entry[k];
+          if (slot.id < first) break;
+          const vec3 elo = slot.lo, ehi = slot.hi;
           if (!(lo.x <= ehi.x && elo.x <= hi.x && lo.y <= ehi.y && elo.y <= hi.y && lo.z <= ehi.z && elo.z <= hi.z))
             continue;
-          if (cellOf(glm::max(lo, elo), inv_cell) == cell) f(e);
+          if (glm::max(a, slot.cell) == cell) f(slot.id);
         }
       }
 }
@@ -70,31 +83,58 @@ bool less4(uvec4 a, uvec4 b) {
 
 } // namespace
 
-void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3>& hi, float inv_cell) {
+void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3>& hi, float inv_cell, WorkerPool& pool,
+                             uint32_t part_boxes) {
   const uint32_t n = uint32_t(lo.size());
   const uint32_t size = std::bit_ceil(std::max(2u * n, 16u));
   mask = size - 1;
-  start.assign(size + 1, 0);
+  // The boxes in `parts` runs of consecutive ones, each counted and filled by one thread into its
+  // own share of each bucket, the runs' shares in their order: the entries rise in every bucket
+  // whatever the thread count
+  const uint32_t parts = std::max(1u, std::min({pool.size(), kGridParts, n / part_boxes}));
+  auto first = [&](uint32_t part) { return uint32_t(uint64_t(n) * part / parts); };
+  fill.assign(size_t(parts) * size, 0);
+  last.assign(size_t(parts) * size, ~0u);
   // Calls f(h) for the bucket of each cell box i spans, each bucket once (two cells of a box may
-  // share one): `last` holds the box that last went into each bucket
-  last.assign(size, ~0u);
-  auto buckets = [&](uint32_t i, auto&& f) {
-    const ivec3 a = cellOf(lo[i], inv_cell), b = cellOf(hi[i], inv_cell);
+  // share one): `seen` holds the box that last went into each bucket
+  auto buckets = [&](uint32_t i, uint32_t* seen, auto&& f) {
+    const ivec3 a = gridCell(lo[i], inv_cell), b = gridCell(hi[i], inv_cell);
     for (int z = a.z; z <= b.z; ++z)
       for (int y = a.y; y <= b.y; ++y)
         for (int x = a.x; x <= b.x; ++x) {
           const uint32_t h = hashCell(ivec3(x, y, z), mask);
-          if (last[h] == i) continue;
-          last[h] = i;
+          if (seen[h] == i) continue;
+          seen[h] = i;
           f(h);
         }
   };
-  for (uint32_t i = 0; i < n; ++i) buckets(i, [&](uint32_t h) { ++start[h + 1]; });
-  for (uint32_t h = 0; h < size; ++h) start[h + 1] += start[h];
-  entry.resize(start[size]);
-  fill.assign(start.begin(), start.end() - 1);
-  last.assign(size, ~0u);
-  for (uint32_t i = 0; i < n; ++i) buckets(i, [&](uint32_t h) { entry[fill[h]++] = i; });
+  auto each = [&](auto&& visit) {
+    pool.parallelFor(parts, 1, [&](uint32_t begin, uint32_t end) {
+      for (uint32_t part = begin; part < end; ++part) {
+        uint32_t *count = fill.data() + size_t(part) * size, *seen = last.data() + size_t(part) * size;
+        for (uint32_t i = first(part); i < first(part + 1); ++i) visit(i, seen, count);
+      }
+    });
+  };
+  each([&](uint32_t i, uint32_t* seen, uint32_t* count) { buckets(i, seen, [&](uint32_t h) { ++count[h]; }); });
+  // Each part's first slot in each bucket, after the parts before it
+  start.resize(size + 1);
+  uint32_t total = 0;
+  for (uint32_t h = 0; h < size; ++h) {
+    start[h] = total;
+    for (uint32_t part = 0; part < parts; ++part) {
+      const uint32_t k = fill[size_t(part) * size + h];
+      fill[size_t(part) * size + h] = total;
+      total += k;
+    }
+  }
+  start[size] = total;
+  entry.resize(total);
+  std::fill(last.begin(), last.end(), ~0u);
+  each([&](uint32_t i, uint32_t* seen, uint32_t* slot) {
+    const Slot box{lo[i], i, hi[i], gridCell(lo[i], inv_cell)};
+    buckets(i, seen, [&](uint32_t h) { entry[slot[h]++] = box; });
+  });
 }
 
 void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::vec4>& prev,
@@ -328,11 +368,11 @@ void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vec
   const float inv_cell = 1.0f / (1.01f * longest);
   if (uint64_t(checked) * count > kBruteForceTests && std::isfinite(inv_cell) && longest < 1e30f) {
     // Many: through a grid of the triangles' boxes
-    grid_.build(lo_, hi_, inv_cell);
+    grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
     pool_.parallelFor(checked, kGrainCollide, [&](uint32_t begin, uint32_t end) {
       for (uint32_t k = begin; k < end; ++k) {
         const uint32_t t = checked_[k];
-        visitBox(grid_, lo_, hi_, lo_[t], hi_[t], inv_cell, 0, [&](uint32_t o) { test(t, o); });
+        visitBox(grid_, lo_[t], hi_[t], inv_cell, 0, [&](uint32_t o) { test(t, o); });
       }
     });
   } else {
@@ -366,38 +406,44 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
   // Particles against the triangles that do not hold them: the boxes of the triangles in the grid,
   // each particle's box of half-width `reach` against them
   boxTriangles(pos, triangles, count);
-  grid_.build(lo_, hi_, inv_cell);
-  pool_.parallelFor(n, kGrainCollide, [&](uint32_t begin, uint32_t end) {
-    std::vector<uvec4> found;
-    for (uint32_t v = begin; v < end; ++v) {
-      const vec3 p = at(v), plo = p - vec3(reach), phi = p + vec3(reach);
-      visitBox(grid_, lo_, hi_, plo, phi, inv_cell, 0, [&](uint32_t t) {
-        const uvec4 tri = triangles[t];
-        if (v == tri.x || v == tri.y || v == tri.z) return;
-        if (pointTriangleDistance2(p, at(tri.x), at(tri.y), at(tri.z)) < reach2)
-          found.push_back(uvec4(v, tri.x, tri.y, tri.z));
-      });
-    }
-    const std::lock_guard<std::mutex> lock(merge);
-    vf_.insert(vf_.end(), found.begin(), found.end());
-  });
+  grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
+  pool_.parallelFor(
+      n, kGrainCollide,
+      [&](uint32_t begin, uint32_t end) {
+        std::vector<uvec4> found;
+        for (uint32_t v = begin; v < end; ++v) {
+          const vec3 p = at(v), plo = p - vec3(reach), phi = p + vec3(reach);
+          visitBox(grid_, plo, phi, inv_cell, 0, [&](uint32_t t) {
+            const uvec4 tri = triangles[t];
+            if (v == tri.x || v == tri.y || v == tri.z) return;
+            if (pointTriangleDistance2(p, at(tri.x), at(tri.y), at(tri.z)) < reach2)
+              found.push_back(uvec4(v, tri.x, tri.y, tri.z));
+          });
+        }
+        const std::lock_guard<std::mutex> lock(merge);
+        vf_.insert(vf_.end(), found.begin(), found.end());
+      },
+      kSearchShares);
   // Edges against the edges that share no particle with them, each pair once
   boxEdges(pos);
-  grid_.build(lo_, hi_, inv_cell);
-  pool_.parallelFor(edge_count, kGrainCollide, [&](uint32_t begin, uint32_t end) {
-    std::vector<uvec4> found;
-    for (uint32_t k = begin; k < end; ++k) {
-      const uvec2 e = edges_[k];
-      const vec3 elo = lo_[k] - vec3(reach), ehi = hi_[k] + vec3(reach);
-      visitBox(grid_, lo_, hi_, elo, ehi, inv_cell, k + 1, [&](uint32_t j) {
-        const uvec2 f = edges_[j];
-        if (f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
-        if (segmentDistance2(at(e.x), at(e.y), at(f.x), at(f.y)) < reach2) found.push_back(uvec4(e, f));
-      });
-    }
-    const std::lock_guard<std::mutex> lock(merge);
-    ee_.insert(ee_.end(), found.begin(), found.end());
-  });
+  grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
+  pool_.parallelFor(
+      edge_count, kGrainCollide,
+      [&](uint32_t begin, uint32_t end) {
+        std::vector<uvec4> found;
+        for (uint32_t k = begin; k < end; ++k) {
+          const uvec2 e = edges_[k];
+          const vec3 elo = lo_[k] - vec3(reach), ehi = hi_[k] + vec3(reach);
+          visitBox(grid_, elo, ehi, inv_cell, k + 1, [&](uint32_t j) {
+            const uvec2 f = edges_[j];
+            if (f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
+            if (segmentDistance2(at(e.x), at(e.y), at(f.x), at(f.y)) < reach2) found.push_back(uvec4(e, f));
+          });
+        }
+        const std::lock_guard<std::mutex> lock(merge);
+        ee_.insert(ee_.end(), found.begin(), found.end());
+      },
+      kSearchShares);
   // The same lists whatever the threads' order (visitBox meets each pair once)
   std::sort(vf_.begin(), vf_.end(), less4);
   std::sort(ee_.begin(), ee_.end(), less4);
@@ -501,10 +547,10 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
   };
   // The particles that moved against every triangle near them
   boxTriangles(pos, triangles, count);
-  grid_.build(lo_, hi_, inv_cell);
+  grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
   search(added_vf, [&](uint32_t v, std::vector<uvec4>& found) {
     const vec3 p = at(v);
-    visitBox(grid_, lo_, hi_, p - vec3(reach), p + vec3(reach), inv_cell, 0, [&](uint32_t t) {
+    visitBox(grid_, p - vec3(reach), p + vec3(reach), inv_cell, 0, [&](uint32_t t) {
       const uvec4 tri = triangles[t];
       if (v == tri.x || v == tri.y || v == tri.z) return;
       if (pointTriangleDistance2(p, at(tri.x), at(tri.y), at(tri.z)) < reach2)
@@ -515,14 +561,14 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
   // moved found theirs above)
   points_.resize(n);
   for (uint32_t i = 0; i < n; ++i) points_[i] = at(i);
-  points_grid_.build(points_, points_, inv_cell);
+  points_grid_.build(points_, points_, inv_cell, pool_, grid_part_boxes_);
   dirty_.clear();
   for (uint32_t t = 0; t < count; ++t)
     if (moved_[triangles[t].x] | moved_[triangles[t].y] | moved_[triangles[t].z]) dirty_.push_back(t);
   search(added_vf, [&](uint32_t t, std::vector<uvec4>& found) {
     const uvec4 tri = triangles[t];
     const vec3 a = at(tri.x), b = at(tri.y), c = at(tri.z);
-    visitBox(points_grid_, points_, points_, lo_[t] - vec3(reach), hi_[t] + vec3(reach), inv_cell, 0, [&](uint32_t v) {
+    visitBox(points_grid_, lo_[t] - vec3(reach), hi_[t] + vec3(reach), inv_cell, 0, [&](uint32_t v) {
       if (moved_[v] || v == tri.x || v == tri.y || v == tri.z) return;
       if (pointTriangleDistance2(at(v), a, b, c) < reach2) found.push_back(uvec4(v, tri.x, tri.y, tri.z));
     });
@@ -530,13 +576,13 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
   // The edges with a particle that moved against every edge near them, a pair of two such from the
   // first of them
   boxEdges(pos);
-  grid_.build(lo_, hi_, inv_cell);
+  grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
   dirty_.clear();
   for (uint32_t k = 0; k < edge_count; ++k)
     if (moved_[edges_[k].x] | moved_[edges_[k].y]) dirty_.push_back(k);
   search(added_ee, [&](uint32_t k, std::vector<uvec4>& found) {
     const uvec2 e = edges_[k];
-    visitBox(grid_, lo_, hi_, lo_[k] - vec3(reach), hi_[k] + vec3(reach), inv_cell, 0, [&](uint32_t j) {
+    visitBox(grid_, lo_[k] - vec3(reach), hi_[k] + vec3(reach), inv_cell, 0, [&](uint32_t j) {
       const uvec2 f = edges_[j];
       if (j == k || f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
       if ((moved_[f.x] | moved_[f.y]) && j < k) return;

@@ -28,7 +28,9 @@ public:
     Kept,    ///< kept while they hold every pair that can touch (the travels, turned, clusters), then built whole
     Repaired ///< kept so, else repaired where a few particles travelled too far, else built whole
   };
-  CpuContact(WorkerPool& pool, Lists lists) : pool_(pool), lists_kept_(lists) {}
+  /// `min_chunk`: CpuOptions::min_chunk (1 splits every grid build among the threads).
+  CpuContact(WorkerPool& pool, Lists lists, uint32_t min_chunk = 0)
+      : pool_(pool), lists_kept_(lists), grid_part_boxes_(min_chunk ? min_chunk : kGridPartBoxes) {}
 
   /// The step bound of each particle at `pos` (xyz; w inverse mass; `prev` where each was a
   /// substep before) in substep `s`, of the sheet made of the first `count` triangles of
@@ -82,11 +84,28 @@ public:
 private:
   /// A uniform grid of boxes hashed into a power-of-two table: a box is an entry of every cell it
   /// overlaps, once in each bucket; the entries of bucket h at [start[h], start[h + 1]), rising.
-  struct Grid {
-    std::vector<uint32_t> start, entry, fill, last;
-    uint32_t mask = 0;
-    void build(const std::vector<glm::vec3>& lo, const std::vector<glm::vec3>& hi, float inv_cell);
+  /// Each entry holds a copy of its box and the cell of its lowest corner, so that a search reads a
+  /// bucket in one sweep of memory.
+  struct Slot {
+    glm::vec3 lo;
+    uint32_t id;
+    glm::vec3 hi;
+    glm::ivec3 cell;
   };
+  struct Grid {
+    std::vector<uint32_t> start, fill, last;
+    std::vector<Slot> entry;
+    uint32_t mask = 0;
+    /// With up to kGridParts threads of `pool`, `part_boxes` boxes at least each.
+    void build(const std::vector<glm::vec3>& lo, const std::vector<glm::vec3>& hi, float inv_cell, WorkerPool& pool,
+               uint32_t part_boxes);
+  };
+  /// The most runs of boxes a grid is built in, one a thread (each holds a count and a mark a
+  /// bucket), and the fewest boxes a run
+  static constexpr uint32_t kGridParts = 4, kGridPartBoxes = 4096;
+  /// Shares a worker takes of a list build's searches: a crumpled part of the sheet costs more than
+  /// a flat one, and an edge looks only at the edges after it, so the first edges cost the most
+  static constexpr uint32_t kSearchShares = 8;
 
   /// Calls visit(particle, SlideHalf) for each half-space the pairs closer than the radius set
   /// their particles at `start`, from the pool's threads.
@@ -139,6 +158,7 @@ private:
 
   WorkerPool& pool_;
   Lists lists_kept_;
+  uint32_t grid_part_boxes_;
   std::vector<glm::uvec4> vf_;       ///< particle, then the triangle's three: pairs within radius + skin
   std::vector<glm::ivec4> sums_;     ///< each particle's pushes in fixed point, and their count
   std::vector<glm::uvec4> ee_;       ///< two edges' particles: pairs within radius + skin
