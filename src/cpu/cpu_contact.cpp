@@ -81,6 +81,23 @@ bool less4(uvec4 a, uvec4 b) {
   return a.w < b.w;
 }
 
+/// Calls look(k, found) for each k of [0, count) on the pool's threads (`shares` a worker) and
+/// appends what each finds to `out`, in any order (the lists are sorted after).
+template <typename Look>
+void gatherPairs(WorkerPool& pool, uint32_t count, uint32_t grain, uint32_t shares, std::vector<uvec4>& out,
+                 Look&& look) {
+  std::mutex merge;
+  pool.parallelFor(
+      count, grain,
+      [&](uint32_t begin, uint32_t end) {
+        std::vector<uvec4> found;
+        for (uint32_t k = begin; k < end; ++k) look(k, found);
+        const std::lock_guard<std::mutex> lock(merge);
+        out.insert(out.end(), found.begin(), found.end());
+      },
+      shares);
+}
+
 } // namespace
 
 void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3>& hi, float inv_cell, WorkerPool& pool,
@@ -402,48 +419,31 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
   const float inv_cell = listCell(pos, reach);
   if (!(inv_cell > 0.0f)) return;
   const float reach2 = reach * reach;
-  std::mutex merge;
   // Particles against the triangles that do not hold them: the boxes of the triangles in the grid,
   // each particle's box of half-width `reach` against them
   boxTriangles(pos, triangles, count);
   grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
-  pool_.parallelFor(
-      n, kGrainCollide,
-      [&](uint32_t begin, uint32_t end) {
-        std::vector<uvec4> found;
-        for (uint32_t v = begin; v < end; ++v) {
-          const vec3 p = at(v), plo = p - vec3(reach), phi = p + vec3(reach);
-          visitBox(grid_, plo, phi, inv_cell, 0, [&](uint32_t t) {
-            const uvec4 tri = triangles[t];
-            if (v == tri.x || v == tri.y || v == tri.z) return;
-            if (pointTriangleDistance2(p, at(tri.x), at(tri.y), at(tri.z)) < reach2)
-              found.push_back(uvec4(v, tri.x, tri.y, tri.z));
-          });
-        }
-        const std::lock_guard<std::mutex> lock(merge);
-        vf_.insert(vf_.end(), found.begin(), found.end());
-      },
-      kSearchShares);
+  gatherPairs(pool_, n, kGrainCollide, kSearchShares, vf_, [&](uint32_t v, std::vector<uvec4>& found) {
+    const vec3 p = at(v), plo = p - vec3(reach), phi = p + vec3(reach);
+    visitBox(grid_, plo, phi, inv_cell, 0, [&](uint32_t t) {
+      const uvec4 tri = triangles[t];
+      if (v == tri.x || v == tri.y || v == tri.z) return;
+      if (pointTriangleDistance2(p, at(tri.x), at(tri.y), at(tri.z)) < reach2)
+        found.push_back(uvec4(v, tri.x, tri.y, tri.z));
+    });
+  });
   // Edges against the edges that share no particle with them, each pair once
   boxEdges(pos);
   grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
-  pool_.parallelFor(
-      edge_count, kGrainCollide,
-      [&](uint32_t begin, uint32_t end) {
-        std::vector<uvec4> found;
-        for (uint32_t k = begin; k < end; ++k) {
-          const uvec2 e = edges_[k];
-          const vec3 elo = lo_[k] - vec3(reach), ehi = hi_[k] + vec3(reach);
-          visitBox(grid_, elo, ehi, inv_cell, k + 1, [&](uint32_t j) {
-            const uvec2 f = edges_[j];
-            if (f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
-            if (segmentDistance2(at(e.x), at(e.y), at(f.x), at(f.y)) < reach2) found.push_back(uvec4(e, f));
-          });
-        }
-        const std::lock_guard<std::mutex> lock(merge);
-        ee_.insert(ee_.end(), found.begin(), found.end());
-      },
-      kSearchShares);
+  gatherPairs(pool_, edge_count, kGrainCollide, kSearchShares, ee_, [&](uint32_t k, std::vector<uvec4>& found) {
+    const uvec2 e = edges_[k];
+    const vec3 elo = lo_[k] - vec3(reach), ehi = hi_[k] + vec3(reach);
+    visitBox(grid_, elo, ehi, inv_cell, k + 1, [&](uint32_t j) {
+      const uvec2 f = edges_[j];
+      if (f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
+      if (segmentDistance2(at(e.x), at(e.y), at(f.x), at(f.y)) < reach2) found.push_back(uvec4(e, f));
+    });
+  });
   // The same lists whatever the threads' order (visitBox meets each pair once)
   std::sort(vf_.begin(), vf_.end(), less4);
   std::sort(ee_.begin(), ee_.end(), less4);
@@ -534,16 +534,11 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
   auto touched = [&](uvec4 q) { return (moved_[q.x] | moved_[q.y] | moved_[q.z] | moved_[q.w]) != 0; };
   vf_.erase(std::remove_if(vf_.begin(), vf_.end(), touched), vf_.end());
   ee_.erase(std::remove_if(ee_.begin(), ee_.end(), touched), ee_.end());
-  std::mutex merge;
   std::vector<uvec4> added_vf, added_ee;
   // Calls look(k, found) for each of `dirty_` in parallel and gathers what they find into `added`
   auto search = [&](std::vector<uvec4>& added, auto&& look) {
-    pool_.parallelFor(uint32_t(dirty_.size()), kGrainRepair, [&](uint32_t begin, uint32_t end) {
-      std::vector<uvec4> found;
-      for (uint32_t k = begin; k < end; ++k) look(dirty_[k], found);
-      const std::lock_guard<std::mutex> lock(merge);
-      added.insert(added.end(), found.begin(), found.end());
-    });
+    gatherPairs(pool_, uint32_t(dirty_.size()), kGrainRepair, 1, added,
+                [&](uint32_t k, std::vector<uvec4>& found) { look(dirty_[k], found); });
   };
   // The particles that moved against every triangle near them
   boxTriangles(pos, triangles, count);
