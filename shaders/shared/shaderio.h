@@ -40,7 +40,7 @@ inline uint atomicAdd(SharedWords::Word word, uint value) { return atomicAdd(*wo
 #include "xpbd.h"
 
 static_assert(sizeof(Constraint) == 16);
-static_assert(sizeof(ContactParticle) == 64);
+static_assert(sizeof(ContactParticle) == 80);
 static_assert(sizeof(SimPush) == 16);
 static_assert(sizeof(Counters) == 80);
 static_assert(sizeof(FusedPush) == 16);

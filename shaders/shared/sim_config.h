@@ -94,7 +94,7 @@
 // SIM_CONTACT_LIST_CAPACITY slots for them
 #define SIM_BIND_CONTACT_LISTS 30
 // Per particle (ContactParticle): where it starts the substep, its bound and push, its nearest
-// distance and whether it is free, its pushes in fixed point
+// distance and whether it is free, its pushes and passed steps in fixed point
 #define SIM_BIND_CONTACT 31
 // The contact grid's words: SIM_CONTACT_HEADER words (ContactHeader), then the grid's entries
 // (SIM_CONTACT_CELLS_PER_BOX per triangle and edge at most) and the boxes
@@ -256,6 +256,12 @@
 // particle on top of its bound (contactPushWithin): two sides moving 0.4 (d - m) + 0.1 (d - m/2)
 // each keep 0.9 m between them, and no pair closes below m/2
 #define SIM_CONTACT_PUSH_FRACTION 0.1f
+// The part of the excess a pair's half-space takes out of a particle's step (slideExcess) that it
+// passes on to the other primitive (contactPassed): the pull or push the sheet had against a layer
+// moves the layer instead of vanishing. A half passes the motion of pressed layers to and fro so
+// that a crumple on a floor never comes to rest; a tenth lets it rest and frees a strip held under
+// a fold of the sheet it hangs from (bench/README.md, Contact)
+#define SIM_CONTACT_PASS_FRACTION 0.1f
 // How far a pair's normal (slideConstraint) may turn from rounding, per unit of the largest
 // coordinate of its particles (and one) over their distance: far above the rounding of the nearest
 // points and their difference (a few parts in 2^23 of the coordinates)

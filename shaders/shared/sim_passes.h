@@ -52,6 +52,7 @@
   X(limit, SIM, 1, 1)                                                                                                  \
   X(crease, SIM, 1, 1)                                                                                                 \
   X(floor, SIM, 1, 1)                                                                                                  \
+  X(contact_pass, SIM, 1, 1)                                                                                           \
   X(contact_excess, SIM, 1, 1)                                                                                         \
   X(contact_share, SIM, 1, 1)                                                                                          \
   X(contact_step, SIM, 1, 1)                                                                                           \
@@ -149,6 +150,7 @@
   X(limit, limit, RINGS, Threads, LIMIT, LIMIT, Project)                                                               \
   X(crease, crease, HINGES, Threads, CREASE, CREASE, Project)                                                          \
   X(floor, floor, PARTICLES, Threads, TICK, ALWAYS, Floor)                                                             \
+  X(floor, contact_pass, CONTACT_QUERIES, Threads, CONTACT, CONTACT, Floor)                                            \
   X(floor, contact_excess, CONTACT_QUERIES, Threads, CONTACT, CONTACT, Floor)                                          \
   X(floor, contact_share, CONTACT_QUERIES, Threads, CONTACT, CONTACT, Floor)                                           \
   X(floor, contact_step, PARTICLES, Threads, CONTACT, CONTACT, Floor)                                                  \

@@ -200,13 +200,15 @@ struct PickPush {
 /// A particle's contact in a substep (SIM_BIND_CONTACT): xyz where it starts the substep and w its
 /// step bound (contact_bound); xyz the push that parts its close pairs (contactAverage); x the
 /// bits of its squared distance to the nearest primitive, y 1 when it is free (its triangle crosses
-/// another) and 2 when it was in the last substep; its pushes in fixed point (two's complement) and
-/// their count.
+/// another) and 2 when it was in the last substep, z its share of its step after the floor
+/// (slideShare); its pushes (after the floor: its steps' excess) in fixed point (two's complement)
+/// and their count; what its pairs pass on to it after the floor (contactPassed) likewise.
 struct ContactParticle {
   vec4 start;
   vec4 push;
   uvec4 state;
   uvec4 sum;
+  uvec4 passed;
 };
 
 #endif

@@ -210,6 +210,14 @@ void addPush(uint i, vec3 push) {
   atomicAdd(contact_particles[i].sum.z, uint(f.z));
   atomicAdd(contact_particles[i].sum.w, 1u);
 }
+// Adds what particle i is passed (contactPassed) to its passed sum in fixed point and counts it
+void addPassed(uint i, vec3 passed) {
+  ivec3 f = contactFixed(passed, contactKeys().w);
+  atomicAdd(contact_particles[i].passed.x, uint(f.x));
+  atomicAdd(contact_particles[i].passed.y, uint(f.y));
+  atomicAdd(contact_particles[i].passed.z, uint(f.z));
+  atomicAdd(contact_particles[i].passed.w, 1u);
+}
 
 void contactPair(uvec4 q, ContactPair c) {
   float r = contactKeys().x, thickness = contactKeys().z;
@@ -432,19 +440,20 @@ void contactCross(uint t, uint s) {
 #define NEAR_SEARCH 1u
 #define NEAR_WALK 2u
 // ... or every query's pairs at the start of the substep again, through its list or (overflowed)
-// the grid, for the half-spaces of the steps (contact_excess, contact_share: slidePair)
-#define NEAR_EXCESS 3u
-#define NEAR_SHARE 4u
+// the grid, for the half-spaces of the steps (contact_pass, contact_excess, contact_share: slidePair)
+#define NEAR_PASS 3u
+#define NEAR_EXCESS 4u
+#define NEAR_SHARE 5u
 // ... or those half-spaces listed by particle for the settle stage: counted (contact_half_count),
 // then, after the counts' scan, filled (contact_half_fill)
-#define NEAR_HALF_COUNT 5u
-#define NEAR_HALF_FILL 6u
+#define NEAR_HALF_COUNT 6u
+#define NEAR_HALF_FILL 7u
 // Candidates contactNearOf gathers before it weighs them
 #define CONTACT_BATCH 16u
 
 // Where contactNearOf weighs particle j: where it is, or where it started the substep (the
 // half-spaces' passes, after the floor)
-vec4 nearPosition(uint j, uint only) { return only >= NEAR_EXCESS ? contact_particles[j].start : SIM_POSITION(j); }
+vec4 nearPosition(uint j, uint only) { return only >= NEAR_PASS ? contact_particles[j].start : SIM_POSITION(j); }
 
 // The settle stage's half-spaces listed by particle (settle_bodies.h), in scratch from
 // u.contact_check.z: particle i's count, then (their exclusive scan) where its list starts
@@ -479,21 +488,40 @@ void listHalf(uint i, SlideHalf h, uint only) {
   contact_lists[w + 4u] = floatBitsToUint(h.slack);
 }
 
+// Particle j of pair q
+uint pairParticle(uvec4 q, uint j) { return j == 0u ? q.x : (j == 1u ? q.y : (j == 2u ? q.z : q.w)); }
+
+// The mean of what particle i is passed (contactPassed), summed by contact_pass
+vec3 passedMean(uint i) { return contactAverage(ivec4(contact_particles[i].passed), contactKeys().w); }
+
 // The half-spaces pair q sets its particles' steps in (slideConstraint; `edge`: two edges; x0..x3
-// where they started the substep, c their nearest points): each step's excess beyond them summed
-// into its particle's sums (NEAR_EXCESS), or the share of the step less that excess's mean that
-// keeps them lowering its share (NEAR_SHARE), or listed by particle (NEAR_HALF_*)
+// where they started the substep, c their nearest points): each step's excess beyond them passed
+// on to the other primitive's particles (NEAR_PASS), or the excess of the step with its passed
+// mean (passedPosition) summed into its particle's sums (NEAR_EXCESS), or the share of that step
+// less that excess's mean that keeps them lowering its share (NEAR_SHARE), or listed by particle
+// (NEAR_HALF_*)
 void slidePair(uvec4 q, vec3 x0, vec3 x1, vec3 x2, vec3 x3, ContactPair c, bool edge, uint only) {
   vec3 frame = contactFrameNow();
   for (uint j = 0u; j < 4u; ++j) {
     SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, contactKeys().x, contactKeys().y, j);
     if (h.h.w < 0.0f) continue;
-    uint i = j == 0u ? q.x : (j == 1u ? q.y : (j == 2u ? q.z : q.w));
+    uint i = pairParticle(q, j);
     if (only >= NEAR_HALF_COUNT) {
       listHalf(i, h, only);
       continue;
     }
-    vec3 step = vec3(SIM_POSITION(i)) - (vec3(contact_particles[i].start) + frame);
+    vec3 start = vec3(contact_particles[i].start) + frame;
+    if (only == NEAR_PASS) {
+      vec3 e = slideExcess(h, vec3(SIM_POSITION(i)) - start);
+      if (e == vec3(0.0f)) continue;
+      for (uint k = 0u; k < 4u; ++k) {
+        uint o = pairParticle(q, k);
+        vec4 x = SIM_POSITION(o); // whole (see contactSlideStep)
+        if (contactOpposite(j, k, edge) && x.w > 0.0f) addPassed(o, contactPassed(e, c, k));
+      }
+      continue;
+    }
+    vec3 step = passedPosition(SIM_POSITION(i), passedMean(i), u.floor_y) - start;
     if (only == NEAR_EXCESS) {
       vec3 e = slideExcess(h, step);
       if (e != vec3(0.0f)) addPush(i, e);
@@ -598,7 +626,7 @@ void contactNearOf(uint k, uint only, bool particle) {
       vec3 x0 = vec3(nearPosition(q.x, only)), x1 = vec3(nearPosition(q.y, only)), x2 = vec3(nearPosition(q.z, only)),
            x3 = vec3(nearPosition(q.w, only));
       ContactPair c = particle ? pointTriangle(x0, x1, x2, x3) : segmentSegment(x0, x1, x2, x3);
-      if (only >= NEAR_EXCESS) {
+      if (only >= NEAR_PASS) {
         if (!free) slidePair(q, x0, x1, x2, x3, c, !particle, only);
         continue;
       }
@@ -683,9 +711,10 @@ void contactBound(uint i, uint s) {
       0.0f);
 }
 
-// The floor's step with contact (after floor.comp, contact_excess and contact_share): particle i's
-// step less the frame cut to its pairs' half-spaces (the excess's mean taken out, the rest cut to
-// the share), then to its bound, then pushed (slideStep)
+// The floor's step with contact (after floor.comp, contact_pass, contact_excess and contact_share):
+// particle i's step with what it is passed (passedState) less the frame cut to its pairs'
+// half-spaces (the excess's mean taken out, the rest cut to the share), then to its bound, then
+// pushed (slideStep)
 VerletState contactSlideStep(uint i, VerletState st, uint s) {
   // The grab's target, start and bound each in one load: a fleet's lavapipe build reads a component
   // loaded apart from its vector as the vector's first
@@ -693,15 +722,18 @@ VerletState contactSlideStep(uint i, VerletState st, uint s) {
   vec4 target = u.grab_target[s];
   if (!contactBounded(st.position.w, i == u.grab_index, target.w)) return st;
   vec4 start = contact_particles[i].start;
+  st = passedState(st, passedMean(i), u.floor_y);
   return slideStep(st, vec3(start), vec3(contact_particles[i].push),
                    contactAverage(ivec4(contact_particles[i].sum), contactKeys().w),
                    uintBitsToFloat(contact_particles[i].state.z), start.w, contactFrameNow());
 }
 
-// What the floor pass leaves for the half-spaces' passes: particle i's sums cleared for the
-// excess and its share whole; with the settle on, its half-spaces' count and fill cleared
+// What the floor pass leaves for the half-spaces' passes: particle i's sums cleared for what it is
+// passed and its excess, and its share whole; with the settle on, its half-spaces' count and fill
+// cleared
 void contactSlideClear(uint i) {
   contact_particles[i].sum = uvec4(0u);
+  contact_particles[i].passed = uvec4(0u);
   contact_particles[i].state.z = floatBitsToUint(1.0f);
   if (contactChecks().y == 0u) return;
   scratch[halfStarts() + i] = 0u;

@@ -1,6 +1,6 @@
 #version 460
 // The ground contact; with contact on, the particle's sums and share readied for the half-spaces'
-// passes (contact_excess, contact_share), which contact_step's bounded step follows.
+// passes (contact_pass, contact_excess, contact_share), which contact_step's bounded step follows.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PARTICLES
 #define SIM_PUSH_TYPE SimPush

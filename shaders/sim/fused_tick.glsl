@@ -71,11 +71,13 @@ void scanWorkgroup(uint mode, uint offset, uint count, uint sums) {
 }
 
 #ifdef SIM_FUSED_CONTACT
-// The floor's steps with contact (as contact_excess, contact_share and contact_step): each query's
-// pairs from where the particles started, twice, then each step cut
+// The floor's steps with contact (as contact_pass, contact_excess, contact_share and contact_step):
+// each query's pairs from where the particles started, three times, then each step cut
 void contactSlideSubstep(uint s, uint n) {
   uint lid = gl_LocalInvocationID.x;
   uint queries = u.particle_count + contactEdgeCount();
+  for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_PASS);
+  sync();
   for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_EXCESS);
   sync();
   for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_SHARE);
@@ -334,8 +336,8 @@ void main() {
     }
     sync();
 #ifdef SIM_FUSED_CONTACT
-    // With contact, the steps cut to their pairs' half-spaces and their bounds (as contact_excess,
-    // contact_share and contact_step)
+    // With contact, the steps cut to their pairs' half-spaces and their bounds (as contact_pass,
+    // contact_excess, contact_share and contact_step)
     if (contactKeys().x > 0.0f) contactSlideSubstep(s, n);
 #endif
     if (stopsAfter(first_pass + floor_pass)) {

@@ -252,7 +252,8 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
         for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], c.d2);
         if (!(c.d2 < thickness * thickness)) continue;
         const glm::vec4 x[4] = {pos[q.x], pos[q.y], pos[q.z], pos[q.w]};
-        for (uint32_t j = 0; j < 4; ++j) addPush(q[j], contactPush(x[0], x[1], x[2], x[3], c, thickness, j), scale);
+        for (uint32_t j = 0; j < 4; ++j)
+          addFixed(sums_, q[j], contactPush(x[0], x[1], x[2], x[3], c, thickness, j), scale);
       }
     });
   };
@@ -270,6 +271,7 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
 
 // Each pair's half-spaces, weighed at `start` as computeBounds weighed it; `visit` sees each of its
 // particles' (a pair once, from any thread: what it sums and lowers must not depend on the order)
+// with the pair, its nearest points and the particle's place in it
 template <class Visit>
 void CpuContact::visitHalfSpaces(const std::vector<glm::vec4>& start, const SimUniforms& u, Visit&& visit) {
   const float radius = u.contact.x, fraction = u.contact.y;
@@ -285,7 +287,7 @@ void CpuContact::visitHalfSpaces(const std::vector<glm::vec4>& start, const SimU
         if (!(c.d2 < radius * radius)) continue;
         for (uint32_t j = 0; j < 4; ++j) {
           const SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, radius, fraction, j);
-          if (h.h.w >= 0.0f) visit(q[j], h);
+          if (h.h.w >= 0.0f) visit(q, c, edge, j, h);
         }
       }
     });
@@ -293,25 +295,38 @@ void CpuContact::visitHalfSpaces(const std::vector<glm::vec4>& start, const SimU
 }
 
 void CpuContact::slide(const std::vector<glm::vec4>& start, const std::vector<glm::vec4>& pos, const SimUniforms& u,
-                       std::vector<glm::vec4>& excess, std::vector<float>& share) {
+                       std::vector<glm::vec4>& passed, std::vector<glm::vec4>& excess, std::vector<float>& share) {
   const uint32_t n = uint32_t(pos.size());
   const float scale = u.contact.w;
+  passed.assign(n, glm::vec4(0.0f));
   excess.assign(n, glm::vec4(0.0f));
   share.assign(n, 1.0f);
-  sums_.assign(n, glm::ivec4(0));
-  auto step = [&](uint32_t i) { return vec3(pos[i]) - (vec3(start[i]) + frame_); };
-  auto pairs = [&](auto&& visit) { visitHalfSpaces(start, u, visit); };
   if (!lists_) return; // positions gone wrong: the bounds hold every particle
-  pairs([&](uint32_t i, const SlideHalf& h) {
-    const vec3 e = slideExcess(h, step(i));
-    if (e != vec3(0.0f)) addPush(i, e, scale);
+  auto pairs = [&](auto&& visit) { visitHalfSpaces(start, u, visit); };
+  // What each step's excess passes on to the other primitive of its pairs
+  sums_.assign(n, glm::ivec4(0));
+  pairs([&](const uvec4& q, const ContactPair& c, bool edge, uint32_t j, const SlideHalf& h) {
+    const vec3 e = slideExcess(h, vec3(pos[q[j]]) - (vec3(start[q[j]]) + frame_));
+    if (e == vec3(0.0f)) return;
+    for (uint32_t k = 0; k < 4; ++k)
+      if (contactOpposite(j, k, edge) && pos[q[k]].w > 0.0f) addFixed(sums_, q[k], contactPassed(e, c, k), scale);
+  });
+  for (uint32_t i = 0; i < n; ++i) passed[i] = glm::vec4(contactAverage(sums_[i], scale), 0.0f);
+  // The steps with what they are passed: their excess beyond their half-spaces, then the share
+  auto step = [&](uint32_t i) {
+    return passedPosition(pos[i], vec3(passed[i]), u.floor_y) - (vec3(start[i]) + frame_);
+  };
+  sums_.assign(n, glm::ivec4(0));
+  pairs([&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf& h) {
+    const vec3 e = slideExcess(h, step(q[j]));
+    if (e != vec3(0.0f)) addFixed(sums_, q[j], e, scale);
   });
   for (uint32_t i = 0; i < n; ++i) excess[i] = glm::vec4(contactAverage(sums_[i], scale), 0.0f);
   std::vector<uint32_t>& bits = share_bits_;
   bits.assign(n, std::bit_cast<uint32_t>(1.0f));
-  pairs([&](uint32_t i, const SlideHalf& h) {
-    const float s = slideShare(h, step(i) + vec3(excess[i]));
-    if (s < 1.0f) lower(bits[i], s);
+  pairs([&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf& h) {
+    const float s = slideShare(h, step(q[j]) + vec3(excess[q[j]]));
+    if (s < 1.0f) lower(bits[q[j]], s);
   });
   for (uint32_t i = 0; i < n; ++i) share[i] = std::bit_cast<float>(bits[i]);
 }
@@ -321,23 +336,23 @@ void CpuContact::listHalfSpaces(const std::vector<glm::vec4>& start, const SimUn
   const uint32_t n = uint32_t(start.size());
   half_start_.assign(n + 1, 0u);
   if (!lists_) return;
-  visitHalfSpaces(start, u, [&](uint32_t i, const SlideHalf&) {
-    std::atomic_ref<uint32_t>(half_start_[i + 1]).fetch_add(1u, std::memory_order_relaxed);
+  visitHalfSpaces(start, u, [&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf&) {
+    std::atomic_ref<uint32_t>(half_start_[q[j] + 1]).fetch_add(1u, std::memory_order_relaxed);
   });
   for (uint32_t i = 0; i < n; ++i) half_start_[i + 1] += half_start_[i];
   half_.resize(half_start_[n]);
   half_slack_.resize(half_start_[n]);
   half_fill_.assign(half_start_.begin(), half_start_.end() - 1);
-  visitHalfSpaces(start, u, [&](uint32_t i, const SlideHalf& h) {
-    const uint32_t k = std::atomic_ref<uint32_t>(half_fill_[i]).fetch_add(1u, std::memory_order_relaxed);
+  visitHalfSpaces(start, u, [&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf& h) {
+    const uint32_t k = std::atomic_ref<uint32_t>(half_fill_[q[j]]).fetch_add(1u, std::memory_order_relaxed);
     half_[k] = h.h;
     half_slack_[k] = h.slack;
   });
 }
 
-void CpuContact::addPush(uint32_t i, vec3 push, float scale) {
-  const glm::ivec3 f = contactFixed(push, scale);
-  int32_t* sum = &sums_[i].x;
+void CpuContact::addFixed(std::vector<glm::ivec4>& sums, uint32_t i, vec3 v, float scale) {
+  const glm::ivec3 f = contactFixed(v, scale);
+  int32_t* sum = &sums[i].x;
   for (uint32_t c = 0; c < 3; ++c) std::atomic_ref<int32_t>(sum[c]).fetch_add(f[c], std::memory_order_relaxed);
   std::atomic_ref<int32_t>(sum[3]).fetch_add(1, std::memory_order_relaxed);
 }
@@ -378,7 +393,7 @@ void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vec
     // The pushes that untangle the pair, summed in fixed point with the contact's
     for (uint32_t k = 0; k < 6; ++k) {
       const vec3 push = untanglePush(x[0], x[1], x[2], x[3], x[4], x[5], gap, k);
-      if (push != vec3(0.0f)) addPush(k < 3 ? a[k] : b[k - 3], push, scale);
+      if (push != vec3(0.0f)) addFixed(sums_, k < 3 ? a[k] : b[k - 3], push, scale);
     }
   };
   const uint32_t checked = uint32_t(checked_.size());

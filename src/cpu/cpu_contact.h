@@ -42,11 +42,13 @@ public:
                      const std::vector<glm::uvec4>& triangles, uint32_t count, const shaderio::SimUniforms& u,
                      uint32_t s, std::vector<float>& bound, std::vector<glm::vec4>& push);
   /// The half-spaces of the pairs of the last computeBounds on the steps of the substep (the
-  /// particles from `start`, where that call had them, to `pos`, less frame()): each particle's
-  /// excess beyond them, the mean of slideExcess over its pairs, into `excess`, and the share of its
-  /// step with that taken out that keeps every one, the least slideShare, into `share` (slideStep).
+  /// particles from `start`, where that call had them, to `pos`, less frame()): what each particle
+  /// is passed of the excess of the steps of its pairs' other primitives, the mean of
+  /// contactPassed, into `passed`; the excess of its step with that (passedPosition) beyond them,
+  /// the mean of slideExcess over its pairs, into `excess`; and the share of that step with the
+  /// excess taken out that keeps every one, the least slideShare, into `share` (slideStep).
   void slide(const std::vector<glm::vec4>& start, const std::vector<glm::vec4>& pos, const shaderio::SimUniforms& u,
-             std::vector<glm::vec4>& excess, std::vector<float>& share);
+             std::vector<glm::vec4>& passed, std::vector<glm::vec4>& excess, std::vector<float>& share);
   /// Lists each particle's half-spaces of the last computeBounds's pairs (those slide cuts the
   /// steps to; the pairs from `start`, where that call had the particles) for the settle stage.
   void listHalfSpaces(const std::vector<glm::vec4>& start, const shaderio::SimUniforms& u);
@@ -107,15 +109,15 @@ private:
   /// a flat one, and an edge looks only at the edges after it, so the first edges cost the most
   static constexpr uint32_t kSearchShares = 8;
 
-  /// Calls visit(particle, SlideHalf) for each half-space the pairs closer than the radius set
-  /// their particles at `start`, from the pool's threads.
+  /// Calls visit(pair, ContactPair, edge, j, SlideHalf) for each half-space the pairs closer than
+  /// the radius set their particles (particle j of the pair) at `start`, from the pool's threads.
   template <class Visit>
   void visitHalfSpaces(const std::vector<glm::vec4>& start, const shaderio::SimUniforms& u, Visit&& visit);
   /// Box tests below which the crossing check tests its triangles against every triangle
   static constexpr uint64_t kBruteForceTests = 1u << 20;
   /// Adds a push to particle i's sum in fixed point (contactFixed, `scale` units a unit of length)
   /// and counts it; from any thread (the integer sums give the same bits in any order).
-  void addPush(uint32_t i, glm::vec3 push, float scale);
+  static void addFixed(std::vector<glm::ivec4>& sums, uint32_t i, glm::vec3 v, float scale);
   /// Sets free_ to the particles of the triangles that cross another, among the pairs with one of
   /// the triangles crossingChecked names (contact.h), and adds each crossing pair's untanglePush to
   /// the sums (`gap`: how far beyond, `scale`: their fixed point); the last call's free_ is was_free_.

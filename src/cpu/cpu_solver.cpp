@@ -284,14 +284,15 @@ void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
     }
   });
   if (!contact) return;
-  // The steps' excess beyond their pairs' half-spaces and the share that keeps them, then each
-  // step cut to them and to its bound
-  contact_.slide(start_, pos_, u, excess_, share_);
+  // What each step is passed by its pairs, its excess beyond their half-spaces and the share that
+  // keeps them, then each step with what it is passed cut to them and to its bound
+  contact_.slide(start_, pos_, u, passed_, excess_, share_);
   pool_->parallelFor(n, grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
     for (uint32_t i = begin; i < end; ++i) {
       if (!contactBounded(pos_[i].w, i == u.grab_index, u.grab_target[s].w)) continue;
-      const VerletState st = slideStep(VerletState{pos_[i], prev_[i]}, vec3(start_[i]), vec3(push_[i]),
-                                       vec3(excess_[i]), share_[i], bound_[i], frame);
+      const VerletState passed = passedState(VerletState{pos_[i], prev_[i]}, vec3(passed_[i]), u.floor_y);
+      const VerletState st =
+          slideStep(passed, vec3(start_[i]), vec3(push_[i]), vec3(excess_[i]), share_[i], bound_[i], frame);
       pos_[i] = st.position;
       prev_[i] = st.previous;
     }
@@ -555,7 +556,8 @@ uint64_t CpuSolver::memoryBytes() const {
          capacityBytes(torn_) + capacityBytes(hinges_) + capacityBytes(con_a_) + capacityBytes(con_b_) +
          capacityBytes(con_kind_) + capacityBytes(con_id_) + capacityBytes(con_rest_) + capacityBytes(con_hinge_) +
          capacityBytes(hinge_corners_) + capacityBytes(triangles_) + collision_.memoryBytes() + contact_.memoryBytes() +
-         capacityBytes(start_) + capacityBytes(bound_) + capacityBytes(push_);
+         capacityBytes(start_) + capacityBytes(bound_) + capacityBytes(push_) + capacityBytes(passed_) +
+         capacityBytes(excess_) + capacityBytes(share_);
 }
 
 } // namespace tender

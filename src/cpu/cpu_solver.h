@@ -152,6 +152,7 @@ private:
   bool contact_on_ = false;       ///< the last tick had contact on
   std::vector<glm::vec4> start_;  ///< with contact on: the positions at the start of the substep
   std::vector<float> bound_;      ///< with contact on: each particle's step bound in this substep
+  std::vector<glm::vec4> passed_; ///< with contact on: what each step is passed by its pairs (contactPassed)
   std::vector<glm::vec4> excess_; ///< with contact on: each step's excess beyond its pairs' half-spaces
   std::vector<float> share_;      ///< with contact on: the share of each step that keeps them
   std::vector<glm::vec4> push_;   ///< with contact on: the push parting its contacts (CpuContact)

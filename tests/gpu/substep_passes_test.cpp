@@ -123,7 +123,8 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   expected.push_back("limit");
   expected.push_back("crease");
   // The floor, then the steps cut to their pairs' half-spaces
-  for (const char* k : {"floor", "contact_excess", "contact_share", "contact_step"}) expected.push_back(k);
+  for (const char* k : {"floor", "contact_pass", "contact_excess", "contact_share", "contact_step"})
+    expected.push_back(k);
   // The settle: whether an edge is over the limit, the half-spaces counted by particle, scanned (one
   // block here) and listed, then in each sweep every colour that holds edges
   ASSERT_LE(topo.particleCount() + 1, SIM_SCAN_BLOCK);

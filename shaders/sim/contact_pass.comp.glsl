@@ -1,0 +1,14 @@
+#version 460
+// Contact (contact.glsl), after the floor: each query's pairs from where the particles started the
+// substep, each step's excess beyond its pairs' half-spaces passed on in part to the other
+// primitive's particles (slidePair), before contact_excess weighs the steps with what they are passed.
+// Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
+#define SIM_LOCAL_SIZE SIM_WG_PARTICLES
+#define SIM_PUSH_TYPE SimPush
+#include "contact.glsl"
+#include "sim_common.glsl"
+
+void main() {
+  uint k = threadIndex();
+  if (k < p.count) contactNear(k, NEAR_PASS);
+}
