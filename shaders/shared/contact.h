@@ -363,8 +363,8 @@ SIM_INLINE vec3 passedPosition(vec4 p, vec3 passed, float floor_y) {
 
 /// A particle's state moved by its passed step (passedPosition), its previous position with it: the
 /// step moves it without speeding it up, as the push does. (Passed as a velocity, a tenth of the
-/// excess kept two pressed layers of a crumple on the floor shaking in turn at 1.4 units/s, each
-/// substep's pass answering the last.)
+/// excess kept four particles of a fold of a crumple on the floor shaking in turn at 1.4 units/s,
+/// each substep's pass answering the last.)
 SIM_INLINE VerletState passedState(VerletState st, vec3 passed, float floor_y) {
   vec3 x = passedPosition(st.position, passed, floor_y);
   vec3 d = x - vec3(st.position);
