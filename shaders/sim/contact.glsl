@@ -515,9 +515,10 @@ void slidePair(uvec4 q, vec3 x0, vec3 x1, vec3 x2, vec3 x3, ContactPair c, bool 
       vec3 e = slideExcess(h, vec3(SIM_POSITION(i)) - start);
       if (e == vec3(0.0f)) continue;
       for (uint k = 0u; k < 4u; ++k) {
+        if (!contactOpposite(j, k, edge)) continue;
         uint o = pairParticle(q, k);
         vec4 x = SIM_POSITION(o); // whole (see contactSlideStep)
-        if (contactOpposite(j, k, edge) && x.w > 0.0f) addPassed(o, contactPassed(e, c, k));
+        if (x.w > 0.0f) addPassed(o, contactPassed(e, c, k));
       }
       continue;
     }
