@@ -58,8 +58,10 @@ TEST(Params, OverridesParseAndValidate) {
   EXPECT_FALSE(p.collision);
   EXPECT_FALSE(applyOverride(p, "gravity=3.5"));
   EXPECT_FLOAT_EQ(p.gravity, 3.5f);
-  for (const char* bad : {"nope=1", "cols=0", "cols=-3", "cols=1e3", "damping=1.01", "damping=x", "gravity=nan",
-                          "gravity=inf", "pins=middle", "wind=maybe", "substeps=33", "cols", "=4", "cols=99999999999"})
+  for (const char* bad :
+       {"nope=1", "cols=0", "cols=-3", "cols=1e3", "damping=1.01", "damping=x", "gravity=nan", "gravity=inf",
+        "pins=middle", "wind=maybe", "substeps=33", "cols", "=4", "cols=99999999999", "contact_factor=-0.5",
+        "contact_factor=nan", "contact_factor=1e30", "contact_settle=65", "contact_settle=-1"})
     EXPECT_TRUE(applyOverride(p, bad)) << bad;
 }
 
