@@ -106,6 +106,10 @@ void headlessOptionsFor(const CommonOptions& common, const RenderOptions& o, con
                         render::HeadlessOptions& out);
 /// `tender render --video`: every frame of the run piped to ffmpeg (H.264 MP4).
 int runVideo(const CommonOptions& common, const RenderOptions& o);
+/// The program's main job: `tender` launches tender-demo (or, without a renderer, runs the simulation
+/// headless); tender-demo opens its window.
 int runDemo(const CommonOptions& common, const DemoOptions& o);
+/// The name --version prints: defined beside runDemo, by the file that makes each program what it is.
+extern const char* const kProgramName;
 
 } // namespace tender

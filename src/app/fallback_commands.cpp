@@ -9,6 +9,8 @@ int runRender(const CommonOptions&, const RenderOptions&) {
   return fail("this build has no renderer (configure with TENDER_VULKAN=ON)");
 }
 
+const char* const kProgramName = "tender";
+
 int runDemo(const CommonOptions& common, const DemoOptions&) {
   std::printf("tender: no renderer in this build; running the simulation headless\n");
   SimOptions o;

@@ -75,6 +75,8 @@ int launchDemo(const std::filesystem::path& demo) {
 
 } // namespace
 
+const char* const kProgramName = "tender";
+
 int runDemo(const CommonOptions& common, const DemoOptions& o) {
   std::error_code ec;
   const std::filesystem::path demo = std::filesystem::read_symlink("/proc/self/exe", ec).parent_path() / "tender-demo";

@@ -7,10 +7,6 @@
 #include "commands.h"
 #include "core/output.h"
 
-#ifndef TENDER_PROGRAM
-#define TENDER_PROGRAM "tender" // tender-demo names itself (its man page is its own)
-#endif
-
 namespace tender {
 
 namespace {
@@ -67,7 +63,7 @@ std::optional<std::string> resolve(CommonOptions& o) {
 int main(int argc, char** argv) {
   using namespace tender;
   CLI::App app{"Tender: a sheet of receipt paper to grab, crumple, fold, toss and tear."};
-  app.set_version_flag("--version", std::string(TENDER_PROGRAM " ") + TENDER_VERSION);
+  app.set_version_flag("--version", std::string(kProgramName) + " " + TENDER_VERSION);
   app.footer(keyList());
   app.require_subcommand(0, 1);
 

@@ -396,6 +396,8 @@ void DemoApp::printCamera() const {
               follow_on_ ? "on" : "off", double(t.x), double(t.y), double(t.z), centre);
 }
 
+const char* const kProgramName = "tender-demo";
+
 int runDemo(const CommonOptions& common, const DemoOptions& options) {
   DemoApp app(common, options);
   return app.run();
