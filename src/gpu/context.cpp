@@ -374,9 +374,31 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   return R(std::move(ctx));
 }
 
+VkPipeline VulkanContext::sharedPipeline(const std::string& name,
+                                         const std::function<VkPipeline(VkShaderModule&)>& make) {
+  {
+    std::lock_guard lock(pipelines_mutex_);
+    if (auto it = pipelines_.find(name); it != pipelines_.end()) return it->second.first;
+  }
+  // Made outside the lock (seconds on a CPU device); a twin made meanwhile wins
+  VkShaderModule module = VK_NULL_HANDLE;
+  VkPipeline pipeline = make(module);
+  std::lock_guard lock(pipelines_mutex_);
+  auto [it, added] = pipelines_.try_emplace(name, pipeline, module);
+  if (!added) {
+    vkDestroyPipeline(device_, pipeline, nullptr);
+    vkDestroyShaderModule(device_, module, nullptr);
+  }
+  return it->second.first;
+}
+
 VulkanContext::~VulkanContext() {
   if (device_) {
     vkDeviceWaitIdle(device_);
+    for (auto& [name, made] : pipelines_) {
+      vkDestroyPipeline(device_, made.first, nullptr);
+      vkDestroyShaderModule(device_, made.second, nullptr);
+    }
     if (once_fence_) vkDestroyFence(device_, once_fence_, nullptr);
     if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
     vkDestroyDevice(device_, nullptr);

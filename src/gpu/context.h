@@ -15,7 +15,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -153,6 +155,12 @@ public:
   uint32_t validationMessages() const { return validation_messages_.load(); }
   bool validationEnabled() const { return validation_; }
 
+  /// The pipeline `name` names, made by `make` (which sets the shader module to destroy with it)
+  /// the first time it is asked for: the simulation's pipelines, which every solver and fleet on
+  /// this context shares (sim_pipeline.h, SimLayout), live until the context does. Thread-safe:
+  /// pipelines of different names are made side by side.
+  VkPipeline sharedPipeline(const std::string& name, const std::function<VkPipeline(VkShaderModule&)>& make);
+
   /// Creates a buffer in device-local memory.
   Buffer createDeviceBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
   /// Creates a persistently mapped host-visible, host-coherent buffer.
@@ -198,6 +206,8 @@ private:
   bool validation_ = false, quiet_ = false;
   bool device_addresses_ = false;
   std::atomic<uint32_t> validation_messages_{0};
+  std::mutex pipelines_mutex_;
+  std::map<std::string, std::pair<VkPipeline, VkShaderModule>> pipelines_; ///< sharedPipeline's
 };
 
 /// Sets VK_DRIVER_FILES to lavapipe when it is unset (tests: results independent of the machine).

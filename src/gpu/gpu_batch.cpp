@@ -84,7 +84,6 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
   VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &layout_));
   float_rules_ = floatRulesFor(ctx_.floatControls());
   math_ = MathSwitches::fromEnvironment();
-  passes_ = makePassPipelines(ctx_, layout_, float_rules_, math_, true, owned_pipelines_);
   // The fused tick's shape on this kind of device (see FusedShape in gpu_solver.h); a device with
   // too little shared memory for it runs every sheet's per-colour passes, as a sheet alone does.
   const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
@@ -95,6 +94,8 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
   fused_max_cell_spacings_ = shape.max_cell_spacings;
   sheets_per_group_ = std::max(1u, std::thread::hardware_concurrency()) * SIM_BATCH_CPU_SHEETS_PER_THREAD;
   per_sheet_ = passes == BatchPasses::PerSheet || (passes == BatchPasses::Auto && cpu_device);
+  // The batched passes, or each sheet's (below): only those this batch records
+  if (!per_sheet_) passes_ = makePassPipelines(ctx_, {layout_, "batch"}, float_rules_, math_, true);
   {
     // The layouts of one sheet's passes at a time (per_sheet_)
     sheet_set_layout_ = createSheetSetLayout(dev);
@@ -103,12 +104,11 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
     pli.pSetLayouts = &sheet_set_layout_;
     pli.pPushConstantRanges = &sheet_range;
     VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &sheet_layout_));
-    if (per_sheet_)
-      sheet_passes_ = makePassPipelines(ctx_, sheet_layout_, float_rules_, math_, false, owned_pipelines_);
+    if (per_sheet_) sheet_passes_ = makePassPipelines(ctx_, {sheet_layout_, "sheet"}, float_rules_, math_, false);
   }
   if (fusedTickSupported(ctx_))
-    tick_batch_ = makeComputePipeline(ctx_, "tick_batch.comp", layout_, float_rules_, math_, sizeof(BatchPush), 1,
-                                      shape.workgroup, true, owned_pipelines_);
+    tick_batch_ = makeComputePipeline(ctx_, "tick_batch.comp", {layout_, "batch"}, float_rules_, math_,
+                                      sizeof(BatchPush), 1, shape.workgroup, true);
 
   VkFenceCreateInfo fci{};
   fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
@@ -149,7 +149,6 @@ GpuBatch::~GpuBatch() {
   ctx_.destroyBuffer(inputs_);
   if (cmd_) vkFreeCommandBuffers(dev, ctx_.commandPool(), 1, &cmd_);
   if (fence_) vkDestroyFence(dev, fence_, nullptr);
-  owned_pipelines_.destroy(dev);
   if (sheet_pool_) vkDestroyDescriptorPool(dev, sheet_pool_, nullptr);
   if (sheet_layout_) vkDestroyPipelineLayout(dev, sheet_layout_, nullptr);
   if (sheet_set_layout_) vkDestroyDescriptorSetLayout(dev, sheet_set_layout_, nullptr);
@@ -278,8 +277,8 @@ void GpuBatch::flush() {
   queue.insert(queue.end(), fused_contact.begin(), fused_contact.end());
   queue.insert(queue.end(), passes.begin(), passes.end());
   if (!fused_contact.empty() && !tick_batch_contact_.pipeline)
-    tick_batch_contact_ = makeComputePipeline(ctx_, "tick_batch_contact.comp", layout_, float_rules_, math_,
-                                              sizeof(BatchPush), 1, fused_workgroup_, true, owned_pipelines_);
+    tick_batch_contact_ = makeComputePipeline(ctx_, "tick_batch_contact.comp", {layout_, "batch"}, float_rules_, math_,
+                                              sizeof(BatchPush), 1, fused_workgroup_, true);
   std::memcpy(inputs, queue.data(), 4 * queue.size());
   const VkDeviceSize args_at = uniforms_at + stride_[SIM_BIND_UNIFORMS] * size();
 
@@ -297,9 +296,9 @@ void GpuBatch::flush() {
   VkBufferCopy queue_region{0, 0, 4ull * queue.size()};
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_QUEUE].buffer, 1, &queue_region);
   if (plan.contact && per_sheet_)
-    addContactPipelines(ctx_, sheet_layout_, float_rules_, math_, std::nullopt, sheet_passes_, owned_pipelines_);
+    addContactPipelines(ctx_, {sheet_layout_, "sheet"}, float_rules_, math_, std::nullopt, sheet_passes_);
   else if (plan.contact)
-    addContactPipelines(ctx_, layout_, float_rules_, math_, std::nullopt, passes_, owned_pipelines_, true);
+    addContactPipelines(ctx_, {layout_, "batch"}, float_rules_, math_, std::nullopt, passes_, true);
   if (!passes.empty() && per_sheet_) {
     // Each sheet's full grids of the hash passes and of contact's grid passes, which its
     // candidates_decide and contact_arm copy to the live ones

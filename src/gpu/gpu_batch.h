@@ -89,7 +89,6 @@ private:
   std::vector<std::unique_ptr<QueuedSolver>> queued_;
 
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  PipelineSet owned_pipelines_;
   ComputePipeline tick_batch_;         ///< the fused tick of a batch (null: the device has too little shared memory)
   ComputePipeline tick_batch_contact_; ///< ... with contact's bodies (made when a sheet first takes it)
   uint32_t fused_workgroup_ = 0;       ///< the fused tick's workgroup (FusedShape)

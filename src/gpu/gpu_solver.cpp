@@ -37,7 +37,6 @@ GpuSolver::~GpuSolver() {
   if (normals_fence_) vkDestroyFence(dev, normals_fence_, nullptr);
   if (normals_queries_) vkDestroyQueryPool(dev, normals_queries_, nullptr);
   ctx_.destroyBuffer(small_readback_);
-  owned_pipelines_.destroy(dev);
   if (layout_) vkDestroyPipelineLayout(dev, layout_, nullptr);
   if (set_layout_) vkDestroyDescriptorSetLayout(dev, set_layout_, nullptr);
 }
@@ -61,7 +60,6 @@ void GpuSolver::createPipelines(FusedShape fused) {
   // (TENDER_UNCORRECTED_MATH=1).
   float_rules_ = floatRulesFor(ctx_.floatControls());
   math_ = MathSwitches::fromEnvironment();
-  pipes_ = makePassPipelines(ctx_, layout_, float_rules_, math_, false, owned_pipelines_);
   // The fused tick keeps the positions in shared memory; its shape suits the device.
   const FusedShape shape = resolveFusedShape(ctx_, fused);
   const uint32_t fused_workgroup = shape.workgroup;
@@ -69,12 +67,12 @@ void GpuSolver::createPipelines(FusedShape fused) {
   fused_substeps_ = shape.substeps_per_dispatch;
   fused_max_cell_spacings_ = shape.max_cell_spacings;
   fused_contact_ = shape.contact > 0;
+  // The per-colour passes, the fused tick and the picks, made together (contact's wait for contact)
+  std::vector<PipelineRequest> requests = passPipelineRequests(ctx_, pipes_, false);
   if (fusedTickSupported(ctx_))
-    pipes_.tick_fused = makeComputePipeline(ctx_, "tick_fused.comp", layout_, float_rules_, math_, sizeof(FusedPush), 1,
-                                            fused_workgroup, true, owned_pipelines_);
-  for (uint32_t s = 0; s < 3; ++s)
-    pipes_.pick[s] = makeComputePipeline(ctx_, "pick.comp", layout_, float_rules_, math_, sizeof(PickPush), 1, s, false,
-                                         owned_pipelines_);
+    requests.push_back({&pipes_.tick_fused, "tick_fused.comp", sizeof(FusedPush), 1, fused_workgroup, true});
+  for (uint32_t s = 0; s < 3; ++s) requests.push_back({&pipes_.pick[s], "pick.comp", sizeof(PickPush), 1, s, false});
+  makeComputePipelines(ctx_, {layout_, "solver"}, float_rules_, math_, requests);
 
   // Per tick in flight: fences and timestamp pools (chain of timestamps at pass boundaries).
   query_capacity_ = 2 + marksPerSubstep() * SIM_MAX_SUBSTEPS;
@@ -136,9 +134,8 @@ void GpuSolver::tick(const SimUniforms& u) {
   if (contact) {
     // The contact's buffers and pipelines, the first time contact is on
     if (!layout_sizes_.contact) sizeContact();
-    addContactPipelines(ctx_, layout_, float_rules_, math_,
-                        pipes_.tick_fused.pipeline ? std::optional<uint32_t>(fused_workgroup_) : std::nullopt, pipes_,
-                        owned_pipelines_);
+    addContactPipelines(ctx_, {layout_, "solver"}, float_rules_, math_,
+                        pipes_.tick_fused.pipeline ? std::optional<uint32_t>(fused_workgroup_) : std::nullopt, pipes_);
   }
   last_contact_ = contact;
   const uint32_t index = next_in_flight_;

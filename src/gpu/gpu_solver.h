@@ -201,7 +201,6 @@ private:
   VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   SimPipelines pipes_;
-  PipelineSet owned_pipelines_;   ///< every pipeline created, for the destructor
   InFlight* recording_ = nullptr; ///< the tick in flight being recorded
 
   std::array<Buffer, kBindingCount> buf_{};

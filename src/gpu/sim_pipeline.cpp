@@ -1,10 +1,14 @@
 #include "gpu/sim_pipeline.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <string>
 #include <string_view>
+#include <system_error>
+#include <thread>
 
 #include "gpu/barriers.h"
 #include "gpu/shaders.h"
@@ -86,28 +90,68 @@ uint32_t localSizeX(std::span<const uint32_t> code) {
 
 } // namespace
 
-void PipelineSet::destroy(VkDevice dev) {
-  for (VkPipeline p : pipelines) vkDestroyPipeline(dev, p, nullptr);
-  for (VkShaderModule m : modules) vkDestroyShaderModule(dev, m, nullptr);
-  pipelines.clear();
-  modules.clear();
-}
+namespace {
 
-ComputePipeline makeComputePipeline(VulkanContext& ctx, std::string_view key, VkPipelineLayout layout,
-                                    const FloatRules& rules, MathSwitches math, uint32_t push_size,
-                                    uint32_t per_invocation, std::optional<uint32_t> spec0, bool spec0_is_size,
-                                    PipelineSet& owned) {
-  ComputePipeline p;
-  VkShaderModule module = VK_NULL_HANDLE;
-  p.pipeline = createSimPipeline(ctx, key, layout, rules, math, spec0, module);
-  owned.modules.push_back(module);
-  owned.pipelines.push_back(p.pipeline);
-  p.push_size = push_size;
-  // The workgroup size comes from the shader itself (its local_size_x, or the specialised size).
+/// The workgroup of a pipeline of `key`: its local_size_x (or the specialised size) times the
+/// elements an invocation takes.
+uint32_t workgroupOf(std::string_view key, uint32_t per_invocation, std::optional<uint32_t> spec0, bool spec0_is_size) {
   const uint32_t local = spec0_is_size && spec0 ? *spec0 : localSizeX(simShader(key));
   if (local == 0) vkCheckFailed(VK_ERROR_INITIALIZATION_FAILED, std::string(key).c_str(), __FILE__, __LINE__);
-  p.workgroup = local * per_invocation;
+  return local * per_invocation;
+}
+
+} // namespace
+
+ComputePipeline makeComputePipeline(VulkanContext& ctx, std::string_view key, const SimLayout& layout,
+                                    const FloatRules& rules, MathSwitches math, uint32_t push_size,
+                                    uint32_t per_invocation, std::optional<uint32_t> spec0, bool spec0_is_size) {
+  PipelineRequest request{nullptr, std::string(key), push_size, per_invocation, spec0, spec0_is_size};
+  ComputePipeline p;
+  request.out = &p;
+  makeComputePipelines(ctx, layout, rules, math, std::span<PipelineRequest>(&request, 1));
   return p;
+}
+
+void makeComputePipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
+                          std::span<PipelineRequest> requests) {
+  // The workgroups first: a missing shader throws before anything is compiled
+  for (PipelineRequest& r : requests) {
+    r.out->push_size = r.push_size;
+    r.out->workgroup = workgroupOf(r.key, r.per_invocation, r.spec0, r.spec0_is_size);
+  }
+  // The context's name of each: everything that makes one pipeline differ from another
+  std::vector<std::string> names;
+  for (const PipelineRequest& r : requests)
+    names.push_back(r.key + "|" + layout.kind + "|" + (r.spec0 ? std::to_string(*r.spec0) : "-") + "|" +
+                    std::to_string(int(math.inexact)) + std::to_string(int(math.corrected)) +
+                    std::to_string(int(rules.rounding_rte)) + std::to_string(int(rules.denormals)));
+  // Drivers compile a pipeline on the calling thread (lavapipe: seconds for the large kernels), so
+  // each thread takes the next request; the context makes each name once.
+  std::vector<std::exception_ptr> errors(requests.size());
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t k; (k = next.fetch_add(1)) < requests.size();) {
+      try {
+        const PipelineRequest& r = requests[k];
+        r.out->pipeline = ctx.sharedPipeline(names[k], [&](VkShaderModule& module) {
+          return createSimPipeline(ctx, r.key, layout.layout, rules, math, r.spec0, module);
+        });
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    }
+  };
+  const size_t threads = std::min<size_t>(requests.size(), std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<std::thread> helpers;
+  try {
+    for (size_t t = 1; t < threads; ++t) helpers.emplace_back(work);
+  } catch (const std::system_error&) {
+    // no more threads: the calling thread takes what is left
+  }
+  work();
+  for (std::thread& t : helpers) t.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
 }
 
 namespace {
@@ -139,35 +183,42 @@ uint32_t limitWorkgroup(const VulkanContext& ctx) {
       {uint32_t(SIM_WG_LIMIT_GPU), limits.maxComputeWorkGroupInvocations, limits.maxComputeWorkGroupSize[0]});
 }
 
-SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
-                               bool batched, PipelineSet& owned) {
+std::vector<PipelineRequest> passPipelineRequests(const VulkanContext& ctx, SimPipelines& pipes, bool batched) {
   using namespace shaderio;
-  SimPipelines pipes;
+  std::vector<PipelineRequest> requests;
   for (const PipelineSpec& spec : kPasses) {
     if ((batched && !spec.batched) || isContactKernel(spec)) continue;
     const std::string key = batched ? std::string(spec.key) + ".batch" : std::string(spec.key);
     // The stretch limit's workgroup is the device's (specialization constant 0)
     const std::optional<uint32_t> size =
         spec.member == &SimPipelines::limit ? std::optional<uint32_t>(limitWorkgroup(ctx)) : std::nullopt;
-    pipes.*spec.member =
-        makeComputePipeline(ctx, key, layout, rules, math, batched ? uint32_t(sizeof(BatchPassPush)) : spec.push_size,
-                            spec.per_invocation, size, size.has_value(), owned);
+    requests.push_back({&(pipes.*spec.member), key, batched ? uint32_t(sizeof(BatchPassPush)) : spec.push_size,
+                        spec.per_invocation, size, size.has_value()});
   }
+  return requests;
+}
+
+SimPipelines makePassPipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
+                               bool batched) {
+  SimPipelines pipes;
+  std::vector<PipelineRequest> requests = passPipelineRequests(ctx, pipes, batched);
+  makeComputePipelines(ctx, layout, rules, math, requests);
   return pipes;
 }
 
-void addContactPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
-                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, PipelineSet& owned,
-                         bool batched) {
+void addContactPipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
+                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, bool batched) {
   using namespace shaderio;
+  std::vector<PipelineRequest> requests;
   for (const PipelineSpec& spec : kPasses)
     if (isContactKernel(spec) && !(pipes.*spec.member).pipeline)
-      pipes.*spec.member = makeComputePipeline(
-          ctx, batched ? std::string(spec.key) + ".batch" : std::string(spec.key), layout, rules, math,
-          batched ? uint32_t(sizeof(BatchPassPush)) : spec.push_size, spec.per_invocation, std::nullopt, false, owned);
+      requests.push_back({&(pipes.*spec.member), batched ? std::string(spec.key) + ".batch" : std::string(spec.key),
+                          batched ? uint32_t(sizeof(BatchPassPush)) : spec.push_size, spec.per_invocation, std::nullopt,
+                          false});
   if (fused_workgroup && !pipes.tick_fused_contact.pipeline)
-    pipes.tick_fused_contact = makeComputePipeline(ctx, "tick_fused_contact.comp", layout, rules, math,
-                                                   sizeof(FusedPush), 1, *fused_workgroup, true, owned);
+    requests.push_back(
+        {&pipes.tick_fused_contact, "tick_fused_contact.comp", sizeof(FusedPush), 1, *fused_workgroup, true});
+  makeComputePipelines(ctx, layout, rules, math, requests);
 }
 
 void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math, MathOp op) {

@@ -4,6 +4,8 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -50,21 +52,37 @@ struct SimPipelines {
   std::array<ComputePipeline, 3> pick;
 };
 
-/// Pipelines and modules to destroy together.
-struct PipelineSet {
-  std::vector<VkShaderModule> modules;
-  std::vector<VkPipeline> pipelines;
-  void destroy(VkDevice dev);
+/// A pipeline layout of the simulation's kernels and its kind. Layouts of one kind are defined alike
+/// (the same set layouts and push-constant range: compatible, in Vulkan's words), so a pipeline made
+/// on one serves them all: the context keeps one pipeline per kernel, kind, specialization and math
+/// for every solver and fleet on it (VulkanContext::sharedPipeline).
+struct SimLayout {
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  const char* kind = ""; ///< "sheet" (a sheet's set, SimPush), "solver" (a sheet's set, PickPush), "batch"
 };
 
 /// A ComputePipeline of shaders/sim/<key>.glsl (see createSimPipeline) whose push constants take
 /// `push_size` bytes and whose invocations take `per_invocation` elements each; the workgroup size
 /// comes from the SPIR-V, or is `spec0` for a shader whose size is specialization constant 0
-/// (`spec0_is_size`). What it creates joins `owned`.
-ComputePipeline makeComputePipeline(VulkanContext& ctx, std::string_view key, VkPipelineLayout layout,
+/// (`spec0_is_size`). The context keeps it (SimLayout).
+ComputePipeline makeComputePipeline(VulkanContext& ctx, std::string_view key, const SimLayout& layout,
                                     const FloatRules& rules, MathSwitches math, uint32_t push_size,
-                                    uint32_t per_invocation, std::optional<uint32_t> spec0, bool spec0_is_size,
-                                    PipelineSet& owned);
+                                    uint32_t per_invocation, std::optional<uint32_t> spec0, bool spec0_is_size);
+
+/// One pipeline of makeComputePipelines: what makeComputePipeline takes, and where it goes.
+struct PipelineRequest {
+  ComputePipeline* out;
+  std::string key;
+  uint32_t push_size, per_invocation;
+  std::optional<uint32_t> spec0;
+  bool spec0_is_size;
+};
+
+/// The pipelines of `requests`: those the context has not made yet compiled side by side on every
+/// core (drivers compile on the calling thread). Each goes to its request's `out`; when any fails,
+/// the first error is thrown after every other has been made.
+void makeComputePipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
+                          std::span<PipelineRequest> requests);
 
 /// Invocations of the stretch limit's workgroup (limit.comp) on this device: SIM_WG_LIMIT on a CPU
 /// device, SIM_WG_LIMIT_GPU (or the device's most) on a GPU.
@@ -74,16 +92,18 @@ uint32_t limitWorkgroup(const VulkanContext& ctx);
 /// `layout`: a sheet's own, or a fleet's (`batched`: the SIM_BATCH_PASS builds, "<key>.batch",
 /// whose push constants are BatchPassPush; no normals pass). The contact's kernels (contact_*)
 /// wait for addContactPipelines.
-SimPipelines makePassPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
-                               bool batched, PipelineSet& owned);
+SimPipelines makePassPipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
+                               bool batched);
+
+/// What makePassPipelines makes, as requests into `pipes` (to make with others).
+std::vector<PipelineRequest> passPipelineRequests(const VulkanContext& ctx, SimPipelines& pipes, bool batched);
 
 /// Adds the contact's kernels (contact_*) to `pipes`, passes on `layout` as makePassPipelines
 /// makes them (`batched`: a fleet's), and, with `fused_workgroup` set, the fused tick with contact
 /// (tick_fused_contact): made when a sheet first has contact on, so that a solver without it does
 /// not compile them. Nothing when they are made.
-void addContactPipelines(VulkanContext& ctx, VkPipelineLayout layout, const FloatRules& rules, MathSwitches math,
-                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, PipelineSet& owned,
-                         bool batched = false);
+void addContactPipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
+                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, bool batched = false);
 
 /// One input of the device math check and its results (bits of floats).
 struct MathCase {
