@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The GPU proof kit: tools/gpu-bundle packs this build's programs into a folder, a copy of the
-# folder elsewhere (the original removed) runs `gpu-check --quick` in an environment holding only
+# folder elsewhere (the original removed) runs `gpu-check --smoke` (every check once, on the least
+# that runs it; the full and quick runs are for real GPUs) in an environment holding only
 # PATH, HOME and the driver (lavapipe), exits 0 and writes a report naming every check; bad usage
 # exits 2 with one line. Also the kit's shape: at most 60 MiB, stripped programs with an RPATH
 # into the kit, a validation layer manifest that points into the kit.
@@ -42,15 +43,15 @@ grep -q '"library_path": "../../../lib/libVkLayer_khronos_validation.so"' \
 scrubbed=(env -i PATH=/usr/bin:/bin HOME="$tmp" VK_DRIVER_FILES="$DRIVER")
 "${scrubbed[@]}" "$kit/tender" --version | grep -q '^tender ' || fail "the kit's tender --version"
 
-# gpu-check --quick from the copy, in a scrubbed environment.
+# gpu-check --smoke from the copy, in a scrubbed environment.
 start=$(date +%s)
 # Two shards: the tests' logs are gathered from two processes (one on a 2-core machine otherwise).
-"${scrubbed[@]}" "$kit/gpu-check" --quick --shards 2 --out "$tmp/report" >"$tmp/check.out" 2>&1
+"${scrubbed[@]}" "$kit/gpu-check" --smoke --shards 2 --out "$tmp/report" >"$tmp/check.out" 2>&1
 rc=$?
-echo "gpu-check --quick: exit $rc in $(($(date +%s) - start)) s"
+echo "gpu-check --smoke: exit $rc in $(($(date +%s) - start)) s"
 report=$tmp/report/report.md
 if [ "$rc" -ne 0 ]; then
-  fail "gpu-check --quick exited $rc"
+  fail "gpu-check --smoke exited $rc"
   cat "$tmp/check.out"
   for log in "$tmp"/report/logs/*.log; do
     echo "--- $(basename "$log") (last lines)"
@@ -62,9 +63,10 @@ if [ -f "$report" ]; then
     diff-crumple-yank diff-crumple-contact contact bench fleet fleet-large; do
     grep -q "^| $check | .* | pass | " "$report" || fail "report.md: check $check did not pass or is missing"
   done
-  grep -q '^\*\*PASS\*\*' "$report" || fail "report.md does not say PASS"
+  grep -q '^\*\*PASS\*\*: .* (smoke mode)' "$report" || fail "report.md does not say PASS in smoke mode"
   # The shards' counts add up to the whole binary's.
-  render_count=$("${scrubbed[@]}" "$kit/bin/tender_render_tests" --gtest_list_tests | grep -c '^  ')
+  render_count=$("${scrubbed[@]}" "$kit/bin/tender_render_tests" --gtest_list_tests \
+    --gtest_filter='Camera.*:Receipt.*:Golden.TornSheetShowsTheGap' | grep -c '^  ')
   grep -q "^| render-tests | .* | $render_count tests, $render_count passed (2 processes) |" "$report" ||
     fail "report.md: render-tests did not count $render_count tests from 2 processes"
   grep -q '^| dispatch cost | [0-9.]* us per empty dispatch' "$report" || fail "report.md has no dispatch cost"
