@@ -200,7 +200,9 @@ SIM_INLINE bool unsupported(uint a, uint b, uint kind, uint cols, bool gone0, bo
 /// the quad to its left.
 SIM_INLINE uvec2 edgeTriangles(uint a, uint b, uint cols, uint rows) {
   uint x = a % cols, y = a / cols, quads = cols - 1u;
-  if (b == a + 1u)
+  // a row edge: b the next particle of a's row (in a sheet one particle wide, b == a + 1 is a's
+  // column neighbour, whose edge no triangle holds)
+  if (b == a + 1u && x + 1u < cols)
     return uvec2(y + 1u < rows ? 2u * (y * quads + x) + 1u : SIM_NONE, y > 0u ? 2u * ((y - 1u) * quads + x) : SIM_NONE);
   return uvec2(x + 1u < cols ? 2u * (y * quads + x) : SIM_NONE, x > 0u ? 2u * (y * quads + x - 1u) + 1u : SIM_NONE);
 }

@@ -1,7 +1,10 @@
 // Physics of the CPU reference: the behaviour every solver shares (tests/common/solver_cases.h)
 // on the plain scalar reference and on the SIMD kernels over threads, and what only the CPU
 // solver lets a test do (set positions directly).
+#include <cmath>
 #include <cstdio>
+#include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -66,6 +69,32 @@ TEST(Verlet, ChangingTheSubstepsKeepsTheVelocity) {
       EXPECT_GT(va, 0.4f);
       EXPECT_NEAR(vb, va, 1e-3f * va) << change << contact;
     }
+}
+
+TEST(Degenerate, SheetsOneParticleWideOrLongTearHangAndCrumple) {
+  // 1 x N, N x 1, 1 x 1 and 2 x 2 sheets with every rule that walks the grid: hinges and creases
+  // (crumple), the stretch limit, the hand's squeeze, a yank that tears, and contact. A sheet one
+  // particle wide has edges no triangle holds (edgeTriangles took its column edges for row edges
+  // and read past the triangles: a crash). Each runs, and stays finite; the GPU's paths give the
+  // same bits (Parity.AwkwardSizes).
+  for (const auto& [cols, rows] :
+       {std::pair{1, 10}, std::pair{10, 1}, std::pair{1, 3}, std::pair{1, 1}, std::pair{2, 2}}) {
+    for (const char* p : {"tender", "crumple"}) {
+      const SimParams params =
+          preset(p, {("cols=" + std::to_string(cols)).c_str(), ("rows=" + std::to_string(rows)).c_str(),
+                     "stretch_limit=1.01", "contact_factor=0.5", "wind=off"});
+      const uint32_t last = uint32_t(cols * rows - 1);
+      const std::string text =
+          "0 grab particle " + std::to_string(last) + "\n1 move 0 0 0\n2 squeeze 1\n" + "8 move 6 -4 5\n14 release\n";
+      CpuSolver cpu;
+      Simulation sim(params, cpu);
+      sim.setScript(script(text.c_str()));
+      const SimState s = run(sim, 20);
+      ASSERT_EQ(s.pos.size(), size_t(cols * rows)) << cols << "x" << rows << " " << p;
+      for (const glm::vec4& q : s.pos)
+        ASSERT_TRUE(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z)) << cols << "x" << rows << " " << p;
+    }
+  }
 }
 
 TEST(Collision, FoldedSheetKeepsLayersApart) {

@@ -523,8 +523,9 @@ TEST_F(Parity, SameGpuRunTwiceIsBitwiseIdentical) {
 
 TEST_F(Parity, AwkwardSizes) {
   // 7 x 11 = 77 particles: not a multiple of any workgroup size (64, 256) nor of the subgroup (8).
-  const std::pair<const char*, const char*> sizes[] = {
-      {"cols=1", "rows=2"}, {"cols=2", "rows=2"}, {"cols=7", "rows=11"}, {"cols=37", "rows=53"}};
+  const std::pair<const char*, const char*> sizes[] = {{"cols=1", "rows=2"},  {"cols=1", "rows=10"},
+                                                       {"cols=10", "rows=1"}, {"cols=2", "rows=2"},
+                                                       {"cols=7", "rows=11"}, {"cols=37", "rows=53"}};
   for (auto [c, r] : sizes) {
     SimParams p = preset("tender", {"contact_factor=0", c, r, "wind=on"});
     const uint32_t last = p.cols * p.rows - 1;
