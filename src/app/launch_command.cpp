@@ -42,8 +42,19 @@ std::vector<std::string> ownArguments() {
   return args;
 }
 
+// The demo this process waits for: the signals that end a session reach it (forwardToDemo).
+volatile std::sig_atomic_t demo_pid = 0;
+constexpr int kForwarded[] = {SIGINT, SIGTERM, SIGHUP};
+
+extern "C" void forwardToDemo(int sig) {
+  if (demo_pid > 0) kill(pid_t(demo_pid), sig);
+}
+
 // Runs tender-demo with this process's arguments and waits for it: its exit status, or
-// kExitNoWindow when it could not be started or could not open a window.
+// kExitNoWindow when it could not be started or could not open a window. SIGINT, SIGTERM and
+// SIGHUP sent to this process alone (a supervisor's, `timeout`'s, a desktop's) are passed on to the
+// demo, which ends its session as a window close does; a terminal's Ctrl-C reaches both, and the
+// demo takes the second as the first.
 int launchDemo(const std::filesystem::path& demo) {
   std::vector<std::string> args = ownArguments();
   if (args.empty()) args.push_back("tender");
@@ -52,23 +63,38 @@ int launchDemo(const std::filesystem::path& demo) {
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   std::fflush(nullptr);
+  // Held until the handlers know the child: a signal meanwhile waits, and is then passed on
+  sigset_t forwarded, before;
+  sigemptyset(&forwarded);
+  for (int sig : kForwarded) sigaddset(&forwarded, sig);
+  sigprocmask(SIG_BLOCK, &forwarded, &before);
   const pid_t child = fork();
   if (child == 0) {
+    sigprocmask(SIG_SETMASK, &before, nullptr);
     setenv(kLaunchedVariable, "1", 1);
     execv(demo.c_str(), argv.data());
     std::fprintf(stderr, "tender: cannot start %s; rendering a picture instead\n", demo.c_str());
     _exit(kExitNoWindow);
   }
   if (child < 0) {
+    sigprocmask(SIG_SETMASK, &before, nullptr);
     std::fprintf(stderr, "tender: cannot start %s; rendering a picture instead\n", demo.c_str());
     return kExitNoWindow;
   }
-  // Ctrl-C reaches the demo, which ends its session; its status is ours.
-  std::signal(SIGINT, SIG_IGN);
+  demo_pid = child;
+  struct sigaction sa {
+  }, old[std::size(kForwarded)];
+  sa.sa_handler = forwardToDemo;
+  sigemptyset(&sa.sa_mask);
+  for (size_t k = 0; k < std::size(kForwarded); ++k) sigaction(kForwarded[k], &sa, &old[k]);
+  sigprocmask(SIG_SETMASK, &before, nullptr);
   int status = 0;
-  while (waitpid(child, &status, 0) < 0)
-    if (errno != EINTR) return kExitBadInput;
-  std::signal(SIGINT, SIG_DFL);
+  pid_t waited;
+  while ((waited = waitpid(child, &status, 0)) < 0 && errno == EINTR) {
+  }
+  for (size_t k = 0; k < std::size(kForwarded); ++k) sigaction(kForwarded[k], &old[k], nullptr);
+  demo_pid = 0;
+  if (waited < 0) return kExitBadInput;
   if (WIFEXITED(status)) return WEXITSTATUS(status);
   return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }

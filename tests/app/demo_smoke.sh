@@ -100,4 +100,38 @@ grep -q "steps: tender sim --script <this file> --ticks $steps ends at state has
 "$(dirname "$DEMO")/tender" sim --backend cpu --script "$tmp/term.txt" --ticks "$steps" | grep -q "state hash $hash" ||
   fail "SIGTERM: the recording does not replay to the demo's state"
 echo "ok: SIGTERM ends the session with its recording ($steps steps) and summary"
+
+# The launcher `tender` passes SIGINT, SIGTERM and SIGHUP sent to its pid alone (a supervisor's,
+# `timeout`'s) on to the demo it started: the demo ends its session with its recording, and its
+# status is the launcher's; nothing is left running.
+launcher_bin=$(dirname "$DEMO")/tender
+for sig in INT TERM HUP; do
+  display_up
+  "$launcher_bin" --backend cpu --record "$tmp/launched_$sig.txt" --width 640 --height 480 >"$tmp/demo.log" 2>&1 &
+  launcher=$!
+  demo=
+  for _ in $(seq 100); do
+    demo=$(pgrep -P "$launcher" -x tender-demo)
+    [ -n "$demo" ] && xdotool search --name "Tender" >/dev/null 2>&1 && break
+    sleep 0.1
+  done
+  [ -n "$demo" ] || { kill -KILL "$launcher"; fail "SIG$sig: tender started no tender-demo with a window"; }
+  sleep 1
+  kill -"$sig" "$launcher"
+  for _ in $(seq 100); do kill -0 "$launcher" 2>/dev/null || break; sleep 0.1; done
+  if kill -0 "$launcher" 2>/dev/null; then
+    kill -KILL "$demo" "$launcher"
+    fail "SIG$sig to tender's pid: still running 10 s later"
+  fi
+  wait "$launcher"
+  rc=$?
+  kill -0 "$demo" 2>/dev/null && { kill -KILL "$demo"; fail "SIG$sig to tender's pid: tender-demo was left running"; }
+  demo=
+  [ "$rc" -eq 2 ] || fail "SIG$sig to tender's pid: exit $rc"
+  grep -q "^tender: error: interrupted (SIG$sig); the session is recorded in $tmp/launched_$sig.txt$" "$tmp/demo.log" ||
+    fail "SIG$sig to tender's pid: no error line naming the recording"
+  grep -q "steps: tender sim --script <this file>" "$tmp/launched_$sig.txt" ||
+    fail "SIG$sig to tender's pid: the recording was not written"
+done
+echo "ok: SIGINT, SIGTERM and SIGHUP sent to tender's pid alone end the demo's session with its recording"
 echo "PASS"
