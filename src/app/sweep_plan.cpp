@@ -51,7 +51,8 @@ std::vector<std::string> split(const std::string& s, char sep) {
 std::optional<std::string> parseNumber(const std::string& s, double& out) {
   const char* end = s.data() + s.size();
   auto [ptr, ec] = std::from_chars(s.data(), end, out);
-  if (s.empty() || ec != std::errc() || ptr != end || !std::isfinite(out)) return "'" + s + "' is not a number";
+  if (s.empty() || ec != std::errc() || ptr != end || std::isnan(out)) return "'" + s + "' is not a number";
+  if (std::isinf(out)) return "'" + s + "' is not finite";
   return std::nullopt;
 }
 

@@ -39,7 +39,8 @@ std::optional<std::string> parseFloat(const std::string& s, float lo, float hi, 
   float v = 0.0f;
   const char* end = s.data() + s.size();
   auto [ptr, ec] = std::from_chars(s.data(), end, v);
-  if (s.empty() || ec != std::errc() || ptr != end || !std::isfinite(v)) return "'" + s + "' is not a number";
+  if (s.empty() || ec != std::errc() || ptr != end || std::isnan(v)) return "'" + s + "' is not a number";
+  if (std::isinf(v)) return "'" + s + "' is not finite";
   if (v < lo || v > hi) {
     char buf[128];
     snprintf(buf, sizeof(buf), "%s is out of range [%g, %g]", s.c_str(), double(lo), double(hi));

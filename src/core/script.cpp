@@ -219,9 +219,11 @@ std::optional<std::string> checkScript(const InputScript& script, const SimParam
 std::optional<std::string> checkClosure(double closure) {
   if (std::isnan(closure)) return std::string("the closure is not a number");
   if (closure < 0.0 || closure > 1.0) {
-    char buf[96];
-    snprintf(buf, sizeof(buf), "the closure %g is out of range [0, 1] (0: open, 1: closed)", closure);
-    return std::string(buf);
+    // the shortest decimal that reads back as this closure: 1.0000001 is not "1"
+    char digits[32];
+    auto [ptr, ec] = std::to_chars(digits, digits + sizeof(digits), closure);
+    return "the closure " + (ec == std::errc() ? std::string(digits, ptr) : std::to_string(closure)) +
+           " is out of range [0, 1] (0: open, 1: closed)";
   }
   return std::nullopt;
 }

@@ -63,6 +63,13 @@ TEST(Params, OverridesParseAndValidate) {
         "pins=middle", "wind=maybe", "substeps=33", "cols", "=4", "cols=99999999999", "contact_factor=-0.5",
         "contact_factor=nan", "contact_factor=1e30", "contact_settle=65", "contact_settle=-1"})
     EXPECT_TRUE(applyOverride(p, bad)) << bad;
+  // The message says what is wrong: infinity is a number, but not a finite one
+  EXPECT_EQ(applyOverride(p, "contact_factor=inf").value_or(""), "contact_factor: 'inf' is not finite");
+  EXPECT_EQ(applyOverride(p, "gravity=nan").value_or(""), "gravity: 'nan' is not a number");
+  // A closure just over 1 is printed with the digits that show it is (not as "1")
+  EXPECT_EQ(checkClosure(1.0000001).value_or(""), "the closure 1.0000001 is out of range [0, 1] (0: open, 1: closed)");
+  EXPECT_EQ(checkClosure(1.0 + 1e-9).value_or(""),
+            "the closure 1.000000001 is out of range [0, 1] (0: open, 1: closed)");
 }
 
 TEST(Params, ValidateRejectsImpossibleSheets) {
