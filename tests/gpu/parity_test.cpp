@@ -332,13 +332,16 @@ TEST_F(Parity, ContactIsTheSameOnTheGpu) {
   EXPECT_GT(cpu.contacts(), 0);
   for (uint32_t capacity : {SIM_CONTACT_LIST_CAPACITY, 1u}) {
     // On the per-colour passes (the fused tick takes the yank below); with lists of one pair, the
-    // queries with more search the grid every substep, with the same bits
+    // queries with more search the grid every substep, with the same bits. The forcing through,
+    // contact off, runs the fused tick (the paths take turns bitwise below), the per-colour passes
+    // from the tick that turns contact on and sizes its buffers.
     gpu::GpuSolver gpu(ctx());
-    gpu.setFusedPath(false);
     gpu.setContactListCapacity(capacity);
     Simulation g(p, gpu);
     g.setScript(script(text.c_str()));
     run(g, 29);
+    EXPECT_TRUE(gpu.usesFusedPath(g.lastUniforms())) << capacity << " pairs a list";
+    gpu.setFusedPath(false);
     const SimState gpu_end = run(g, 45);
     EXPECT_EQ(cpu.contacts(), gpu.contacts()) << capacity << " pairs a list";
     EXPECT_TRUE(sameState(cpu_end, gpu_end)) << capacity << " pairs a list";
