@@ -101,8 +101,12 @@ int main(int argc, char** argv) {
       for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
       return fail("unknown preset '" + o.preset + "' (one of " + names + ")");
     }
-    for (const std::string& s : o.sets)
+    for (const std::string& s : o.sets) {
+      // The grid is --sizes': a `--set cols/rows` would run a sheet the table does not name
+      const std::string key = s.substr(0, s.find('='));
+      if (key == "cols" || key == "rows") return fail("--set " + key + ": the grid is set by --sizes (WxH)");
       if (auto err = applyOverride(*p, s)) return fail(*err);
+    }
     if (auto err = validate(*p, "cpu")) return fail(*err);
     cpu_threads = p->threads;
   }

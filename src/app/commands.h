@@ -85,7 +85,8 @@ struct DemoOptions {
 
 /// The input script of `path` checked against the sheet of `params` (an empty path: no events);
 /// nullopt and `error` on failure.
-std::optional<InputScript> scriptFor(const std::string& path, const SimParams& params, std::string& error);
+std::optional<InputScript> scriptFor(const std::string& path, const SimParams& params, const std::string& backend,
+                                     std::string& error);
 
 int runSim(const CommonOptions& common, const SimOptions& o);
 int runDevices(const CommonOptions& common);

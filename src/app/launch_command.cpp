@@ -125,7 +125,7 @@ int runDemo(const CommonOptions& common, const DemoOptions& o) {
   r.ticks = uint64_t(2.0f * common.params.tick_hz);
   r.out = "tender.png";
   std::string error;
-  std::optional<InputScript> replay = scriptFor(o.replay, common.params, error);
+  std::optional<InputScript> replay = scriptFor(o.replay, common.params, common.backend, error);
   if (!replay) return fail(error);
   OutputSet record;
   if (auto err = record.addInput(o.replay)) return fail(*err);

@@ -10,9 +10,10 @@ BackendOptions CommonOptions::backendOptions() const {
   return b;
 }
 
-std::optional<InputScript> scriptFor(const std::string& path, const SimParams& params, std::string& error) {
+std::optional<InputScript> scriptFor(const std::string& path, const SimParams& params, const std::string& backend,
+                                     std::string& error) {
   if (path.empty()) return InputScript{};
-  return loadScriptFor(path, params, error);
+  return loadScriptFor(path, params, backend, error);
 }
 
 } // namespace tender

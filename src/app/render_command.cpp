@@ -23,7 +23,7 @@ int runRender(const CommonOptions& common, const RenderOptions& o) {
   OutputSet outputs;
   if (auto err = outputs.add(o.out)) return fail(*err);
   std::string error;
-  auto script = scriptFor(common.script, common.params, error);
+  auto script = scriptFor(common.script, common.params, common.backend, error);
   if (!script) return fail(error);
   render::HeadlessOptions h;
   headlessOptionsFor(common, o, *script, h);

@@ -107,7 +107,7 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
     scene.texture_png = receiptPng(common.params.preset);
   }
   std::string error;
-  auto script = scriptFor(common.script, common.params, error);
+  auto script = scriptFor(common.script, common.params, common.backend, error);
   if (!script) return fail(error);
   Backend backend;
   if (auto err = createBackend(common.backendOptions(), backend)) return fail(*err);

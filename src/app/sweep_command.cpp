@@ -158,7 +158,7 @@ int runSweep(const CommonOptions& common, const SweepOptions& o) {
   for (uint64_t index : indices) {
     SweepSheet sheet;
     if (auto err = makeSheet(plan, index, sheet)) return fail(*err);
-    if (auto err = checkScript(*script, sheet.params, true))
+    if (auto err = checkScript(*script, sheet.params, plan.backend, true))
       return fail(common.script + ": sheet " + std::to_string(index) + ": " + *err);
   }
   const auto script_hash = common.script.empty() ? std::nullopt : fileHash(common.script);

@@ -200,7 +200,7 @@ int runVideo(const CommonOptions& common, const RenderOptions& o) {
   // Ticks per frame p / q.
   const u128 p = u128(hz.num) * fps.den, q = u128(hz.den) * fps.num;
   std::string error;
-  auto script = scriptFor(common.script, common.params, error);
+  auto script = scriptFor(common.script, common.params, common.backend, error);
   if (!script) return fail(error);
   u128 frames = 0, limit = ~u128(0); // limit: the ticks of the last frame, when given in ticks
   if (!o.seconds.empty() || (!o.ticks_given && common.script.empty())) {

@@ -153,11 +153,11 @@ std::optional<InputScript> loadScript(const std::string& path, std::string& erro
   return s;
 }
 
-std::optional<InputScript> loadScriptFor(const std::string& path, const SimParams& params, std::string& error,
-                                         bool fixed_layout) {
+std::optional<InputScript> loadScriptFor(const std::string& path, const SimParams& params, const std::string& backend,
+                                         std::string& error) {
   auto s = loadScript(path, error);
   if (!s) return s;
-  if (auto err = checkScript(*s, params, fixed_layout)) {
+  if (auto err = checkScript(*s, params, backend)) {
     error = path + ": " + *err;
     return std::nullopt;
   }
@@ -192,7 +192,8 @@ std::optional<std::string> applySettings(SimParams& params, const Settings& sett
   return std::nullopt;
 }
 
-std::optional<std::string> checkScript(const InputScript& script, const SimParams& params, bool fixed_layout) {
+std::optional<std::string> checkScript(const InputScript& script, const SimParams& params, const std::string& backend,
+                                       bool fixed_layout) {
   SimParams p = params;
   const auto& events = script.events;
   for (size_t i = 0; i < events.size();) {
@@ -212,6 +213,13 @@ std::optional<std::string> checkScript(const InputScript& script, const SimParam
         return at + "set " + key +
                ": the sheets of a fleet keep their layout (set only keys that do not rebuild the sheet)";
     if (auto err = applySettings(p, settings)) return at + "set: " + *err;
+    // A sheet the settings rebuild passes the check of `--set`, its memory on the backend included
+    if (rebuildsSheet(settings))
+      if (auto err = validate(p, backend)) return at + "set: " + *err;
+    if (fixed_layout && p.contact_factor > 0.0f && !(params.contact_factor > 0.0f))
+      return at + "set contact_factor: the sheets of a fleet keep their layout, and contact's buffers are sized " +
+             "when they are made: make the sheet with contact_factor above 0 (a set event may turn it off and on "
+             "again)";
   }
   return std::nullopt;
 }

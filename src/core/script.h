@@ -60,15 +60,19 @@ struct InputScript {
 std::optional<InputScript> parseScript(const std::string& text, std::string& error);
 /// Reads and parses a script file; errors name the file.
 std::optional<InputScript> loadScript(const std::string& path, std::string& error);
-/// Checks a script against a sheet of `params`, following its `set` events: a grabbed particle must
-/// exist on the sheet as it is then, and each tick's `set` events must give parameters that pass
-/// checkRules(). With `fixed_layout` (a fleet's sheets, which share their layout) only keys that
-/// do not rebuild the sheet may be set. Returns an error message.
-std::optional<std::string> checkScript(const InputScript& script, const SimParams& params, bool fixed_layout = false);
-/// Reads, parses and checks a script file against a sheet of `params` (what every program does
-/// with a script it is given); errors name the file.
-std::optional<InputScript> loadScriptFor(const std::string& path, const SimParams& params, std::string& error,
-                                         bool fixed_layout = false);
+/// Checks a script against a sheet of `params` run on `backend` ("cpu" or "gpu", as validate()
+/// takes it), following its `set` events: a grabbed particle must exist on the sheet as it is then,
+/// each tick's `set` events must give parameters that pass checkRules(), and a sheet they rebuild
+/// must fit this machine's memory on the backend (validate(), the check of `--set`). With
+/// `fixed_layout` (a fleet's sheets, which share their layout) only keys that do not rebuild the
+/// sheet may be set, and contact may not be turned on in a sheet made without it (a fleet sizes
+/// contact's buffers when its sheets are made). Returns an error message.
+std::optional<std::string> checkScript(const InputScript& script, const SimParams& params, const std::string& backend,
+                                       bool fixed_layout = false);
+/// Reads, parses and checks a script file against a sheet of `params` on `backend` (what every
+/// program does with a script it is given); errors name the file.
+std::optional<InputScript> loadScriptFor(const std::string& path, const SimParams& params, const std::string& backend,
+                                         std::string& error);
 /// `set` assignments applied together: key (or "preset") and value, in order.
 using Settings = std::vector<std::pair<std::string, std::string>>;
 /// The parameters `params` become with the assignments of one step applied in order; returns the

@@ -243,7 +243,7 @@ public:
         std::string error;
         auto script = parseScript(scripts->at(i), error);
         if (!script) throw py::value_error("scripts[" + std::to_string(i) + "]: " + error);
-        if (auto err = checkScript(*script, list[i].params, true))
+        if (auto err = checkScript(*script, list[i].params, backend, true))
           throw py::value_error("scripts[" + std::to_string(i) + "]: " + *err);
         list[i].script = std::move(*script);
       }

@@ -115,6 +115,14 @@ expect_msg "empty" sim "${small[@]}" --ticks 2 --out "$tmp/e.glb" --frames-every
 rc=$?
 [ "$rc" -eq 2 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ] && grep -q '^tender-bench: error: --batch: the value is empty' "$tmp/err" ||
   fail "tender-bench --batch '' -> exit $rc: $(cat "$tmp/err")"
+# The grid is --sizes': a --set of cols or rows beside it would run a sheet the table does not name.
+for key in cols rows; do
+  "$B" --backends cpu --sizes 8x8 --ticks 1 --set "$key=1" >"$tmp/out" 2>"$tmp/err"
+  rc=$?
+  [ "$rc" -eq 2 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ] &&
+    grep -q "^tender-bench: error: --set $key: the grid is set by --sizes" "$tmp/err" ||
+    fail "tender-bench --sizes 8x8 --set $key=1 -> exit $rc: $(cat "$tmp/err")"
+done
 
 # 8. Ctrl-C or SIGTERM: one line, exit 2, no output and no temporary file left.
 # (Python restores SIGINT's default, which a background job of a script ignores.)

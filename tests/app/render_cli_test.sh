@@ -65,6 +65,13 @@ else
 fi
 # A sheet larger than the device binds is refused with one line.
 expect_bad sim --backend gpu --set cols=4096 --set rows=2048 --ticks 1
+# A script's sheet passes the memory check of --set: 2^24 particles' GPU buffers (about 25 GiB)
+# refused before anything is allocated, where this machine's memory cannot hold them.
+printf '0 set cols 4096\n0 set rows 4096\n' >"$tmp/grow.txt"
+expect_bad sim --backend gpu --script "$tmp/grow.txt" --ticks 1
+if [ "$(awk '/^MemAvailable:/ {print $2}' /proc/meminfo)" -lt $((26 * 1024 * 1024)) ]; then
+  grep -q "grow.txt: tick 0: set: a 4096x4096 sheet needs about" "$tmp/err" || fail "a script's 4096x4096 sheet: $(cat "$tmp/err")"
+fi
 # The GPU runs below are the seeds' cloth, the tender preset's contact off: a CPU device takes seconds
 # to build contact's kernels (contact on the GPU: Parity.*Contact*, the crumple sweeps and diffs).
 seeds=(--set contact_factor=0)

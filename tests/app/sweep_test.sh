@@ -157,6 +157,10 @@ expect_bad sweep "${small[@]}" --vary damping=0.9,1 --ticks 5 --out "$tmp/yank.t
 expect_bad sweep "${small[@]}" --vary damping=0.9,1 --ticks 5 --script "$tmp/missing.txt" --out "$tmp/bad"
 printf '0 grab particle 96\n' >"$tmp/far.txt"
 expect_bad sweep "${small[@]}" --vary damping=0.9,1 --ticks 5 --script "$tmp/far.txt" --out "$tmp/bad"
+# Contact turned on by the script in sheets made without it: refused before any tick, on every backend
+printf '0 grab particle 27\n2 set contact_factor 0.5\n' >"$tmp/contact_later.txt"
+expect_bad sweep "${small[@]}" --vary damping=0.9,1 --ticks 5 --script "$tmp/contact_later.txt" --out "$tmp/bad"
+grep -q 'set contact_factor' "$tmp/err" || fail "contact turned on later: $(cat "$tmp/err")"
 [ ! -e "$tmp/bad" ] || fail "bad input created its --out folder"
 
 [ "$failures" -eq 0 ] && echo "ok: tender sweep"

@@ -140,7 +140,7 @@ TEST(Script, AnEmptyFileHasNoEvents) {
   ASSERT_TRUE(f);
   std::fclose(f);
   std::string err;
-  auto s = loadScriptFor(path, *presetParams("tender"), err);
+  auto s = loadScriptFor(path, *presetParams("tender"), "cpu", err);
   ASSERT_TRUE(s) << err;
   EXPECT_TRUE(s->events.empty());
   std::remove(path.c_str());

@@ -279,6 +279,11 @@ def test_fleet_bad_input_raises():
         tender.Fleet(2, scripts=["0 grab particle 99999\n", ""])
     with pytest.raises(ValueError):
         tender.Fleet(2, scripts=[""])
+    # A fleet sizes contact's buffers when its sheets are made: a script may not turn it on later
+    # (refused when the fleet is made, on every backend, not after some ticks on the GPU)
+    with pytest.raises(ValueError, match=r"^scripts\[0\]: tick 2: set contact_factor: "):
+        tender.Fleet(2, preset="crumple", backend="cpu", cols=8, rows=8, contact_factor=0,
+                     scripts=["0 grab particle 27\n2 set contact_factor 0.5\n", "0 grab particle 27\n"])
     fleet = tender.Fleet(2, cols=8, rows=8)
     with pytest.raises(IndexError):
         fleet.grab(2, 0)

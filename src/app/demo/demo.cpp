@@ -101,7 +101,7 @@ bool DemoApp::init() {
   createSolver();
   if (!backend_.solver) return false;
   std::string error;
-  auto replay = scriptFor(options_.replay, common_.params, error);
+  auto replay = scriptFor(options_.replay, common_.params, common_.backend, error);
   if (!replay) {
     fail(error);
     return false;
