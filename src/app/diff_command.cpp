@@ -230,13 +230,12 @@ int runDiff(const CommonOptions& common, const DiffOptions& o) {
   BackendOptions oa, ob;
   if (auto err = parseBackend(o.a, common, oa)) return fail("--a: " + *err);
   if (auto err = parseBackend(o.b, common, ob)) return fail("--b: " + *err);
-  std::optional<InputScript> script;
-  for (const BackendOptions* opt : {&oa, &ob}) {
-    const std::string backend = opt->backend == "cpu" ? "cpu" : "gpu";
-    if (auto err = validate(common.params, backend)) return fail(*err);
-    script = scriptFor(common.script, common.params, backend, error); // the sheets it makes, on each side
-    if (!script) return fail(error);
-  }
+  for (const BackendOptions* opt : {&oa, &ob})
+    if (auto err = validate(common.params, opt->backend == "cpu" ? "cpu" : "gpu")) return fail(*err);
+  // The sheets the script makes, checked once on the side that needs more memory (a GPU's)
+  const bool gpu = oa.backend != "cpu" || ob.backend != "cpu";
+  auto script = scriptFor(common.script, common.params, gpu ? "gpu" : "cpu", error);
+  if (!script) return fail(error);
   // The test hook: a one-ULP change planted in the CPU side (b when both are)
   if (const char* plant = std::getenv("TENDER_TEST_PLANT_ULP"); plant && *plant) {
     auto p = parsePlantedUlp(plant, error);
