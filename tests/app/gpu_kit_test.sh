@@ -2,7 +2,7 @@
 # The GPU proof kit: tools/gpu-bundle packs this build's programs into a folder, a copy of the
 # folder elsewhere (the original removed) runs `gpu-check --smoke` (every check once, on the least
 # that runs it; the full and quick runs are for real GPUs) in an environment holding only
-# PATH, HOME and the driver (lavapipe), exits 0 and writes a report naming every check; bad usage
+# PATH, HOME and the driver (lavapipe and its cache), exits 0 and writes a report naming every check; bad usage
 # exits 2 with one line. Also the kit's shape: at most 60 MiB, stripped programs with an RPATH
 # into the kit, a validation layer manifest that points into the kit.
 set -u
@@ -40,7 +40,10 @@ for f in "$kit"/bin/tender*; do
 done
 grep -q '"library_path": "../../../lib/libVkLayer_khronos_validation.so"' \
   "$kit/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json" || fail "the layer manifest's library_path"
-scrubbed=(env -i PATH=/usr/bin:/bin HOME="$tmp" VK_DRIVER_FILES="$DRIVER")
+# The driver's settings pass: its shader cache (Mesa's and the validation layer's, under
+# XDG_CACHE_HOME; cold, the kit's dozen programs compile every pipeline again) and LP_NUM_THREADS.
+scrubbed=(env -i PATH=/usr/bin:/bin HOME="$tmp" VK_DRIVER_FILES="$DRIVER" XDG_CACHE_HOME="${XDG_CACHE_HOME:-$HOME/.cache}"
+  ${LP_NUM_THREADS:+LP_NUM_THREADS="$LP_NUM_THREADS"})
 "${scrubbed[@]}" "$kit/tender" --version | grep -q '^tender ' || fail "the kit's tender --version"
 
 # gpu-check --smoke from the copy, in a scrubbed environment.
