@@ -7,6 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/text.h" // printable()
+
 namespace tender {
 
 /// Exit status of every error (bad input, a fault, an interrupt), with one line on stderr.
@@ -14,9 +16,6 @@ constexpr int kExitBadInput = 2;
 
 /// The name error lines start with ("tender" unless set).
 void setProgramName(const char* name);
-/// `text` with every control character, DEL and byte that is not UTF-8 written as an escape (\n,
-/// \t, \xNN), so that it prints as one line of text whatever it held (a NUL included).
-std::string printable(const std::string& text);
 /// Prints "<program>: error: <message>" (printable) and returns kExitBadInput.
 int fail(const std::string& message);
 /// Flushes standard output; when anything written there was lost (a full disk, a closed pipe),

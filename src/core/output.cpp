@@ -113,6 +113,8 @@ int makeTemp(const std::string& path, std::string& temp) {
 
 std::optional<std::string> checkOutputPath(const std::string& path) {
   if (path.empty()) return std::string("an output path is empty");
+  // (from Python: the system would take the path as ending at the NUL, another file)
+  if (path.find('\0') != std::string::npos) return cannotWrite(path, "a path cannot hold a NUL");
   struct stat st {};
   if (stat(path.c_str(), &st) == 0) {
     if (S_ISDIR(st.st_mode)) return cannotWrite(path, "it is a folder");

@@ -3,8 +3,14 @@
 #include <cmath>
 
 #include "core/script.h"
+#include "core/text.h"
 
 namespace tender {
+
+void raise(PyObject* type, const std::string& message) {
+  PyErr_SetString(type, printable(message).c_str());
+  throw py::error_already_set();
+}
 
 std::string typeName(const py::handle& value) {
   return py::str(py::type::of(value).attr("__name__")).cast<std::string>();
@@ -30,21 +36,21 @@ std::string spell(const std::string& key, const py::handle& value) {
     err = key + ": expected a bool, an int, a float or a str, got " + typeName(value);
   }
   if (!err) return out;
-  if (!paramInfo(key)) throw py::key_error(*err);
-  throw py::type_error(*err);
+  if (!paramInfo(key)) raise(PyExc_KeyError, *err);
+  raise(PyExc_TypeError, *err);
 }
 
 void applyKey(SimParams& p, const std::string& key, const py::handle& value) {
   const std::string assignment = key + "=" + spell(key, value);
   auto err = applyOverride(p, assignment);
   if (!err) return;
-  if (key.empty() || !paramInfo(key)) throw py::key_error(*err);
-  throw py::value_error(*err);
+  if (key.empty() || !paramInfo(key)) raise(PyExc_KeyError, *err);
+  raise(PyExc_ValueError, *err);
 }
 
 std::string keyOf(const py::handle& key, const std::string& what) {
   if (!py::isinstance<py::str>(key))
-    throw py::type_error(what + ": keys are parameter names (str), got " + typeName(key));
+    raise(PyExc_TypeError, what + ": keys are parameter names (str), got " + typeName(key));
   return key.cast<std::string>();
 }
 
@@ -54,18 +60,17 @@ bool truthValue(const py::handle& value, const char* what) {
     py::object item = value.attr("item")();
     if (py::isinstance<py::bool_>(item)) return item.cast<bool>();
   }
-  throw py::type_error(std::string(what) + ": expected True or False, got " + typeName(value));
+  raise(PyExc_TypeError, std::string(what) + ": expected True or False, got " + typeName(value));
 }
 
 void writeOutput(const std::string& path, const std::function<std::optional<std::string>(OutputSet&)>& stage) {
-  if (path.empty()) throw py::value_error("an output path is empty");
+  if (path.empty()) raise(PyExc_ValueError, "an output path is empty");
   OutputSet outputs;
   std::optional<std::string> err = outputs.add(path);
   if (!err) err = stage(outputs);
   if (!err) err = outputs.commit();
   if (err) {
-    PyErr_SetString(PyExc_OSError, err->c_str());
-    throw py::error_already_set();
+    raise(PyExc_OSError, *err);
   }
 }
 
@@ -79,25 +84,25 @@ glm::vec3 coordinates(double x, double y, double z, const char* what) {
   const double v[3] = {x, y, z};
   for (double d : v)
     if (!(std::fabs(d) <= double(kMaxCoordinate)))
-      throw py::value_error(std::string(what) + ": " + std::to_string(d) + " is out of range [-" +
-                            std::to_string(int64_t(kMaxCoordinate)) + ", " + std::to_string(int64_t(kMaxCoordinate)) +
-                            "]");
+      raise(PyExc_ValueError, std::string(what) + ": " + std::to_string(d) + " is out of range [-" +
+                                  std::to_string(int64_t(kMaxCoordinate)) + ", " +
+                                  std::to_string(int64_t(kMaxCoordinate)) + "]");
   return {float(x), float(y), float(z)};
 }
 
 float closureOf(double closure) {
-  if (auto err = checkClosure(closure)) throw py::value_error("squeeze: " + *err);
+  if (auto err = checkClosure(closure)) raise(PyExc_ValueError, "squeeze: " + *err);
   return float(closure);
 }
 
 glm::vec3 sequence3(const py::sequence& s, const char* what) {
-  if (py::len(s) != 3) throw py::value_error(std::string(what) + ": expected 3 numbers");
+  if (py::len(s) != 3) raise(PyExc_ValueError, std::string(what) + ": expected 3 numbers");
   double v[3];
   for (size_t k = 0; k < 3; ++k) {
     try {
       v[k] = s[k].cast<double>();
     } catch (const py::cast_error&) {
-      throw py::value_error(std::string(what) + ": expected 3 numbers");
+      raise(PyExc_ValueError, std::string(what) + ": expected 3 numbers");
     }
   }
   return coordinates(v[0], v[1], v[2], what);

@@ -17,6 +17,10 @@ namespace tender {
 
 namespace py = pybind11;
 
+/// Raises `type` (PyExc_ValueError, PyExc_OSError...) with `message` made printable, as the
+/// command line prints its errors: what a message quotes (a path, a key, a preset's name) is
+/// escaped, not cut at a NUL (a C++ exception's what() would end there).
+[[noreturn]] void raise(PyObject* type, const std::string& message);
 /// The name of a Python value's type ("float", "NoneType").
 std::string typeName(const py::handle& value);
 /// A Python value spelled as `--set` takes it, by the rule of preset files (spellTyped): True/False

@@ -39,18 +39,18 @@ public:
   PySimulation(const std::string& preset, const std::string& backend, std::optional<int> device,
                const py::kwargs& params) {
     auto p = presetParams(preset);
-    if (!p) throw py::value_error(unknownPreset(preset));
+    if (!p) raise(PyExc_ValueError, unknownPreset(preset));
     for (auto item : params) applyKey(*p, keyOf(item.first, "params"), item.second);
-    if (backend != "cpu" && backend != "gpu") throw py::value_error("unknown backend '" + backend + "' (cpu or gpu)");
-    if (device && *device < 0) throw py::value_error("device: expected an index >= 0 (see tender.devices())");
-    if (auto err = validate(*p, backend)) throw py::value_error(*err);
+    if (backend != "cpu" && backend != "gpu") raise(PyExc_ValueError, "unknown backend '" + backend + "' (cpu or gpu)");
+    if (device && *device < 0) raise(PyExc_ValueError, "device: expected an index >= 0 (see tender.devices())");
+    if (auto err = validate(*p, backend)) raise(PyExc_ValueError, *err);
     backend_name_ = backend;
     device_ = device.value_or(-1);
     build(*p);
   }
 
   void step(int64_t ticks) {
-    if (ticks < 0) throw py::value_error("ticks: expected a count >= 0, got " + std::to_string(ticks));
+    if (ticks < 0) raise(PyExc_ValueError, "ticks: expected a count >= 0, got " + std::to_string(ticks));
     for (int64_t t = 0; t < ticks; ++t) {
       auto t0 = std::chrono::steady_clock::now();
       const bool ran = sim_->tick();
@@ -65,14 +65,14 @@ public:
   void grab(int64_t particle) {
     const uint32_t n = sim_->topology().particleCount();
     if (particle < 0 || particle >= int64_t(n))
-      throw py::value_error("particle " + std::to_string(particle) + " does not exist (the sheet has " +
-                            std::to_string(n) + ")");
+      raise(PyExc_ValueError,
+            "particle " + std::to_string(particle) + " does not exist (the sheet has " + std::to_string(n) + ")");
     sim_->grabParticle(uint32_t(particle));
   }
 
   bool grabRay(const py::sequence& origin, const py::sequence& direction) {
     glm::vec3 o = sequence3(origin, "origin"), d = sequence3(direction, "direction");
-    if (!(glm::dot(d, d) > 0.0f)) throw py::value_error("direction: expected a non-zero vector");
+    if (!(glm::dot(d, d) > 0.0f)) raise(PyExc_ValueError, "direction: expected a non-zero vector");
     return sim_->grabRay(o, d);
   }
 
@@ -84,11 +84,11 @@ public:
   void set(const std::string& key, const py::handle& value) {
     SimParams p = sim_->params();
     applyKey(p, key, value);
-    if (auto err = validate(p, backend_name_)) throw py::value_error(*err);
+    if (auto err = validate(p, backend_name_)) raise(PyExc_ValueError, *err);
     if (p.threads != sim_->params().threads || p.simd != sim_->params().simd) {
       build(p);
     } else if (auto err = sim_->set({{key, spell(key, value)}})) { // as a script's set event
-      throw py::value_error(*err);
+      raise(PyExc_ValueError, *err);
     }
   }
 
@@ -135,7 +135,7 @@ public:
 
   void save(const std::string& path) {
     auto format = meshFormatFor(path);
-    if (!format) throw py::value_error("'" + path + "': unknown extension (.ply, .glb or .gltf)");
+    if (!format) raise(PyExc_ValueError, "'" + path + "': unknown extension (.ply, .glb or .gltf)");
     writeOutput(path, [&](OutputSet& outputs) -> std::optional<std::string> {
       backend_.solver->computeNormals();
       SimState s;
@@ -149,7 +149,7 @@ public:
       scene.texture_png = png->second;
       std::string error;
       auto bytes = encodeGltf(scene, {meshFrame(s, 0.0)}, *format == MeshFormat::Glb, error);
-      if (!bytes) throw std::runtime_error(error);
+      if (!bytes) raise(PyExc_RuntimeError, error);
       return outputs.stage(path, *bytes);
     });
   }
@@ -176,7 +176,7 @@ private:
     BackendOptions options = backendOptionsFor(backend_name_, p);
     options.device = device_;
     Backend backend;
-    if (auto err = createBackend(options, backend)) throw std::runtime_error(*err);
+    if (auto err = createBackend(options, backend)) raise(PyExc_RuntimeError, *err);
     auto sim = std::make_unique<Simulation>(p, *backend.solver);
     sim_.reset();
     backend_ = std::move(backend); // the solver stays where it is: `sim` keeps pointing at it
@@ -205,66 +205,66 @@ public:
   PyFleet(const py::object& sheets, const std::string& preset, const std::string& backend, std::optional<int> device,
           const std::optional<std::vector<std::string>>& scripts, const py::kwargs& params) {
     auto base = presetParams(preset);
-    if (!base) throw py::value_error(unknownPreset(preset));
+    if (!base) raise(PyExc_ValueError, unknownPreset(preset));
     for (auto item : params) applyKey(*base, keyOf(item.first, "params"), item.second);
-    if (backend != "cpu" && backend != "gpu") throw py::value_error("unknown backend '" + backend + "' (cpu or gpu)");
-    if (device && *device < 0) throw py::value_error("device: expected an index >= 0 (see tender.devices())");
+    if (backend != "cpu" && backend != "gpu") raise(PyExc_ValueError, "unknown backend '" + backend + "' (cpu or gpu)");
+    if (device && *device < 0) raise(PyExc_ValueError, "device: expected an index >= 0 (see tender.devices())");
     // sheets: a count of sheets of the common parameters, or one dict of keys per sheet over them
     std::vector<FleetSheet> list;
     if (py::isinstance<py::bool_>(sheets)) {
-      throw py::type_error("sheets: expected a count or a list of dicts, got bool");
+      raise(PyExc_TypeError, "sheets: expected a count or a list of dicts, got bool");
     } else if (py::isinstance<py::int_>(sheets)) {
       // Compared as Python ints: any size is refused in words, never by a failed conversion.
       if (sheets < py::int_(1) || sheets > py::int_(kMaxBatchSheets))
-        throw py::value_error("sheets: expected 1 to " + std::to_string(kMaxBatchSheets) + ", got " +
-                              py::str(sheets).cast<std::string>());
+        raise(PyExc_ValueError, "sheets: expected 1 to " + std::to_string(kMaxBatchSheets) + ", got " +
+                                    py::str(sheets).cast<std::string>());
       list.assign(sheets.cast<size_t>(), FleetSheet{*base, {}});
     } else if (py::isinstance<py::sequence>(sheets) && !py::isinstance<py::str>(sheets)) {
       size_t i = 0;
       for (const py::handle& item : sheets) {
         const std::string where = "sheets[" + std::to_string(i++) + "]";
-        if (!py::isinstance<py::dict>(item)) throw py::type_error(where + ": expected a dict, got " + typeName(item));
+        if (!py::isinstance<py::dict>(item)) raise(PyExc_TypeError, where + ": expected a dict, got " + typeName(item));
         if (i > kMaxBatchSheets) break;
         FleetSheet s{*base, {}};
         for (auto kv : item.cast<py::dict>()) applyKey(s.params, keyOf(kv.first, where), kv.second);
         list.push_back(std::move(s));
       }
       if (list.empty() || py::len(sheets) > kMaxBatchSheets)
-        throw py::value_error("sheets: expected 1 to " + std::to_string(kMaxBatchSheets) + " sheets, got " +
-                              std::to_string(py::len(sheets)));
+        raise(PyExc_ValueError, "sheets: expected 1 to " + std::to_string(kMaxBatchSheets) + " sheets, got " +
+                                    std::to_string(py::len(sheets)));
     } else {
-      throw py::type_error("sheets: expected a count or a list of dicts, got " + typeName(sheets));
+      raise(PyExc_TypeError, "sheets: expected a count or a list of dicts, got " + typeName(sheets));
     }
     if (scripts) {
       if (scripts->size() != list.size())
-        throw py::value_error("scripts: expected one per sheet (" + std::to_string(list.size()) + "), got " +
-                              std::to_string(scripts->size()));
+        raise(PyExc_ValueError, "scripts: expected one per sheet (" + std::to_string(list.size()) + "), got " +
+                                    std::to_string(scripts->size()));
       for (size_t i = 0; i < list.size(); ++i) {
         std::string error;
         auto script = parseScript(scripts->at(i), error);
-        if (!script) throw py::value_error("scripts[" + std::to_string(i) + "]: " + error);
+        if (!script) raise(PyExc_ValueError, "scripts[" + std::to_string(i) + "]: " + error);
         if (auto err = checkScript(*script, list[i].params, backend, true))
-          throw py::value_error("scripts[" + std::to_string(i) + "]: " + *err);
+          raise(PyExc_ValueError, "scripts[" + std::to_string(i) + "]: " + *err);
         list[i].script = std::move(*script);
       }
     }
     for (size_t i = 0; i < list.size(); ++i) {
       if (auto err = validate(list[i].params, backend))
-        throw py::value_error("sheet " + std::to_string(i) + ": " + *err);
+        raise(PyExc_ValueError, "sheet " + std::to_string(i) + ": " + *err);
       if (auto err = batchMismatch(list[0].params, list[i].params))
-        throw py::value_error("sheet " + std::to_string(i) + ": " + *err);
+        raise(PyExc_ValueError, "sheet " + std::to_string(i) + ": " + *err);
     }
     // The whole batch must fit this machine's memory (and a GPU's), refused before anything is allocated.
     if (auto err = batchMemoryError(list[0].params, backend, list.size(), device.value_or(-1)))
-      throw py::value_error(*err);
+      raise(PyExc_ValueError, *err);
     BackendOptions options = backendOptionsFor(backend, list[0].params);
     options.device = device.value_or(-1);
-    if (auto err = createBatch(options, uint32_t(list.size()), batch_)) throw std::runtime_error(*err);
+    if (auto err = createBatch(options, uint32_t(list.size()), batch_)) raise(PyExc_RuntimeError, *err);
     fleet_ = std::make_unique<Fleet>(*batch_, list);
   }
 
   void step(int64_t ticks) {
-    if (ticks < 0) throw py::value_error("ticks: expected a count >= 0, got " + std::to_string(ticks));
+    if (ticks < 0) raise(PyExc_ValueError, "ticks: expected a count >= 0, got " + std::to_string(ticks));
     for (int64_t t = 0; t < ticks; ++t) {
       auto t0 = std::chrono::steady_clock::now();
       fleet_->tick();
@@ -321,8 +321,8 @@ public:
     Simulation& sim = at(sheet);
     const uint32_t n = sim.topology().particleCount();
     if (particle < 0 || particle >= int64_t(n))
-      throw py::value_error("particle " + std::to_string(particle) + " does not exist (the sheet has " +
-                            std::to_string(n) + ")");
+      raise(PyExc_ValueError,
+            "particle " + std::to_string(particle) + " does not exist (the sheet has " + std::to_string(n) + ")");
     sim.grabParticle(uint32_t(particle));
   }
   void move(int64_t sheet, double x, double y, double z) { at(sheet).moveGrab(coordinates(x, y, z, "move")); }

@@ -161,6 +161,14 @@ def test_bad_input_raises():
         sim.set("iterations", 0)
     with pytest.raises(ValueError):
         sim.save("out.xyz")
+    # What a message quotes is escaped as the command line prints it, not cut at a NUL
+    with pytest.raises(ValueError, match=r"^unknown preset 'a\\x00b' \(one of"):
+        tender.Simulation(preset="a\x00b", backend="cpu")
+    with pytest.raises(ValueError, match=r"a\\x00b"):
+        sim.set("pins", "a\x00b")
+    with pytest.raises(KeyError) as unknown:  # (a KeyError's str() is its message's repr)
+        sim.set("a\x00b", 1)
+    assert unknown.value.args[0].startswith("unknown parameter 'a\\x00b'")
     # The sheet is unchanged and still runs.
     sim.step(1)
     assert sim.stats()["nan_count"] == 0
@@ -181,6 +189,10 @@ def test_save_ply_and_glb(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["a.glb", "a.gltf", "a.ply"]  # no temporary left
     with pytest.raises(OSError, match="cannot write .*does not exist"):
         sim.save(str(tmp_path / "missing" / "a.glb"))
+    # The whole path, escaped, and nothing written (not the file named by the part before the NUL)
+    with pytest.raises(OSError, match=r"cannot write '.*/a\\x00b\.glb': a path cannot hold a NUL"):
+        sim.save(str(tmp_path / "a\x00b.glb"))
+    assert sorted(os.listdir(tmp_path)) == ["a.glb", "a.gltf", "a.ply"]
 
 
 def test_presets_and_devices():
