@@ -76,7 +76,7 @@ TEST(Degenerate, SheetsOneParticleWideOrLongTearHangAndCrumple) {
   // (crumple), the stretch limit, the hand's squeeze, a yank that tears, and contact. A sheet one
   // particle wide has edges no triangle holds (edgeTriangles took its column edges for row edges
   // and read past the triangles: a crash). Each runs, and stays finite; the GPU's paths give the
-  // same bits (Parity.AwkwardSizes).
+  // same bits (Parity.DegenerateSheetsWithEveryRule).
   for (const auto& [cols, rows] :
        {std::pair{1, 10}, std::pair{10, 1}, std::pair{1, 3}, std::pair{1, 1}, std::pair{2, 2}}) {
     for (const char* p : {"tender", "crumple"}) {
