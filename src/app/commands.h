@@ -28,6 +28,7 @@ struct CommonOptions {
   std::string preset_file;       ///< a preset as JSON (--preset-file), instead of --preset
   std::vector<std::string> sets; ///< key=value overrides
   std::string backend = "gpu";   ///< cpu or gpu
+  bool backend_given = false;    ///< --backend was given (the demo's own choice otherwise: runDemo)
   int device = -1;               ///< Vulkan device index, -1 = best
   bool validation = false;       ///< VK_LAYER_KHRONOS_validation
   std::string script;            ///< input script to replay

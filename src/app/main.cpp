@@ -70,6 +70,9 @@ int main(int argc, char** argv) {
   CommonOptions common;
   DemoOptions demo;
   addCommon(app, common, true);
+  CLI::Option* demo_backend = app.get_option("--backend");
+  demo_backend->description("cpu or gpu (the demo: cpu when its Vulkan device is a CPU device, such as\n"
+                            "lavapipe, which runs the simulation slower than the CPU backend; gpu otherwise)");
   app.add_option("--record", demo.record, "write this session's input as an input script");
   app.add_option("--replay", demo.replay, "play an input script back");
   app.add_option("--vsync", demo.vsync, "on or off")->transform(CLI::Transformer({{"on", "1"}, {"off", "0"}}));
@@ -182,6 +185,7 @@ int main(int argc, char** argv) {
     if (*render_cmd) return runRender(common, render);
     if (*diff_cmd) return runDiff(common, diff);
     if (*sweep_cmd) return runSweep(common, sweep);
+    common.backend_given = demo_backend->count() > 0;
     return runDemo(common, demo);
   };
   try {

@@ -49,7 +49,7 @@ SceneView defaultSceneView(const SimParams& p) {
 
 Renderer::Renderer(gpu::VulkanContext& ctx, const RendererOptions& options, const ReceiptImage& receipt)
     : ctx_(ctx), dev_(ctx.device()), options_(options) {
-  shadow_.create(ctx);
+  shadow_.create(ctx, options.shadow_size);
   scene_.create(dev_, options.color_format, options.final_layout, pickSamples(ctx.properties(), options.max_samples));
   createReceiptSampler();
   uploadReceipt(receipt);
@@ -259,7 +259,7 @@ void Renderer::writeUniforms(uint32_t slot, const SceneView& view) {
   u.ground = hexColor(0xd0ccc8, 0.5f);
   u.bg_top = hexColor(0xe8e4e0);
   u.bg_bottom = hexColor(0xd8d4d0);
-  u.floor = glm::vec4(view.floor_y, view.ground, view.scale, 1.0f / float(RENDER_SHADOW_SIZE));
+  u.floor = glm::vec4(view.floor_y, view.ground, view.scale, 1.0f / float(shadow_.size));
   std::memcpy(uniforms_[slot].mapped, &u, sizeof(u));
 }
 

@@ -40,6 +40,7 @@ struct RendererOptions {
   VkImageLayout final_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL; ///< layout of the targets after the pass
   uint32_t frames = 2;                                               ///< frames in flight (uniform and set slots)
   uint32_t max_samples = 4;                                          ///< MSAA samples (lowered to what the device has)
+  uint32_t shadow_size = RENDER_SHADOW_SIZE;                         ///< the shadow map's width and height
 };
 
 /// The renderer. Pipelines are built one by one (buildNext) so that a window can show progress.

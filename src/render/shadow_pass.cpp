@@ -4,7 +4,8 @@
 
 namespace tender::render {
 
-void ShadowPass::create(gpu::VulkanContext& ctx) {
+void ShadowPass::create(gpu::VulkanContext& ctx, uint32_t map_size) {
+  size = map_size;
   VkDevice dev = ctx.device();
   // Render pass: one depth attachment, left readable by the scene pass.
   VkAttachmentDescription a{};
@@ -61,7 +62,7 @@ void ShadowPass::create(gpu::VulkanContext& ctx) {
 
   // The map and its framebuffer.
   ImageDesc d;
-  d.extent = {RENDER_SHADOW_SIZE, RENDER_SHADOW_SIZE};
+  d.extent = {size, size};
   d.format = kDepthFormat;
   d.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
   d.aspect = VK_IMAGE_ASPECT_DEPTH_BIT;
@@ -71,7 +72,7 @@ void ShadowPass::create(gpu::VulkanContext& ctx) {
   fb.renderPass = pass;
   fb.attachmentCount = 1;
   fb.pAttachments = &map.view;
-  fb.width = fb.height = RENDER_SHADOW_SIZE;
+  fb.width = fb.height = size;
   fb.layers = 1;
   VK_CHECK(vkCreateFramebuffer(dev, &fb, nullptr, &framebuffer));
   // Until the first shadow pass, the map reads as fully lit.
@@ -101,11 +102,11 @@ void ShadowPass::record(VkCommandBuffer cmd, const PaperBuffers& paper) const {
   rb.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
   rb.renderPass = pass;
   rb.framebuffer = framebuffer;
-  rb.renderArea = {{0, 0}, {RENDER_SHADOW_SIZE, RENDER_SHADOW_SIZE}};
+  rb.renderArea = {{0, 0}, {size, size}};
   rb.clearValueCount = 1;
   rb.pClearValues = &clear_depth;
   vkCmdBeginRenderPass(cmd, &rb, VK_SUBPASS_CONTENTS_INLINE);
-  setViewport(cmd, {RENDER_SHADOW_SIZE, RENDER_SHADOW_SIZE});
+  setViewport(cmd, {size, size});
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
   vkCmdDrawIndirect(cmd, paper.draw_args, paper.draw_args_offset, 1, 0);
   vkCmdEndRenderPass(cmd);

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Windowed smoke test of tender-demo under Xvfb: drag the sheet, orbit, zoom, pan, resize,
 # minimise and restore, press every key; the program must stay up and answer, the grab must catch
-# the sheet and move it, and the validation layers must stay silent. Exits 77 (skipped) without
-# Xvfb or xdotool.
+# the sheet and move it, and the validation layers must stay silent. On lavapipe without --backend
+# it simulates on the CPU. Exits 77 (skipped) without Xvfb or xdotool.
 set -u
 source "$(dirname "$0")/demo_lib.sh"
 
@@ -134,4 +134,15 @@ for sig in INT TERM HUP; do
     fail "SIG$sig to tender's pid: the recording was not written"
 done
 echo "ok: SIGINT, SIGTERM and SIGHUP sent to tender's pid alone end the demo's session with its recording"
+
+# On a CPU device (lavapipe here) the demo simulates on the CPU backend unless --backend says
+# otherwise, and draws a cheaper picture; its output, the HUD and --help say so.
+"$DEMO" --help | grep -q 'cpu when its Vulkan device is a CPU device' || fail "--help does not say how --backend is chosen"
+start_demo --width 320 --height 240
+sleep 2
+alive "start-up without --backend"
+stop_demo
+grep -q 'is a CPU device: simulating on the CPU, no MSAA, 1024² shadows$' "$tmp/demo.log" ||
+  fail "without --backend on a CPU device, not the CPU backend"
+echo "ok: $(grep 'is a CPU device' "$tmp/demo.log")"
 echo "PASS"

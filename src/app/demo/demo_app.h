@@ -142,8 +142,9 @@ private:
   float follow_clock_ = 0.0f; ///< seconds since the follow last looked at the sheet
   Input input_;
   bool show_fps_ = false;
-  OutputSet record_;        // --record: written when the session ends
-  std::string record_text_; // the events of the session so far, as an input script
+  std::string device_notice_; ///< the HUD's line on a CPU device (init)
+  OutputSet record_;          // --record: written when the session ends
+  std::string record_text_;   // the events of the session so far, as an input script
   SimState state_;
 };
 

@@ -21,6 +21,7 @@ struct HudState {
   bool show_fps = false, paused = false, wind = true, pins = true;
   bool follow = false; ///< the camera follows a tossed sheet
   std::string device;  ///< renderer device name
+  std::string notice;  ///< how the demo runs on this device, when it runs differently (a CPU device)
   const PassTimes* times = nullptr;
   uint32_t triangles = 0; ///< live triangles (0 when unknown)
   /// Where the grab holds the paper, in window pixels, while grabbing: the hand sprite's place
