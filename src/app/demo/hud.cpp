@@ -113,11 +113,9 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
     ImVec2 ts = body_->CalcTextSizeA(body, FLT_MAX, 0.0f, fps);
     textAt(dl, body_, body, {size.x - m - ts.x, m}, rgba(0x444444), fps);
   }
-  // How the demo runs on a CPU device, top-right, under the FPS
-  if (!s.notice.empty()) {
-    ImVec2 ts = body_->CalcTextSizeA(body, FLT_MAX, 0.0f, s.notice.c_str());
-    textAt(dl, body_, body, {size.x - m - ts.x, m + 1.5f * body}, rgba(0x666666), s.notice.c_str());
-  }
+  // How the demo runs on a CPU device, top-left, under the title (the parameters sit top-right)
+  if (!s.notice.empty())
+    textAt(dl, body_, body, {m, m * 0.8f + title_->FontSize + 0.4f * body}, rgba(0x666666), s.notice.c_str());
 
   // Buttons for wind, reset and pins, bottom-right.
   ImGui::SetNextWindowPos({size.x - m, size.y - m}, ImGuiCond_Always, {1.0f, 1.0f});
