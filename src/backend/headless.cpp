@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "backend.h"
+#include "core/sheet.h"
 #include "core/simulation.h"
 #include "gpu/gpu_solver.h"
 #include "render/paper_mesh.h"
@@ -45,7 +46,8 @@ std::optional<std::string> renderSequence(const HeadlessOptions& o, const FrameS
       host = std::make_unique<HostPaperMesh>(*ctx, sim.topology());
     if (host) renderer.setPaper(0, host->buffers());
     OffscreenTarget target(*ctx, renderer, o.width, o.height);
-    const SceneView view = defaultSceneView(sim.params());
+    SceneView view = defaultSceneView(sim.params());
+    const std::vector<uint32_t> samples = sheetSamples(sim.topology());
     uint64_t ticks = 0;
     SimState state;
     for (uint64_t frame = 0; frame < seq.frames; ++frame) {
@@ -56,6 +58,7 @@ std::optional<std::string> renderSequence(const HeadlessOptions& o, const FrameS
         solver.readback(state);
         host->update(state);
       }
+      if (view.sheet_share > 0.0f) followSheet(view, solver.particlePositions(samples));
       if (auto err = seq.sink(target.render(view), frame)) {
         ctx->waitIdle();
         return err;

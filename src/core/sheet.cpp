@@ -72,6 +72,14 @@ SheetPlacement sheetPlacement(const SimParams& p) {
   return at;
 }
 
+std::vector<uint32_t> sheetSamples(const SheetTopology& t) {
+  std::vector<uint32_t> samples;
+  if (t.rows == 0 || t.cols == 0) return samples;
+  for (uint32_t r = 0; r < 3; ++r)
+    for (uint32_t c = 0; c < 3; ++c) samples.push_back((t.rows - 1) * r / 2 * t.cols + (t.cols - 1) * c / 2);
+  return samples;
+}
+
 SheetTopology buildSheet(const SimParams& p) {
   SheetTopology t;
   const uint32_t W = p.cols, H = p.rows, N = W * H;

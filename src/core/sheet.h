@@ -48,6 +48,10 @@ inline uint32_t constraintId(const shaderio::Constraint& c) { return c.kind_id >
 /// Builds particles, constraints (coloured and sorted), adjacency and triangles.
 SheetTopology buildSheet(const SimParams& p);
 
+/// Nine particles spread over the sheet (its corners, its edges' middles and its centre): where a
+/// camera that follows the sheet reads it.
+std::vector<uint32_t> sheetSamples(const SheetTopology& t);
+
 /// Where buildSheet places the sheet: the height of its top edge, and how far its rows go down
 /// and back (the tilt) over the sheet's length.
 struct SheetPlacement {

@@ -36,15 +36,23 @@ SceneView defaultSceneView(const SimParams& p) {
   v.focus = glm::vec3(0.0f, 0.5f * (top + p.floor_y), 0.0f);
   v.extent = std::max(8.0f * s, 0.5f * (top - p.floor_y) + 3.0f * s);
   if (s != 1.0f) {
-    // A scene of another size: the spec's view, scaled, of the sheet's start and the ground below
-    // it, the target between them (and halfway along a tilted sheet's lean).
+    // A scene of another size: the spec's direction of view, scaled, on the sheet's centre, from
+    // where its length spans kFramedSheetShare of the view's height; the shadow's box and the
+    // ground cover the fall below it (and halfway along a tilted sheet's lean).
     v.camera.setScale(s);
-    const glm::vec3 target(0.0f, 0.5f * (top + p.floor_y), -0.5f * at.length * at.back);
-    v.camera.lookAt(target + glm::vec3(4.0f, 10.0f, 9.0f) * s, target);
-    v.focus = target;
+    v.sheet_share = kFramedSheetShare;
+    const glm::vec3 centre(0.0f, top - 0.5f * at.length * at.down, -0.5f * at.length * at.back);
+    const float half_fov = glm::radians(OrbitCamera::kFovDegrees) * 0.5f;
+    const float distance = std::max(at.length, s) / (v.sheet_share * 2.0f * std::tan(half_fov));
+    v.camera.lookAt(centre + glm::normalize(glm::vec3(4.0f, 10.0f, 9.0f)) * distance, centre);
+    v.focus = glm::vec3(0.0f, 0.5f * (top + p.floor_y), -0.5f * at.length * at.back);
     v.ground = v.extent; // as far as the shadow reaches
   }
   return v;
+}
+
+void followSheet(SceneView& view, std::span<const glm::vec3> samples) {
+  if (view.sheet_share > 0.0f && !samples.empty()) view.camera.setTarget(centreOf(samples));
 }
 
 Renderer::Renderer(gpu::VulkanContext& ctx, const RendererOptions& options, const ReceiptImage& receipt)

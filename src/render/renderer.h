@@ -28,11 +28,22 @@ struct SceneView {
   float extent = 10.0f;              ///< half size of the shadow map's box
   float scale = 1.0f;                ///< size of the scene (SimParams::view_scale): grid, light
   float ground = 5.0f;               ///< half size of the ground square
+  /// A framed sheet (a scene of another size): the part of the view's height its length spans,
+  /// the camera's target on its centre (followSheet); 0: a fixed view.
+  float sheet_share = 0.0f;
 };
 
+/// The part of the view's height a framed sheet's length spans: a receipt that falls and lands
+/// fills about a third of a 16:9 view, big enough to read its print.
+inline constexpr float kFramedSheetShare = 0.5f;
+
 /// The scene view of a parameter set: the spec's camera, the floor, a shadow box covering the
-/// sheet and the ground.
+/// sheet and the ground; a scene of another size (SimParams::view_scale) frames its sheet.
 SceneView defaultSceneView(const SimParams& params);
+
+/// Aims a framed view's camera at the centre of the sheet's sample points (sheetSamples), where the
+/// sheet is now; a fixed view (sheet_share 0) or no points leave it as it is.
+void followSheet(SceneView& view, std::span<const glm::vec3> samples);
 
 /// How the renderer's output is used.
 struct RendererOptions {

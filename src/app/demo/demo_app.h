@@ -83,7 +83,9 @@ private:
   /// crumple sheet, which falls to the floor at y = -10, a view from further back that shows the
   /// floor and the shadow on it.
   static render::OrbitCamera startView(const SimParams& p);
-  /// Whether the camera follows a tossed sheet at the start of a preset: on for crumple.
+  /// Whether the camera follows a tossed sheet at the start of a preset: on for crumple and for a
+  /// framed sheet (the paper receipt, render::SceneView::sheet_share), which it keeps in view as it
+  /// falls.
   static bool followsByDefault(const SimParams& p);
   /// The camera back at the start view (C, the View button, a preset switch).
   void resetView();

@@ -196,7 +196,9 @@ render::OrbitCamera DemoApp::startView(const SimParams& p) {
   return c;
 }
 
-bool DemoApp::followsByDefault(const SimParams& p) { return isCrumple(p); }
+bool DemoApp::followsByDefault(const SimParams& p) {
+  return isCrumple(p) || render::defaultSceneView(p).sheet_share > 0.0f;
+}
 
 void DemoApp::resetView() {
   camera_ = startView(sim_->params());
@@ -211,11 +213,7 @@ void DemoApp::setFollow(bool on) {
 }
 
 std::vector<glm::vec3> DemoApp::sheetSamples() const {
-  const SheetTopology& t = sim_->topology();
-  std::vector<uint32_t> samples;
-  for (uint32_t r = 0; r < 3; ++r)
-    for (uint32_t c = 0; c < 3; ++c) samples.push_back((t.rows - 1) * r / 2 * t.cols + (t.cols - 1) * c / 2);
-  return backend_.solver->particlePositions(samples);
+  return backend_.solver->particlePositions(tender::sheetSamples(sim_->topology()));
 }
 
 void DemoApp::updateFollow(float dt) {
