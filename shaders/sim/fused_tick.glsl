@@ -76,12 +76,11 @@ void scanWorkgroup(uint mode, uint offset, uint count, uint sums) {
 void contactSlideSubstep(uint s, uint n) {
   uint lid = gl_LocalInvocationID.x;
   uint queries = u.particle_count + contactEdgeCount();
-  for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_PASS);
-  sync();
-  for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_EXCESS);
-  sync();
-  for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_SHARE);
-  sync();
+  // (one loop over the three, so that the shader holds one copy of contactNear's body, not three)
+  for (uint only = NEAR_PASS; only <= NEAR_SHARE; ++only) {
+    for (uint k = lid; k < queries; k += kInvocations) contactNear(k, only);
+    sync();
+  }
   for (uint i = lid; i < n; i += kInvocations) {
     VerletState st;
     st.position = s_pos[i];
@@ -105,11 +104,12 @@ void contactSettleSubstep(uint s) {
   sync();
   if (!settleStarts()) return;
   uint queries = u.particle_count + contactEdgeCount();
-  for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_HALF_COUNT);
-  sync();
-  scanWorkgroup(SIM_SCAN_SCRATCH, halfStarts(), u.particle_count + 1u, compactSlots());
-  for (uint k = lid; k < queries; k += kInvocations) contactNear(k, NEAR_HALF_FILL);
-  sync();
+  // (counted, then after the counts' scan filled: one loop, one copy of contactNear's body)
+  for (uint only = NEAR_HALF_COUNT; only <= NEAR_HALF_FILL; ++only) {
+    if (only == NEAR_HALF_FILL) scanWorkgroup(SIM_SCAN_SCRATCH, halfStarts(), u.particle_count + 1u, compactSlots());
+    for (uint k = lid; k < queries; k += kInvocations) contactNear(k, only);
+    sync();
+  }
   for (uint sweep = 0u; sweep < contactChecks().y; ++sweep) {
     for (uint c = 0u; c < u.color_count; ++c) {
       uvec2 range = color_range[c];
