@@ -1,6 +1,8 @@
 #include "spirv_rules.h"
 
 #include <algorithm>
+#include <cstring>
+#include <string_view>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -240,6 +242,57 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
   if (preamble_end == code.size()) out.insert(out.end(), decorations.begin(), decorations.end());
   out[3] = types.bound; // the ids the flushes took
   return out;
+}
+
+} // namespace tender::gpu
+
+namespace tender::gpu {
+
+std::vector<std::string> inexactOperations(std::span<const uint32_t> code) {
+  constexpr uint32_t kOpName = 5, kOpExtInstImport = 11, kOpExtInst = 12, kOpFunction = 54, kOpFunctionCall = 57;
+  constexpr uint32_t kOpFDiv = 136, kOpFRem = 140, kOpFMod = 141, kSqrt = 31;
+  std::unordered_map<uint32_t, std::string> names;
+  std::unordered_set<uint32_t> glsl;
+  for (size_t w = 5; w < code.size();) {
+    const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
+    if (count == 0 || w + count > code.size()) break;
+    if ((op == kOpName && count >= 3) || (op == kOpExtInstImport && count >= 3)) {
+      const char* text = reinterpret_cast<const char*>(&code[w + 2]);
+      const std::string str(text, strnlen(text, (count - 2) * 4));
+      if (op == kOpName) names[code[w + 1]] = str;
+      if (op == kOpExtInstImport && str == "GLSL.std.450") glsl.insert(code[w + 1]);
+    }
+    w += count;
+  }
+  auto named = [&](uint32_t id, std::string_view prefix) {
+    auto it = names.find(id);
+    return it != names.end() && std::string_view(it->second).substr(0, prefix.size()) == prefix;
+  };
+  auto nameOf = [&](uint32_t id) {
+    auto it = names.find(id);
+    std::string n = it == names.end() ? "%" + std::to_string(id) : it->second;
+    return n.substr(0, n.find('('));
+  };
+  std::vector<std::string> found;
+  uint32_t function = 0;
+  for (size_t w = 5; w < code.size();) {
+    const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
+    if (count == 0 || w + count > code.size()) break;
+    if (op == kOpFunction && count >= 3) function = code[w + 2];
+    std::string what;
+    if (op == kOpFDiv && !named(function, "deviceDiv(")) what = "OpFDiv";
+    if (op == kOpFRem || op == kOpFMod) what = op == kOpFRem ? "OpFRem" : "OpFMod";
+    if (op == kOpExtInst && count >= 5 && glsl.count(code[w + 3]) && code[w + 4] == kSqrt &&
+        !named(function, "deviceSqrt("))
+      what = "GLSL.std.450 Sqrt";
+    if (op == kOpFunctionCall && count >= 4) {
+      if (named(code[w + 3], "deviceDiv(") && !named(function, "exactDiv(")) what = "a call of deviceDiv";
+      if (named(code[w + 3], "deviceSqrt(") && !named(function, "exactSqrt(")) what = "a call of deviceSqrt";
+    }
+    if (!what.empty()) found.push_back("in " + nameOf(function) + ": " + what);
+    w += count;
+  }
+  return found;
 }
 
 } // namespace tender::gpu

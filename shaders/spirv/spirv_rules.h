@@ -50,4 +50,14 @@ bool isFloatArithmetic(uint32_t opcode);
 /// later (float controls are core there).
 std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const FloatRules& rules);
 
+/// Where a simulation shader asks the device for a result the device may round its own way
+/// (shaders/shared/exact_math.h): an OpFDiv outside deviceDiv, a GLSL.std.450 Sqrt outside
+/// deviceSqrt, a call of either from anywhere but exactDiv and exactSqrt, an OpFRem or OpFMod
+/// anywhere; one line each ("in <function>: OpFDiv"). (Other GLSL.std.450 instructions whose
+/// result the device chooses are refused by tests/gpu/spirv_rules_test.cpp.) `code` is the module as glslc wrote it,
+/// its functions named and not yet inlined. Only these operations can differ on a device whose sqrt and divide are off
+/// by a few ULP (the emulated inexact device, TENDER_EMULATE_INEXACT_MATH), so with none the correction holds at every
+/// call.
+std::vector<std::string> inexactOperations(std::span<const uint32_t> code);
+
 } // namespace tender::gpu

@@ -1,6 +1,8 @@
 // Build step of the simulation's shaders (shaders/CMakeLists.txt):
 //   tender-spirv-rules IN.spv OUT.spv     NoContraction on every float operation (before spirv-opt,
-//                                         which would otherwise fuse a * b + c into Fma)
+//                                         which would otherwise fuse a * b + c into Fma); refuses a
+//                                         shader that divides or takes a square root outside
+//                                         exact_math.h's correction (inexactOperations)
 //   tender-spirv-rules --embed IN.spv OUT the words deflated (zlib), as the initialiser of a C array
 //                                         of words: the SPIR-V's word count, the deflated bytes'
 //                                         count, then those bytes four to a word (little-endian);
@@ -53,6 +55,13 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < packed.size(); ++i) out << packed[i] << (i % 8 == 7 ? ",\n" : ",");
     out << "\n";
   } else {
+    if (const std::vector<std::string> found = tender::gpu::inexactOperations(words); !found.empty()) {
+      for (const std::string& f : found)
+        std::fprintf(stderr, "tender-spirv-rules: error: %s: %s (exact_math.h: simDiv, simSqrt)\n", in_path, f.c_str());
+      out.close();
+      std::remove(tmp_path.c_str());
+      return 2;
+    }
     const std::vector<uint32_t> ruled = tender::gpu::applyFloatRules(words, {false, tender::gpu::Denormals::AsWritten});
     out.write(reinterpret_cast<const char*>(ruled.data()), std::streamsize(ruled.size() * 4));
   }
