@@ -28,15 +28,16 @@ constexpr CpuOptions kOneNoLists{1, 1, false};
 } // namespace
 
 TEST(CpuThreads, HangingSheetIsIdenticalOnOneAndTwoThreads) {
-  SimState one = run("tender", {"contact_factor=0"}, "", 60, kOne);
-  SimState two = run("tender", {"contact_factor=0"}, "", 60, kTwo);
+  SimState one = run("tender", {"contact_factor=0"}, "", 20, kOne);
+  SimState two = run("tender", {"contact_factor=0"}, "", 20, kTwo);
   expectIdentical(one, two);
 }
 
 TEST(CpuThreads, TearingYankIsIdenticalOnOneAndTwoThreads) {
-  const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n40 release\n";
-  SimState one = run("tender", {"contact_factor=0"}, yank, 80, kOne);
-  SimState two = run("tender", {"contact_factor=0"}, yank, 80, kTwo);
+  // (it tears in its second tick; the last ticks run let go)
+  const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n12 release\n";
+  SimState one = run("tender", {"contact_factor=0"}, yank, 20, kOne);
+  SimState two = run("tender", {"contact_factor=0"}, yank, 20, kTwo);
   EXPECT_GT(tornCount(one), 0u); // the run really tears and compacts
   EXPECT_LT(one.triangle_count, 2914u);
   expectIdentical(one, two);
@@ -49,23 +50,24 @@ TEST(CpuThreads, CrumpleTossAndAwkwardSizeAreIdentical) {
 }
 
 TEST(CpuThreads, TunedChunkingIsIdenticalOnALargerSheet) {
-  // Default chunk sizes: the loops of a 96 x 144 sheet are split the way real runs split them.
-  const std::string yank = "0 grab particle 13823\n1 move 6 -4 8\n20 release\n";
+  // Default chunk sizes: the loops of a 64 x 128 sheet are split the way real runs split them (its
+  // 8192 particles are two shares of kGrainParticles, its colours several of kGrainConstraints).
+  const std::string yank = "0 grab particle 8191\n1 move 6 -4 8\n12 release\n";
   SimState one =
-      run("tender", {"contact_factor=0", "cols=96", "rows=144"}, yank, 24, CpuOptions{.threads = 1, .min_chunk = 0});
+      run("tender", {"contact_factor=0", "cols=64", "rows=128"}, yank, 20, CpuOptions{.threads = 1, .min_chunk = 0});
   SimState two =
-      run("tender", {"contact_factor=0", "cols=96", "rows=144"}, yank, 24, CpuOptions{.threads = 2, .min_chunk = 0});
+      run("tender", {"contact_factor=0", "cols=64", "rows=128"}, yank, 20, CpuOptions{.threads = 2, .min_chunk = 0});
   expectIdentical(one, two);
 }
 
 TEST(CpuThreads, FullAdjacencyAndFourThreadsAreIdentical) {
   // Bend and triangle bend together: 16 neighbours per inner particle, the most the collision
   // pass's adjacency test holds in registers; four workers split every loop and phase.
-  const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n30 release\n";
-  SimState one = run("tender", {"contact_factor=0", "tri_bend=on"}, yank, 50, kOne);
+  const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n12 release\n";
+  SimState one = run("tender", {"contact_factor=0", "tri_bend=on"}, yank, 20, kOne);
   EXPECT_GT(tornCount(one), 0u);
   expectIdentical(
-      one, run("tender", {"contact_factor=0", "tri_bend=on"}, yank, 50, CpuOptions{.threads = 4, .min_chunk = 1}));
+      one, run("tender", {"contact_factor=0", "tri_bend=on"}, yank, 20, CpuOptions{.threads = 4, .min_chunk = 1}));
 }
 
 TEST(CpuThreads, ResetAndNoCollisionAreIdentical) {

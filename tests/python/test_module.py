@@ -233,7 +233,8 @@ def test_toss_example(tmp_path):
     assert out.read_bytes()[:4] == b"glTF"
 
 
-YANK = "0 grab particle 186\n1 move 4 -4 6\n30 release\n"
+# (it tears in its second step; the last steps run let go)
+YANK = "0 grab particle 186\n1 move 4 -4 6\n12 release\n"
 
 
 def fleet_sheets():
@@ -252,7 +253,7 @@ def test_fleet_sheets_match_their_runs_alone(backend, cols, rows):
     # test_the_hand_crumples_a_sheet_into_a_ball)
     fleet = tender.Fleet(sheets, preset="tender", backend=backend, cols=cols, rows=rows, contact_factor=0.0,
                          scripts=scripts)
-    fleet.step(40)
+    fleet.step(20)
     assert len(fleet) == 5 and fleet.backend == backend
     pos = fleet.positions
     assert pos.shape == (5, cols * rows, 3) and pos.dtype == np.float32
@@ -262,16 +263,16 @@ def test_fleet_sheets_match_their_runs_alone(backend, cols, rows):
     for i, extra in enumerate(sheets):
         sim = tender.Simulation(preset="tender", backend=backend, cols=cols, rows=rows, contact_factor=0.0, **extra)
         if scripts[i]:
-            for step in range(40):
+            for step in range(20):
                 if step == 0:
                     sim.grab(186)
                 if step == 1:
                     sim.move(4, -4, 6)
-                if step == 30:
+                if step == 12:
                     sim.release()
                 sim.step(1)
         else:
-            sim.step(40)
+            sim.step(20)
         assert hashes[i] == sim.state_hash(), "sheet %d" % i
         assert np.array_equal(pos[i], sim.positions)
         assert fleet.params(i)["damping"] == sim.params["damping"]
