@@ -894,7 +894,8 @@ TEST(Contact, TheBoundsDoNotDependOnTheThreadCount) {
   Simulation sa(p, a), sb(p, b);
   sa.setScript(script(text.c_str()));
   sb.setScript(script(text.c_str()));
-  expectIdentical(run(sa, 30), run(sb, 30));
+  // (the sheet snatched up and swung round: 20 ticks of the crumple's 40)
+  expectIdentical(run(sa, 20), run(sb, 20));
 }
 
 } // namespace
