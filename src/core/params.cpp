@@ -131,7 +131,8 @@ const std::vector<Param>& params() {
       scoped(floatParam("tilt", &SimParams::tilt, 0.0f, 90.0f, "degrees the sheet leans back from hanging (90: flat)"),
              ParamScope::Sheet),
       floatParam("view_scale", &SimParams::view_scale, 1e-3f, 1e3f,
-                 "size of the scene the camera frames and the ground covers (1: the tender sheet's)"),
+                 "size of the scene the ground covers (1: the tender sheet's; at any other, the camera frames the "
+                 "sheet and follows it)"),
       scoped(boolParam("shear", &SimParams::shear, "diagonal constraints"), ParamScope::Topology),
       scoped(boolParam("bend", &SimParams::bend, "skip-one bend constraints"), ParamScope::Topology),
       scoped(boolParam("tri_bend", &SimParams::tri_bend, "bending across adjacent triangles"), ParamScope::Topology),

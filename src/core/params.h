@@ -25,7 +25,8 @@ struct SimParams {
   PinMode pins = PinMode::Top3;
   float top_y = 0.0f;      ///< y of the top edge; 0: centred on y = 1, above the floor
   float tilt = 0.0f;       ///< degrees the sheet leans back from hanging (about its top edge): 90 lies flat
-  float view_scale = 1.0f; ///< size of the scene the camera frames and the ground covers (1: the tender sheet's)
+  float view_scale = 1.0f; ///< size of the scene the ground covers (1: the tender sheet's; any other: the camera frames
+                           ///< the sheet, render::SceneView::sheet_share)
   bool shear = true;       ///< diagonal constraints
   bool bend = true;        ///< skip-one bend constraints (rest 2 x spacing)
   bool tri_bend = false;   ///< bending across each pair of adjacent triangles
