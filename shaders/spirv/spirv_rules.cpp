@@ -244,10 +244,6 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
   return out;
 }
 
-} // namespace tender::gpu
-
-namespace tender::gpu {
-
 std::vector<std::string> inexactOperations(std::span<const uint32_t> code) {
   constexpr uint32_t kOpName = 5, kOpExtInstImport = 11, kOpExtInst = 12, kOpFunction = 54, kOpFunctionCall = 57;
   constexpr uint32_t kOpFDiv = 136, kOpFRem = 140, kOpFMod = 141, kSqrt = 31;
