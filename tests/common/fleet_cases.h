@@ -33,7 +33,7 @@ inline std::vector<FleetSheet> mixedFleet(uint32_t count, uint32_t cols = 12, ui
     std::vector<std::string> sets = {
         "cols=" + std::to_string(cols),
         "rows=" + std::to_string(rows),
-        "contact_factor=0", // the seeds' cloth (fleets with contact: ContactSheetsMatchTheirRunsAloneAndTheCpu)
+        "contact_factor=0", // the seeds' cloth (fleets with contact: ContactSheetsMatchTheCpuReference)
         "spacing=0.16",
         std::string("pins=") + kPins[i % 3],
         std::string("wind_kind=") + (i % 2 ? "noise" : "sinusoid"),
@@ -89,7 +89,7 @@ inline std::vector<FleetSheet> paperFleet(uint32_t count, bool receipt = false) 
                                                       : "1.01"),
         "crease_hardening=" + std::to_string(0.25 * (i % 3)),
         "iterations=" + std::to_string(3 + i % 2),
-        "contact_factor=0", // (fleets with contact: ContactSheetsMatchTheirRunsAloneAndTheCpu)
+        "contact_factor=0", // (fleets with contact: ContactSheetsMatchTheCpuReference)
     };
     if (receipt) {
       sets.push_back(std::string("air=") + (i % 5 == 4 ? "off" : "on"));
