@@ -92,6 +92,23 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
 #endif
 }
 
+std::optional<std::string> createSharedContext([[maybe_unused]] const BackendOptions& o,
+                                               std::shared_ptr<gpu::VulkanContext>& out) {
+  out.reset();
+#ifdef TENDER_HAS_GPU
+  try {
+    std::unique_ptr<gpu::VulkanContext> ctx;
+    if (auto err = createContext(o, ctx)) return err;
+    out = std::move(ctx);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return std::nullopt;
+#else
+  return std::string("this build has no Vulkan backend (try --backend cpu)");
+#endif
+}
+
 uint64_t gpuMemoryBytes([[maybe_unused]] int device) {
 #ifdef TENDER_HAS_GPU
   auto devices = gpu::listDevices();

@@ -59,6 +59,11 @@ bool vulkanBuilt();
 /// error) and leaves `out` empty.
 std::optional<std::string> createBackend(const BackendOptions& options, Backend& out);
 
+/// A Vulkan context of the options' device (and validation) for solvers and batches to share
+/// (BackendOptions::context): each compiles the simulation's kernels once a context. On failure
+/// returns the line createBackend gives and leaves `out` empty.
+std::optional<std::string> createSharedContext(const BackendOptions& options, std::shared_ptr<gpu::VulkanContext>& out);
+
 /// Bytes of device-local memory of Vulkan device `device` (-1: the one a solver given no index
 /// takes); 0 when it is unknown (no such device, or no Vulkan).
 uint64_t gpuMemoryBytes(int device);

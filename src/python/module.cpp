@@ -34,6 +34,26 @@ namespace py = pybind11;
 namespace tender {
 namespace {
 
+/// One Vulkan context a device for every GPU Simulation and Fleet of the process: each compiles
+/// the simulation's kernels once a context (VulkanContext::sharedPipeline), on lavapipe seconds,
+/// so once a process rather than once an object. Every call holds the GIL: no two objects use a
+/// context at once. Each object holds its context as well, so a context outlives its solvers; the
+/// cache lets go of its own at exit (atexit), while the driver is still loaded.
+std::map<int, std::shared_ptr<gpu::VulkanContext>>& contextCache() {
+  static std::map<int, std::shared_ptr<gpu::VulkanContext>> cache;
+  return cache;
+}
+
+/// The shared context of `options`' device, made at first use; RuntimeError when there is none.
+std::shared_ptr<gpu::VulkanContext> sharedContext(const BackendOptions& options) {
+  auto& cache = contextCache();
+  if (auto it = cache.find(options.device); it != cache.end()) return it->second;
+  std::shared_ptr<gpu::VulkanContext> ctx;
+  if (auto err = createSharedContext(options, ctx)) raise(PyExc_RuntimeError, *err);
+  cache[options.device] = ctx;
+  return ctx;
+}
+
 class PySimulation {
 public:
   PySimulation(const std::string& preset, const std::string& backend, std::optional<int> device,
@@ -175,11 +195,17 @@ private:
   void build(const SimParams& p) {
     BackendOptions options = backendOptionsFor(backend_name_, p);
     options.device = device_;
+    std::shared_ptr<gpu::VulkanContext> context;
+    if (backend_name_ == "gpu") {
+      context = sharedContext(options);
+      options.context = context.get();
+    }
     Backend backend;
     if (auto err = createBackend(options, backend)) raise(PyExc_RuntimeError, *err);
     auto sim = std::make_unique<Simulation>(p, *backend.solver);
     sim_.reset();
     backend_ = std::move(backend); // the solver stays where it is: `sim` keeps pointing at it
+    context_ = std::move(context); // after the old solver is gone
     sim_ = std::move(sim);
     ms_.clear();
   }
@@ -192,6 +218,7 @@ private:
 
   std::string backend_name_;
   int device_ = -1;
+  std::shared_ptr<gpu::VulkanContext> context_; // the GPU solver's (declared first: it goes last)
   Backend backend_;
   std::unique_ptr<Simulation> sim_;
   std::vector<double> ms_;
@@ -259,6 +286,10 @@ public:
       raise(PyExc_ValueError, *err);
     BackendOptions options = backendOptionsFor(backend, list[0].params);
     options.device = device.value_or(-1);
+    if (backend == "gpu") {
+      context_ = sharedContext(options);
+      options.context = context_.get();
+    }
     if (auto err = createBatch(options, uint32_t(list.size()), batch_)) raise(PyExc_RuntimeError, *err);
     fleet_ = std::make_unique<Fleet>(*batch_, list);
   }
@@ -350,6 +381,7 @@ private:
     return s;
   }
 
+  std::shared_ptr<gpu::VulkanContext> context_; // the GPU batch's (declared first: it goes last)
   std::unique_ptr<SheetBatch> batch_;
   std::unique_ptr<Fleet> fleet_;
   std::vector<double> ms_;
@@ -390,6 +422,7 @@ PYBIND11_MODULE(tender, m) {
     py::detail::npy_api::get();
   } catch (const py::error_already_set&) {
   }
+  py::module_::import("atexit").attr("register")(py::cpp_function([] { contextCache().clear(); }));
   m.attr("__version__") = TENDER_VERSION;
   m.def("presets", &presetNames, "The names of the built-in presets.");
   m.def("devices", &devices,
