@@ -81,13 +81,14 @@ Param boolParam(const char* key, bool SimParams::*m, const char* help) {
           [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); },
           [m](const SimParams& p) { return std::string(p.*m ? "on" : "off"); }};
 }
-/// A float key that is 0 (off) or at least 1 (a ratio to a rest length), at most `hi`.
-Param ratioParam(const char* key, float SimParams::*m, float hi, const char* help) {
+/// A float key that is 0 (off) or in [lo, hi] (on): a value between 0 and lo is neither.
+Param offOrRange(const char* key, float SimParams::*m, float lo, float hi, const char* help) {
   Param p = floatParam(key, m, 0.0f, hi, help);
-  p.set = [m, hi](SimParams& s, const std::string& v) -> std::optional<std::string> {
+  p.info.least_on = lo;
+  p.set = [m, lo, hi](SimParams& s, const std::string& v) -> std::optional<std::string> {
     float f = 0.0f;
     if (auto err = parseFloat(v, 0.0f, hi, f)) return err;
-    if (f > 0.0f && f < 1.0f) return v + " is neither 0 (off) nor at least 1";
+    if (f > 0.0f && f < lo) return v + " is neither 0 (off) nor at least " + fmt(lo);
     s.*m = f;
     return std::nullopt;
   };
@@ -163,8 +164,8 @@ const std::vector<Param>& params() {
                  "degrees a hinge bends past its rest angle before it creases (0: elastic)"),
       floatParam("crease_hardening", &SimParams::crease_hardening, 0.0f, 1000.0f,
                  "yield a crease adds per radian it moves the rest angle"),
-      ratioParam("stretch_limit", &SimParams::stretch_limit, 10.0f,
-                 "longest a structural edge may be after each substep, x rest (0: off)"),
+      offOrRange("stretch_limit", &SimParams::stretch_limit, 1.0f, 10.0f,
+                 "longest a structural edge may be after each substep, x rest (0: off, else at least 1)"),
       floatParam("tear_factor", &SimParams::tear_factor, 0.0f, 100.0f, "tear beyond factor x rest; 0: never"),
       boolParam("tear_structural", &SimParams::tear_structural, "structural constraints may tear"),
       boolParam("tear_shear", &SimParams::tear_shear, "shear constraints may tear"),
@@ -174,8 +175,8 @@ const std::vector<Param>& params() {
       floatParam("collision_factor", &SimParams::collision_factor, 0.0f, 10.0f,
                  "repulsion radius as a multiple of spacing"),
       floatParam("collision_stiffness", &SimParams::collision_stiffness, 0.0f, 1.0f, "repulsion strength"),
-      floatParam("contact_factor", &SimParams::contact_factor, 0.0f, 10.0f,
-                 "penetration-free contact radius as a multiple of spacing (0: off)"),
+      offOrRange("contact_factor", &SimParams::contact_factor, kMinContactFactor, kMaxContactFactor,
+                 "penetration-free contact radius as a multiple of spacing (0: off, else 0.25 to 0.75)"),
       uintParam("contact_settle", &SimParams::contact_settle, 0, SIM_SETTLE_MAX_SWEEPS,
                 "sweeps a substep that shorten edges the contact held past the stretch limit (0: none)"),
       floatParam("floor_y", &SimParams::floor_y, -1e4f, 1e4f, "ground height"),

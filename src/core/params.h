@@ -124,6 +124,18 @@ constexpr float kPaperStretchLimit = 1.01f;
 /// Paper's layers never pass through each other: contact (contact.h) within half a spacing, the
 /// sheet's own thickness at the presets' scales.
 constexpr float kPaperContactFactor = 0.5f;
+/// The range of contact_factor when on (0 is off). Contact is the paper's own thickness around the
+/// sheet, so its radius stays under the mesh's spacing:
+/// - at sqrt 2 spacings the offsets of particles that share no triangle overlap in the flat sheet,
+///   and a sheet at rest moves for ever (a hanging 8 x 8 `crumple` sheet: 0.044 units/s at 1.42,
+///   2.9 at 2; 6.4e-5 up to 1.4);
+/// - above 0.75 the stretch limit no longer holds in the hand's crumple (1.046 x rest at 1.0),
+///   and its pairs grow with the square of the radius (583 ms a tick at 1.0 against 78 at 0.5);
+/// - below 0.25 the radius nears rounding: at 1e-33 no step survives the cut while the hinges
+///   crease from the steps it cut, and a denormal one (1e-38) reads as off on one path and on on
+///   another.
+constexpr float kMinContactFactor = 0.25f;
+constexpr float kMaxContactFactor = 0.75f;
 /// The settle stage's sweeps a substep (settle_bodies.h): the edges the contact's cut held past the
 /// stretch limit shortened within its bounds; they stop after one that moves nothing.
 constexpr uint32_t kPaperSettleSweeps = 16;
@@ -145,6 +157,7 @@ struct ParamInfo {
   double lo = 0.0, hi = 0.0; ///< accepted range of a number (lo == hi: not a number)
   bool whole = false;        ///< a whole number (else a float, if a number)
   bool on_off = false;       ///< on/off (else, when not a number, one of some names)
+  double least_on = 0.0;     ///< > 0: the number is 0 (off) or at least this
   ParamScope scope = ParamScope::Live;
 };
 /// True when setting `key` rebuilds the sheet at rest (its scope is Sheet or Topology): the keys

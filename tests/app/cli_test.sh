@@ -17,6 +17,9 @@ expect_bad "${sim[@]}" --set gravity=nan
 expect_bad "${sim[@]}" --set stretch_limit=0.5
 expect_bad "${sim[@]}" --set stretch_limit=-1
 expect_bad "${sim[@]}" --set stretch_limit=inf
+# Contact's radius: 0 (off) or 0.25 to 0.75 spacings (a denormal is neither)
+expect_bad "${sim[@]}" --set contact_factor=1e-38
+expect_bad "${sim[@]}" --set contact_factor=2
 expect_bad "${sim[@]}" --set pins=middle
 expect_bad "${sim[@]}" --set substeps=0
 expect_bad "${sim[@]}" --set collision=maybe

@@ -63,6 +63,17 @@ TEST(Params, OverridesParseAndValidate) {
         "pins=middle", "wind=maybe", "substeps=33", "cols", "=4", "cols=99999999999", "contact_factor=-0.5",
         "contact_factor=nan", "contact_factor=1e30", "contact_settle=65", "contact_settle=-1"})
     EXPECT_TRUE(applyOverride(p, bad)) << bad;
+  // Contact is off at 0 and on from 0.25 to 0.75 spacings: a radius under it (a denormal one,
+  // which one path read as off and another as on) or past it (where a sheet at rest moves by
+  // itself) is refused, and the message gives the range
+  for (const char* bad : {"contact_factor=1e-38", "contact_factor=1e-33", "contact_factor=0.1", "contact_factor=1",
+                          "contact_factor=2", "contact_factor=10"})
+    EXPECT_TRUE(applyOverride(p, bad)) << bad;
+  EXPECT_EQ(applyOverride(p, "contact_factor=1e-38").value_or(""),
+            "contact_factor: 1e-38 is neither 0 (off) nor at least 0.25");
+  EXPECT_EQ(applyOverride(p, "contact_factor=1").value_or(""), "contact_factor: 1 is out of range [0, 0.75]");
+  for (const char* good : {"contact_factor=0", "contact_factor=0.25", "contact_factor=0.75"})
+    EXPECT_FALSE(applyOverride(p, good)) << good;
   // The message says what is wrong: infinity is a number, but not a finite one
   EXPECT_EQ(applyOverride(p, "contact_factor=inf").value_or(""), "contact_factor: 'inf' is not finite");
   EXPECT_EQ(applyOverride(p, "gravity=nan").value_or(""), "gravity: 'nan' is not a number");

@@ -506,6 +506,31 @@ TEST(Contact, PartingLayersGainNoSpeed) {
   EXPECT_EQ(intersectingPairs(s.pos, s.triangles, s.triangle_count).pairs, 0u);
 }
 
+TEST(Contact, ASheetAtRestStaysAtRestAtEveryAcceptedRadius) {
+  // At the least, the paper's and the most contact_factor takes, an 8 x 8 `crumple` sheet hanging
+  // from its corners and one lying flat on the floor stay at rest: no radius lets the contact push
+  // particles that lie still (a radius past sqrt 2 spacings does: 2.9 units/s hanging at 2)
+  const ParamInfo info = *paramInfo("contact_factor");
+  ASSERT_GT(info.least_on, 0.0);
+  for (const float factor : {float(info.least_on), kPaperContactFactor, float(info.hi)})
+    for (const bool flat : {false, true}) {
+      const std::string radius = "contact_factor=" + std::to_string(factor);
+      const SimParams p = flat ? preset("crumple", {"cols=8", "rows=8", "wind=off", "tilt=90", "pins=none",
+                                                    "floor_y=-3", "top_y=-3", radius.c_str()})
+                               : preset("crumple", {"cols=8", "rows=8", "wind=off", radius.c_str()});
+      CpuSolver solver;
+      Simulation sim(p, solver);
+      const SimState first = run(sim, 30);
+      const SimState last = run(sim, 60);
+      float moved = 0.0f;
+      for (size_t i = 0; i < last.pos.size(); ++i)
+        moved = std::max(moved, glm::length(vec3(last.pos[i] - first.pos[i])));
+      const float speed = computeStats(last, p.substepDt()).max_speed;
+      EXPECT_LT(speed, 1e-3f) << radius << (flat ? " on the floor" : " hanging");
+      EXPECT_LT(moved, 1e-3f) << radius << (flat ? " on the floor" : " hanging");
+    }
+}
+
 TEST(Contact, ASheetFallingAsAWholeIsNotHeldBack) {
   // The receipt let go without air, with contact: its bound alone would cap a step at 0.4 of the
   // contact radius, 0.96 m/s; the frame of the steps (contactFrame: the motion every particle
