@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
@@ -211,7 +212,11 @@ std::optional<std::string> parseWhole(const std::string& s, uint64_t lo, uint64_
   return std::nullopt;
 }
 
-std::vector<std::string> presetNames() { return {"tender", "crumple", "tender-low", "crumple-low", "paper"}; }
+std::vector<std::string> presetNames() {
+  std::vector<std::string> names;
+  for (const BuiltinPreset& preset : builtinPresets()) names.push_back(preset.name);
+  return names;
+}
 
 float SimParams::airPressureFactor() const {
   return air_density * drag_coefficient / (2.0f * (paper_weight * 1e-3f) * spacing * spacing);
@@ -233,75 +238,15 @@ float SimParams::handBallRadius() const {
 }
 
 std::optional<SimParams> presetParams(const std::string& name) {
-  SimParams p; // defaults are the `tender` preset, without contact
-  if (name == "tender" || name == "tender-low") {
-    // The seeds' cloth, its particle repulsion kept, with penetration-free contact
-    p.contact_factor = kPaperContactFactor;
-    if (name == "tender-low") p.cols = 24, p.rows = 36, p.spacing = 0.18f * 31.0f / 23.0f;
-  } else if (name == "crumple" || name == "crumple-low") {
-    p.cols = 40;
-    p.rows = 60;
-    p.spacing = 0.15f;
-    p.pins = PinMode::Corners;
-    p.tick_hz = 60.0f;
-    p.substeps = 8;
-    p.iterations = 4;
-    p.gravity = 0.5f;
-    p.damping = 0.995f;
-    p.wind = false;
-    p.wind_kind = WindKind::Noise;
-    p.wind_scale = 0.15f;
-    p.bend = false;
-    // Paper's hinges, creasing, with a rigidity that suits the scene's scale (not SI: a sheet of
-    // 6 x 9 units under a gravity of 0.5)
-    p.dihedral = true;
-    p.bending_rigidity = 0.02f;
-    p.crease_yield = kPaperCreaseYield;
-    p.crease_hardening = kPaperCreaseHardening;
-    p.stretch_limit = kPaperStretchLimit;
-    p.contact_factor = kPaperContactFactor;
-    p.contact_settle = kPaperSettleSweeps;
-    p.cell_size = 0.375f; // 2.5 x spacing, as in `tender`
-    p.floor_y = -10.0f;
-    p.restitution = 0.3f;
-    p.friction = 0.3f;
-    p.release = ReleaseMode::DragVelocity;
-    if (name == "crumple-low")
-      p.cols = 30, p.rows = 45, p.spacing = 0.15f * 39.0f / 29.0f, p.cell_size = 2.5f * p.spacing;
-  } else if (name == "paper") {
-    // A real receipt in SI units: 80 mm x 300 mm of 55 g/m^2 thermal paper, let go in still air
-    // with its lowest point 1 m above the floor, leaning 5 degrees from flat.
-    p.cols = 17;
-    p.rows = 61;
-    p.spacing = 0.005f;
-    p.pins = PinMode::None;
-    p.tilt = 85.0f;
-    p.view_scale = 0.1f;
-    p.paper_weight = 55.0f;
-    p.floor_y = 0.0f;
-    p.damping = 1.0f; // the air slows it, not a uniform damping
-    p.air = true;
-    p.wind = false;
-    // Thermal paper's hinges (README: Paper): its rigidity and the yield of its creases
-    p.bend = false;
-    p.dihedral = true;
-    p.bending_rigidity = kPaperRigidity;
-    p.crease_yield = kPaperCreaseYield;
-    p.crease_hardening = kPaperCreaseHardening;
-    p.stretch_limit = kPaperStretchLimit;
-    p.contact_factor = kPaperContactFactor;
-    p.contact_settle = kPaperSettleSweeps;
-    p.cell_size = 2.5f * p.spacing;
-    p.restitution = 0.05f;
-    p.friction = 0.6f;
-    p.release = ReleaseMode::DragVelocity;
-    p.grab_radius = 0.02f;
-    p.hand_reach = 0.16f; // a hand gathering the receipt from its middle: half its length
-  } else {
-    return std::nullopt;
+  for (const BuiltinPreset& preset : builtinPresets()) {
+    if (name != preset.name) continue;
+    SimParams p; // a built-in file that names no preset starts from the defaults
+    if (auto err = applyPresetText(preset.json, "preset " + name, std::nullopt, p))
+      throw std::logic_error("the built-in " + *err); // the build's own data: the tests read every one
+    p.preset = name;
+    return p;
   }
-  p.preset = name;
-  return p;
+  return std::nullopt;
 }
 
 const std::vector<ParamInfo>& paramKeys() {

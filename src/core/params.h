@@ -110,20 +110,6 @@ struct SimParams {
 /// How much of a ball crumpled by the hand is paper (layers a collision radius thick).
 constexpr float kHandPacking = 0.25f;
 
-/// Thermal receipt paper (README: Paper): 55 g/m^2, 60 um thick, a tensile modulus of about 4 GPa
-/// and a Poisson ratio of 0.3 give D = E t^3 / (12 (1 - nu^2)) = 7.9e-5 N m.
-constexpr float kPaperRigidity = 7.9e-5f;
-/// It yields at a bending strain of about 1 %: a curvature of 2 x 0.01 / t = 333 / m. A crease is
-/// some ten thicknesses wide (0.6 mm), so a hinge creases past 333 / m x 0.6 mm = 0.2 rad.
-constexpr float kPaperCreaseYield = 11.5f;
-/// The yield a crease adds per radian it moves: refolding a crease takes more than folding it.
-constexpr float kPaperCreaseHardening = 0.5f;
-/// Paper stretches well under 1 % before it tears; a sheet's edges are held within 1 % of rest
-/// (the stretch limit), which the projection then closes further.
-constexpr float kPaperStretchLimit = 1.01f;
-/// Paper's layers never pass through each other: contact (contact.h) within half a spacing, the
-/// sheet's own thickness at the presets' scales.
-constexpr float kPaperContactFactor = 0.5f;
 /// The range of contact_factor when on (0 is off). Contact is the paper's own thickness around the
 /// sheet, so its radius stays under the mesh's spacing:
 /// - at sqrt 2 spacings the offsets of particles that share no triangle overlap in the flat sheet,
@@ -136,10 +122,14 @@ constexpr float kPaperContactFactor = 0.5f;
 ///   another.
 constexpr float kMinContactFactor = 0.25f;
 constexpr float kMaxContactFactor = 0.75f;
-/// The settle stage's sweeps a substep (settle_bodies.h): the edges the contact's cut held past the
-/// stretch limit shortened within its bounds; they stop after one that moves nothing.
-constexpr uint32_t kPaperSettleSweeps = 16;
 
+/// A built-in preset: its name and its preset file's text (src/core/presets/NAME.json).
+struct BuiltinPreset {
+  const char* name;
+  const char* json;
+};
+/// The built-in presets, embedded when the programs are built, in the order `--help` lists them.
+const std::vector<BuiltinPreset>& builtinPresets();
 /// Names of the presets, in the order `--help` lists them.
 std::vector<std::string> presetNames();
 /// Looks up a preset; nullopt when unknown.
@@ -208,6 +198,10 @@ std::string presetJson(const SimParams& p);
 /// (`tender` when absent). Returns "<path>: <why>" on failure (unreadable, malformed JSON, an
 /// unknown key or preset, a bad value).
 std::optional<std::string> loadPresetFile(const std::string& path, SimParams& out);
+/// Applies a preset file's JSON `text` to `out` (loadPresetFile's rules; `origin` starts its
+/// errors): from the built-in preset it names, else from `base` (nullopt: `out` as it is).
+std::optional<std::string> applyPresetText(const std::string& text, const std::string& origin,
+                                           const std::optional<std::string>& base, SimParams& out);
 
 /// Sizes of the sheet a SimParams describes, counted without building it.
 struct SheetCounts {

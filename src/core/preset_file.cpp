@@ -111,34 +111,43 @@ private:
 
 } // namespace
 
-std::optional<std::string> loadPresetFile(const std::string& path, SimParams& out) {
-  std::string text;
-  if (auto why = readInputFile(path, kMaxPresetFileBytes, text)) return path + ": cannot read: " + *why;
-  if (text.find('\0') != std::string::npos) return path + ": holds a NUL byte (a preset file is JSON text)";
+std::optional<std::string> applyPresetText(const std::string& text, const std::string& origin,
+                                           const std::optional<std::string>& base, SimParams& out) {
+  if (text.find('\0') != std::string::npos) return origin + ": holds a NUL byte (a preset file is JSON text)";
   PresetReader reader;
   if (!nlohmann::json::sax_parse(text, &reader) || !reader.error.empty())
-    return path + ": " + (reader.error.empty() ? std::string("malformed JSON") : reader.error);
+    return origin + ": " + (reader.error.empty() ? std::string("malformed JSON") : reader.error);
 
-  std::string base = "tender";
+  std::optional<std::string> from = base;
   for (const auto& e : reader.entries)
     if (e.key == "preset") {
-      if (e.type != ValueType::Text) return path + ": preset: expected the name of a preset";
-      base = e.text;
+      if (e.type != ValueType::Text) return origin + ": preset: expected the name of a preset";
+      from = e.text;
     }
-  std::optional<SimParams> p = presetParams(base);
-  if (!p) {
-    std::string names;
-    for (auto& name : presetNames()) names += (names.empty() ? "" : ", ") + name;
-    return path + ": unknown preset '" + base + "' (one of " + names + ")";
+  SimParams p = out;
+  if (from) {
+    std::optional<SimParams> named = presetParams(*from);
+    if (!named) {
+      std::string names;
+      for (auto& name : presetNames()) names += (names.empty() ? "" : ", ") + name;
+      return origin + ": unknown preset '" + *from + "' (one of " + names + ")";
+    }
+    p = *named;
   }
   for (const auto& e : reader.entries) {
     if (e.key == "preset") continue;
     std::string spelled;
-    if (auto err = spellTyped(e.key, e.type, e.text, spelled)) return path + ": " + *err;
-    if (auto err = applyOverride(*p, e.key + "=" + spelled)) return path + ": " + *err;
+    if (auto err = spellTyped(e.key, e.type, e.text, spelled)) return origin + ": " + *err;
+    if (auto err = applyOverride(p, e.key + "=" + spelled)) return origin + ": " + *err;
   }
-  out = *p;
+  out = p;
   return std::nullopt;
+}
+
+std::optional<std::string> loadPresetFile(const std::string& path, SimParams& out) {
+  std::string text;
+  if (auto why = readInputFile(path, kMaxPresetFileBytes, text)) return path + ": cannot read: " + *why;
+  return applyPresetText(text, path, "tender", out);
 }
 
 } // namespace tender

@@ -44,8 +44,31 @@ TEST(Params, PresetsCarryTheSpecValues) {
   EXPECT_FALSE(presetParams("origami"));
   for (auto& name : presetNames()) EXPECT_FALSE(validate(*presetParams(name))) << name;
   // Penetration-free contact in every preset; the seeds' cloth keeps its particle repulsion beside it
-  for (auto& name : presetNames()) EXPECT_FLOAT_EQ(presetParams(name)->contact_factor, kPaperContactFactor) << name;
+  for (auto& name : presetNames()) EXPECT_FLOAT_EQ(presetParams(name)->contact_factor, 0.5f) << name;
   EXPECT_TRUE(t.collision);
+}
+
+TEST(Params, TheBuiltInPresetsAreThePresetFilesTheyDump) {
+  // Each built-in preset is a preset file (src/core/presets), read by loadPresetFile's code: its
+  // dump, read back as a preset file, gives every key the same value; one that names a preset
+  // starts from it, one that names none from the defaults
+  ASSERT_EQ(presetNames(), (std::vector<std::string>{"tender", "crumple", "tender-low", "crumple-low", "paper"}));
+  for (const BuiltinPreset& preset : builtinPresets()) {
+    const SimParams p = *presetParams(preset.name);
+    SimParams back = SimParams{};
+    EXPECT_FALSE(applyPresetText(presetJson(p), "dump", std::nullopt, back)) << preset.name;
+    EXPECT_EQ(paramValues(back), paramValues(p)) << preset.name;
+    EXPECT_EQ(back.preset, p.preset);
+  }
+  const SimParams low = *presetParams("crumple-low"), crumple = *presetParams("crumple");
+  EXPECT_EQ(low.cols, 30u);
+  EXPECT_EQ(low.stretch_limit, crumple.stretch_limit); // from crumple
+  EXPECT_EQ(presetParams("tender")->contact_factor, 0.5f);
+  EXPECT_EQ(presetParams("tender")->cols, SimParams{}.cols); // from the defaults
+  // A file's own errors name it
+  SimParams p;
+  EXPECT_EQ(applyPresetText("{\"preset\": \"origami\"}", "x.json", "tender", p).value_or(""),
+            "x.json: unknown preset 'origami' (one of tender, crumple, tender-low, crumple-low, paper)");
 }
 
 TEST(Params, OverridesParseAndValidate) {

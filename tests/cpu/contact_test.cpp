@@ -512,7 +512,7 @@ TEST(Contact, ASheetAtRestStaysAtRestAtEveryAcceptedRadius) {
   // particles that lie still (a radius past sqrt 2 spacings does: 2.9 units/s hanging at 2)
   const ParamInfo info = *paramInfo("contact_factor");
   ASSERT_GT(info.least_on, 0.0);
-  for (const float factor : {float(info.least_on), kPaperContactFactor, float(info.hi)})
+  for (const float factor : {float(info.least_on), presetParams("crumple")->contact_factor, float(info.hi)})
     for (const bool flat : {false, true}) {
       const std::string radius = "contact_factor=" + std::to_string(factor);
       const SimParams p = flat ? preset("crumple", {"cols=8", "rows=8", "wind=off", "tilt=90", "pins=none",
