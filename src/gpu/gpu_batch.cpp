@@ -261,14 +261,7 @@ void GpuBatch::flush() {
     resets = resets || u.reset_active;
     if (u.reset_active) continue;
     pass_substeps = std::max(pass_substeps, substeps);
-    plan.iterations = std::max(plan.iterations, u.iterations);
-    plan.collision = plan.collision || (u.flags & SIM_FLAG_COLLISION) != 0u;
-    plan.air = plan.air || (u.flags & SIM_FLAG_AIR) != 0u;
-    plan.crease = plan.crease || creasing(u.hinge.y, u.crease.y);
-    plan.contact = plan.contact || u.contact.x > 0.0f;
-    plan.limit = plan.limit || u.limit.x > 0.0f;
-    plan.shorten = plan.shorten || limitShortens(u.limit.x, u.grab_index, u.flags);
-    if (u.contact.x > 0.0f) plan.sweeps = std::max(plan.sweeps, u.contact_check.y);
+    plan.add(substepPlan(u));
   }
   if (fused.empty() && fused_contact.empty() && passes.empty()) return;
   last_dispatches_ = 0;
@@ -363,15 +356,7 @@ void GpuBatch::flush() {
         pass(sheet_passes_.reset, Grid::Threads, n, &all, sizeof(all), 0, SIM_GATE_RESET, 0);
         continue;
       }
-      const SubstepPlan sheet_plan{u.iterations,
-                                   (u.flags & SIM_FLAG_COLLISION) != 0u,
-                                   (u.flags & SIM_FLAG_AIR) != 0u,
-                                   SIM_NONE,
-                                   creasing(u.hinge.y, u.crease.y),
-                                   u.contact.x > 0.0f,
-                                   u.limit.x > 0.0f,
-                                   limitShortens(u.limit.x, u.grab_index, u.flags),
-                                   u.contact.x > 0.0f ? u.contact_check.y : 0u};
+      const SubstepPlan sheet_plan = substepPlan(u);
       for (uint32_t s = 0; s < substepCount(u.substeps); ++s)
         recordSubstep(*this, sheet_passes_, topo_, sizes_, sheet_plan, s, count);
     }

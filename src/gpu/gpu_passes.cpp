@@ -59,8 +59,9 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
     // Small sheet: every pass of fused_substeps_ substeps (on a GPU: all) in one workgroup; on a
     // CPU device with contact on, the contact passes on all its threads before each substep
     // (SIM_FLAG_CONTACT_PASSES), the rest of the substep in the workgroup
-    const uint32_t per = passesPerSubstep(key.iterations, topo_.colorCount(), key.collision);
-    const bool contact_passes = key.contact && !fused_contact_;
+    const SubstepPlan& plan = key.plan;
+    const uint32_t per = passesPerSubstep(plan.iterations, topo_.colorCount(), plan.collision);
+    const bool contact_passes = plan.contact && !fused_contact_;
     const uint32_t step = contact_passes ? 1 : fused_substeps_;
     for (uint32_t s = 0; s < key.substeps; s += step) {
       if (s > 0) computeToCompute(cmd);
@@ -71,18 +72,16 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
         timestamp(cmd, flight, kContact);
       }
       const uint32_t count = std::min(step, key.substeps - s);
-      dispatch(cmd, key.contact ? pipes_.tick_fused_contact : pipes_.tick_fused, Grid::Workgroup, 1,
-               FusedPush{n, s, count, key.stop});
+      dispatch(cmd, plan.contact ? pipes_.tick_fused_contact : pipes_.tick_fused, Grid::Workgroup, 1,
+               FusedPush{n, s, count, plan.stop});
       timestamp(cmd, flight, kFused);
-      if (key.stop != SIM_NONE && key.stop < (s + count) * per) break;
+      if (plan.stop != SIM_NONE && plan.stop < (s + count) * per) break;
     }
   } else {
     uint32_t pass = 0;
-    const SubstepPlan plan{key.iterations, key.collision, key.air,     key.stop,  key.crease,
-                           key.contact,    key.limit,     key.shorten, key.sweeps};
     recording_ = &flight;
     for (uint32_t s = 0; s < key.substeps; ++s)
-      if (recordSubstep(*this, pipes_, topo_, layout_sizes_, plan, s, pass)) break;
+      if (recordSubstep(*this, pipes_, topo_, layout_sizes_, key.plan, s, pass)) break;
     recording_ = nullptr;
   }
   computeToAll(cmd); // the renderer and copies see this tick

@@ -159,17 +159,7 @@ void GpuSolver::tick(const SimUniforms& u) {
     dispatches_per_tick_ = 1;
     return;
   }
-  RecordKey key{substepCount(u.substeps),
-                u.iterations,
-                (u.flags & SIM_FLAG_COLLISION) != 0u,
-                usesFusedPath(u),
-                stop_after_,
-                (u.flags & SIM_FLAG_AIR) != 0u,
-                creasing(u.hinge.y, u.crease.y),
-                contact,
-                u.limit.x > 0.0f,
-                limitShortens(u.limit.x, u.grab_index, u.flags),
-                contact ? u.contact_check.y : 0u};
+  const RecordKey key{substepCount(u.substeps), usesFusedPath(u), substepPlan(u, stop_after_)};
   stop_after_ = SIM_NONE;
   if (flight.recorded != key) recordTick(flight, index, key);
   ctx_.submit(flight.tick, flight.fence);

@@ -138,16 +138,9 @@ private:
   static constexpr uint32_t kStaticUniforms = kInFlight;
   static constexpr uint32_t kBindingCount = kSheetBindingCount;
   struct RecordKey {
-    uint32_t substeps = 0, iterations = 0;
-    bool collision = false;
+    uint32_t substeps = 0;
     bool fused = false;
-    uint32_t stop = SIM_NONE; ///< last pass recorded (stopNextTickAfter)
-    bool air = false;         ///< the air pass runs before integration (SIM_FLAG_AIR)
-    bool crease = false;      ///< the crease pass runs after the projection (creasing)
-    bool contact = false;     ///< the contact passes run (SimUniforms::contact)
-    bool limit = false;       ///< the stretch limit runs after the projection (SimUniforms::limit)
-    bool shorten = false;     ///< the limit shortens edges first (limitShortens)
-    uint32_t sweeps = 0;      ///< the settle stage's sweeps (SimUniforms::contact_check.y)
+    SubstepPlan plan; ///< what each substep runs (substepPlan), up to the pass it stops after
     bool operator==(const RecordKey&) const = default;
   };
   struct InFlight {

@@ -246,6 +246,32 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
 
 } // namespace
 
+SubstepPlan substepPlan(const shaderio::SimUniforms& u, uint32_t stop) {
+  const bool contact = u.contact.x > 0.0f;
+  SubstepPlan plan;
+  plan.iterations = u.iterations;
+  plan.collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
+  plan.air = (u.flags & SIM_FLAG_AIR) != 0u;
+  plan.stop = stop;
+  plan.crease = creasing(u.hinge.y, u.crease.y);
+  plan.contact = contact;
+  plan.limit = u.limit.x > 0.0f;
+  plan.shorten = limitShortens(u.limit.x, u.grab_index, u.flags);
+  plan.sweeps = contact ? u.contact_check.y : 0u;
+  return plan;
+}
+
+void SubstepPlan::add(const SubstepPlan& other) {
+  iterations = std::max(iterations, other.iterations);
+  collision = collision || other.collision;
+  air = air || other.air;
+  crease = crease || other.crease;
+  contact = contact || other.contact;
+  limit = limit || other.limit;
+  shorten = shorten || other.shorten;
+  sweeps = std::max(sweeps, other.sweeps);
+}
+
 uint32_t marksPerSubstep() {
   uint32_t marks = 0;
   for (size_t row = 0; row < std::size(kDispatches); ++row) marks += closesCategory(row) ? 1u : 0u;

@@ -97,8 +97,8 @@ protected:
   ~PassSink() = default;
 };
 
-/// What the passes of a substep cover: for a fleet, the most iterations of its sheets, and air,
-/// collision and creases when any sheet has them.
+/// What the passes of a substep cover: a sheet's from its uniforms (substepPlan); for a fleet, the
+/// union of its sheets' (add): the most iterations and sweeps, and each pass any sheet runs.
 struct SubstepPlan {
   uint32_t iterations = 0;
   bool collision = false;
@@ -109,7 +109,14 @@ struct SubstepPlan {
   bool limit = false;       ///< the stretch limit runs (SimUniforms::limit)
   bool shorten = false;     ///< the limit shortens edges first (limitShortens)
   uint32_t sweeps = 0;      ///< the settle stage's sweeps (SimUniforms::contact_check.y; 0: it does not run)
+
+  /// Widens this plan to cover `other`'s passes as well (its stop is kept).
+  void add(const SubstepPlan& other);
+  bool operator==(const SubstepPlan&) const = default;
 };
+
+/// The plan of a sheet's substeps from its uniforms, recording up to pass `stop`.
+SubstepPlan substepPlan(const shaderio::SimUniforms& u, uint32_t stop = SIM_NONE);
 
 /// Timestamps a substep of the per-colour path records (one where each category ends).
 uint32_t marksPerSubstep();
