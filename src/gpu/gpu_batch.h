@@ -61,6 +61,28 @@ private:
   friend class Sheet;
 
   void create(uint32_t sheets, BatchPasses passes, FusedShape fused);
+  /// The sheets a flush ticks, by the path each takes alone, and where the inputs buffer holds
+  /// their uniforms and the batch's indirect arguments (takeQueued).
+  struct FlushQueue {
+    std::vector<uint32_t> fused, fused_contact, passes; ///< sheets of the fused tick, with contact, of the passes
+    std::vector<shaderio::SimUniforms> pass_uniforms;   /// the uniforms of the passes' sheets, in their order
+    uint32_t fused_substeps = 0, pass_substeps = 0;     ///< the most substeps of each path
+    SubstepPlan plan;                                   ///< the union of the passes' sheets' plans
+    bool resets = false;                                ///< one of the passes' sheets resets
+    VkDeviceSize uniforms_at = 0, args_at = 0;
+    /// The queue the shaders read: the fused sheets without contact, those with, then the others.
+    std::vector<uint32_t> queue() const;
+  };
+  /// Takes the queued sheets' uniforms into the inputs buffer and sorts the sheets by path.
+  FlushQueue takeQueued();
+  /// Records the copies of the inputs (uniforms, queue, indirect arguments) to the device.
+  void recordInputs(const FlushQueue& f);
+  /// Records the fused tick of `count` sheets from queue[queue_first] with `pipe`, `substeps` each.
+  void recordFusedTicks(const ComputePipeline& pipe, uint32_t queue_first, uint32_t count, uint32_t substeps);
+  /// Records each passes' sheet's per-colour passes on its own descriptor set (PerSheet).
+  void recordSheetPasses(const FlushQueue& f);
+  /// Records the per-colour passes once for all the passes' sheets (Batched), and their arguments.
+  void recordBatchedPasses(const FlushQueue& f);
   // PassSink: a pass of the per-colour path for the sheets at queue[pass_first_, + pass_sheets_)
   void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t substep,
             uint32_t gate, uint32_t gate_arg) override;
