@@ -82,9 +82,11 @@ Param boolParam(const char* key, bool SimParams::*m, const char* help) {
           [m](SimParams& p, const std::string& v) { return parseBool(v, p.*m); },
           [m](const SimParams& p) { return std::string(p.*m ? "on" : "off"); }};
 }
-/// A float key that is 0 (off) or in [lo, hi] (on): a value between 0 and lo is neither.
+/// A float key that is 0 (off) or in [lo, hi] (on): a value between 0 and lo is neither. Its help
+/// ends with the range, from the same bounds.
 Param offOrRange(const char* key, float SimParams::*m, float lo, float hi, const char* help) {
   Param p = floatParam(key, m, 0.0f, hi, help);
+  p.info.help += " (0: off, else " + fmt(lo) + " to " + fmt(hi) + ")";
   p.info.least_on = lo;
   p.set = [m, lo, hi](SimParams& s, const std::string& v) -> std::optional<std::string> {
     float f = 0.0f;
@@ -166,7 +168,7 @@ const std::vector<Param>& params() {
       floatParam("crease_hardening", &SimParams::crease_hardening, 0.0f, 1000.0f,
                  "yield a crease adds per radian it moves the rest angle"),
       offOrRange("stretch_limit", &SimParams::stretch_limit, 1.0f, 10.0f,
-                 "longest a structural edge may be after each substep, x rest (0: off, else at least 1)"),
+                 "longest a structural edge may be after each substep, x rest"),
       floatParam("tear_factor", &SimParams::tear_factor, 0.0f, 100.0f, "tear beyond factor x rest; 0: never"),
       boolParam("tear_structural", &SimParams::tear_structural, "structural constraints may tear"),
       boolParam("tear_shear", &SimParams::tear_shear, "shear constraints may tear"),
@@ -177,7 +179,7 @@ const std::vector<Param>& params() {
                  "repulsion radius as a multiple of spacing"),
       floatParam("collision_stiffness", &SimParams::collision_stiffness, 0.0f, 1.0f, "repulsion strength"),
       offOrRange("contact_factor", &SimParams::contact_factor, kMinContactFactor, kMaxContactFactor,
-                 "penetration-free contact radius as a multiple of spacing (0: off, else 0.25 to 0.75)"),
+                 "penetration-free contact radius as a multiple of spacing"),
       uintParam("contact_settle", &SimParams::contact_settle, 0, SIM_SETTLE_MAX_SWEEPS,
                 "sweeps a substep that shorten edges the contact held past the stretch limit (0: none)"),
       floatParam("floor_y", &SimParams::floor_y, -1e4f, 1e4f, "ground height"),
