@@ -1,4 +1,4 @@
-// The settle stage's per-edge body, shared by GLSL and C++ (src/cpu/settle_elements.h includes it
+// The settle stage's per-edge body, shared by GLSL and C++ (settle_elements.h beside it includes it
 // inside a struct whose members bear the buffers' names): after the contact's cut and push, each
 // structural edge longer than the stretch limit is shortened from both ends within what the
 // contact lets each end's step go. It reads u (SimUniforms), the positions through SIM_POSITION(j),

@@ -1,7 +1,7 @@
 // Per-element bodies of the simulation's passes that the CPU reference runs as they are (the
 // projection, the air, the tear marks): the
 // shaders' main()s and the fused tick call them (sim_elements.glsl includes this file after the
-// buffers), and so does CpuSolver (src/cpu/sheet_elements.h includes it inside a struct whose
+// buffers), and so does CpuSolver (sheet_elements.h beside it includes it inside a struct whose
 // members bear the buffers' names). They read the sheet by those names: u (SimUniforms), prev,
 // torn, tri_edges, hinges, counters, and the positions through SIM_POSITION(j); atomicAdd and
 // atomicExchange are GLSL's (C++: shaderio.h).
