@@ -87,9 +87,9 @@
 #define SIM_BIND_HINGES 29
 // Penetration-free contact (contact.h, the contact_* passes), in words: the sheet's edges, each once
 // (four words: its particles a < b, then the ids of the one or two triangles that hold it, SIM_NONE
-// for none), sorted by (a, b); then the pair lists (contact.glsl): SIM_CONTACT_LIST_HEADER words
+// for none), sorted by (a, b); then the pair lists (contact_grid.glsl): SIM_CONTACT_LIST_HEADER words
 // (the triangle count they stand for, the radius, the builds, whether a query searches, the build
-// whose queries are named: contact.glsl's LIST_*), where each particle was when they
+// whose queries are named: contact_grid.glsl's LIST_*), where each particle was when they
 // were built (four words each), and per query (particles, then edges) the count of its pairs and
 // SIM_CONTACT_LIST_CAPACITY slots for them
 #define SIM_BIND_CONTACT_LISTS 30

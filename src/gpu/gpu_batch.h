@@ -60,6 +60,11 @@ private:
   class Sheet;
   friend class Sheet;
 
+  /// Slices start at this alignment (every binding's slice of every sheet).
+  static constexpr VkDeviceSize kSliceAlign = 256;
+  /// The batch's indirect arguments.
+  static constexpr VkDeviceSize kArgsBytes = 16ull * SIM_BATCH_ARGS_COUNT;
+
   void create(uint32_t sheets, BatchPasses passes, FusedShape fused);
   /// The sheets a flush ticks, by the path each takes alone, and where the inputs buffer holds
   /// their uniforms and the batch's indirect arguments (takeQueued).

@@ -132,7 +132,7 @@ SheetLayout SheetLayout::of(const SheetTopology& topo, VkDeviceSize max_range, b
     l.contact_active_sums = l.contact_active + queries + 1;
     l.contact_half = l.contact_active_sums + scanSumsSize(queries + 1);
     l.contact_half_sums = l.contact_half + 2 * topo.particleCount() + 1;
-    // The header, the entries, the boxes and the active queries (contact.glsl)
+    // The header, the entries, the boxes and the active queries (contact_grid.glsl)
     l.contact_words = SIM_CONTACT_HEADER + uint64_t(SIM_CONTACT_CELLS_PER_BOX + 6) * boxes + queries;
     // The edges, then the lists' header, where each particle was, each query's count and pairs,
     // then the settle's half-spaces (five words each)

@@ -79,7 +79,7 @@ void readSheetState(VulkanContext& ctx, const SheetPlace& place, const SheetTopo
 int64_t readContactCount(VulkanContext& ctx, const Buffer& grid, VkDeviceSize offset) {
   uint32_t header[SIM_CONTACT_HEADER];
   ctx.download(grid, header, sizeof(header), offset);
-  return header[2]; // CONTACT_COUNT (contact.glsl)
+  return header[2]; // CONTACT_COUNT (contact_grid.glsl)
 }
 
 } // namespace tender::gpu
