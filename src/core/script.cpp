@@ -53,6 +53,63 @@ std::optional<std::string> parseClosure(const std::string& w, float& closure) {
 
 const char* toggleName(Toggle t) { return t == Toggle::On ? "on" : t == Toggle::Off ? "off" : "toggle"; }
 
+/// The event of a script line after its tick (`verb`, then the rest of the line in `in`) into e; the
+/// reason when the line is wrong.
+std::optional<std::string> parseScriptEvent(const std::string& verb, std::istringstream& in, ScriptEvent& e) {
+  if (verb == "grab") {
+    std::string how;
+    in >> how;
+    if (how == "particle") {
+      long long i = -1;
+      if (!(in >> i) || i < 0 || i > 0xFFFFFFFELL) return "grab particle needs a particle index";
+      e.kind = EventKind::GrabParticle;
+      e.particle = uint32_t(i);
+    } else if (how == "ray") {
+      e.kind = EventKind::GrabRay;
+      std::string bad = readVec(in, e.a);
+      if (bad.empty()) bad = readVec(in, e.b);
+      if (bad == "missing") return "grab ray needs 6 numbers: origin and direction";
+      if (!bad.empty()) return "grab ray: " + bad;
+      if (glm::dot(e.b, e.b) < 1e-12f) return "grab ray direction is zero";
+    } else {
+      return "grab needs 'particle <index>' or 'ray <ox oy oz dx dy dz>'";
+    }
+  } else if (verb == "move") {
+    e.kind = EventKind::Move;
+    const std::string bad = readVec(in, e.a);
+    if (bad == "missing") return "move needs 3 numbers";
+    if (!bad.empty()) return "move: " + bad;
+  } else if (verb == "release") {
+    e.kind = EventKind::Release;
+  } else if (verb == "squeeze") {
+    e.kind = EventKind::Squeeze;
+    std::string word;
+    if (!(in >> word)) return "squeeze needs the hand's closure, 0 (open) to 1 (closed)";
+    if (auto err = parseClosure(word, e.closure)) return "squeeze: " + *err;
+  } else if (verb == "wind" || verb == "pins" || verb == "pause") {
+    e.kind = verb == "wind" ? EventKind::Wind : verb == "pins" ? EventKind::Pins : EventKind::Pause;
+    if (!readToggle(in, e.toggle)) return verb + " needs on, off or toggle";
+  } else if (verb == "reset") {
+    e.kind = EventKind::Reset;
+  } else if (verb == "set") {
+    e.kind = EventKind::Set;
+    if (!(in >> e.key >> e.value)) return "set needs a key and a value";
+    if (e.key == "preset") {
+      if (!presetParams(e.value)) return "set preset: unknown preset '" + e.value + "'";
+    } else {
+      const auto info = paramInfo(e.key);
+      if (!info) return "set: unknown parameter '" + e.key + "'";
+      if (info->scope == ParamScope::Solver)
+        return "set " + e.key + ": it changes the solver, not the sheet (give it on the command line)";
+      SimParams p;
+      if (auto err = applyOverride(p, e.key + "=" + e.value)) return "set " + *err;
+    }
+  } else {
+    return "unknown event '" + verb + "'";
+  }
+  return std::nullopt;
+}
+
 } // namespace
 
 std::optional<InputScript> parseScript(const std::string& text, std::string& error) {
@@ -84,57 +141,7 @@ std::optional<InputScript> parseScript(const std::string& text, std::string& err
     if (!(in >> verb)) return fail("missing event after the tick");
     ScriptEvent e;
     e.tick = tick;
-    if (verb == "grab") {
-      std::string how;
-      in >> how;
-      if (how == "particle") {
-        long long i = -1;
-        if (!(in >> i) || i < 0 || i > 0xFFFFFFFELL) return fail("grab particle needs a particle index");
-        e.kind = EventKind::GrabParticle;
-        e.particle = uint32_t(i);
-      } else if (how == "ray") {
-        e.kind = EventKind::GrabRay;
-        std::string bad = readVec(in, e.a);
-        if (bad.empty()) bad = readVec(in, e.b);
-        if (bad == "missing") return fail("grab ray needs 6 numbers: origin and direction");
-        if (!bad.empty()) return fail("grab ray: " + bad);
-        if (glm::dot(e.b, e.b) < 1e-12f) return fail("grab ray direction is zero");
-      } else {
-        return fail("grab needs 'particle <index>' or 'ray <ox oy oz dx dy dz>'");
-      }
-    } else if (verb == "move") {
-      e.kind = EventKind::Move;
-      const std::string bad = readVec(in, e.a);
-      if (bad == "missing") return fail("move needs 3 numbers");
-      if (!bad.empty()) return fail("move: " + bad);
-    } else if (verb == "release") {
-      e.kind = EventKind::Release;
-    } else if (verb == "squeeze") {
-      e.kind = EventKind::Squeeze;
-      std::string word;
-      if (!(in >> word)) return fail("squeeze needs the hand's closure, 0 (open) to 1 (closed)");
-      if (auto err = parseClosure(word, e.closure)) return fail("squeeze: " + *err);
-    } else if (verb == "wind" || verb == "pins" || verb == "pause") {
-      e.kind = verb == "wind" ? EventKind::Wind : verb == "pins" ? EventKind::Pins : EventKind::Pause;
-      if (!readToggle(in, e.toggle)) return fail(verb + " needs on, off or toggle");
-    } else if (verb == "reset") {
-      e.kind = EventKind::Reset;
-    } else if (verb == "set") {
-      e.kind = EventKind::Set;
-      if (!(in >> e.key >> e.value)) return fail("set needs a key and a value");
-      if (e.key == "preset") {
-        if (!presetParams(e.value)) return fail("set preset: unknown preset '" + e.value + "'");
-      } else {
-        const auto info = paramInfo(e.key);
-        if (!info) return fail("set: unknown parameter '" + e.key + "'");
-        if (info->scope == ParamScope::Solver)
-          return fail("set " + e.key + ": it changes the solver, not the sheet (give it on the command line)");
-        SimParams p;
-        if (auto err = applyOverride(p, e.key + "=" + e.value)) return fail("set " + *err);
-      }
-    } else {
-      return fail("unknown event '" + verb + "'");
-    }
+    if (auto err = parseScriptEvent(verb, in, e)) return fail(*err);
     std::string extra;
     if (in >> extra) return fail("unexpected '" + extra + "' at the end of the line");
     script.events.push_back(e);

@@ -80,16 +80,14 @@ std::vector<uint32_t> sheetSamples(const SheetTopology& t) {
   return samples;
 }
 
-SheetTopology buildSheet(const SimParams& p) {
-  SheetTopology t;
+namespace {
+
+/// The particles of sheet p in t: a portrait sheet in the XY plane, facing +Z, row 0 at the top;
+/// with a tilt it leans back about its top edge. Their texture coordinates, and the pins.
+void placeParticles(const SimParams& p, SheetTopology& t) {
   const uint32_t W = p.cols, H = p.rows, N = W * H;
   const float s = p.spacing;
-  t.cols = W;
-  t.rows = H;
   auto idx = [W](uint32_t i, uint32_t j) { return j * W + i; };
-
-  // Particles: a portrait sheet in the XY plane, facing +Z, row 0 at the top; with a tilt it leans
-  // back about its top edge.
   const float width = float(W - 1) * s;
   const SheetPlacement at = sheetPlacement(p);
   const float top = at.top, down = at.down, back = at.back;
@@ -104,6 +102,50 @@ SheetTopology buildSheet(const SimParams& p) {
       t.uv[idx(i, j)] = glm::vec2(W > 1 ? float(i) / float(W - 1) : 0.5f, H > 1 ? float(j) / float(H - 1) : 0.5f);
     }
   for (uint32_t pin : pinIndices(p.pins, W, H)) t.rest_pos[pin].w = 1.0f;
+}
+
+/// The adjacency of the N particles (CSR, each particle's neighbours rising) from constraints cs.
+void buildAdjacency(const std::vector<shaderio::Constraint>& cs, uint32_t N, SheetTopology& t) {
+  t.adj_offsets.assign(N + 1, 0);
+  for (auto& c : cs) t.adj_offsets[c.a + 1]++, t.adj_offsets[c.b + 1]++;
+  for (uint32_t i = 0; i < N; ++i) t.adj_offsets[i + 1] += t.adj_offsets[i];
+  t.adj_list.resize(t.adj_offsets[N]);
+  {
+    std::vector<uint32_t> cursor(t.adj_offsets.begin(), t.adj_offsets.end() - 1);
+    for (auto& c : cs) t.adj_list[cursor[c.a]++] = c.b, t.adj_list[cursor[c.b]++] = c.a;
+    for (uint32_t i = 0; i < N; ++i)
+      std::sort(t.adj_list.begin() + t.adj_offsets[i], t.adj_list.begin() + t.adj_offsets[i + 1]);
+  }
+}
+
+/// The triangles of a W x H sheet in t: two per quad, split along (i,j)-(i+1,j+1), counter-clockwise
+/// seen from +Z, with their two edges' constraint ids (h_id, v_id: each particle's row and column
+/// edge).
+void addTriangles(uint32_t W, uint32_t H, const std::vector<uint32_t>& h_id, const std::vector<uint32_t>& v_id,
+                  SheetTopology& t) {
+  auto idx = [W](uint32_t i, uint32_t j) { return j * W + i; };
+  for (uint32_t j = 0; j + 1 < H; ++j)
+    for (uint32_t i = 0; i + 1 < W; ++i) {
+      uint32_t tl = idx(i, j), bl = idx(i, j + 1), br = idx(i + 1, j + 1), tr = idx(i + 1, j);
+      uint32_t id = uint32_t(t.triangles.size());
+      t.triangles.push_back({tl, bl, br, id});
+      t.tri_edges.push_back({v_id[tl], h_id[bl]});
+      t.triangles.push_back({tl, br, tr, id + 1});
+      t.tri_edges.push_back({v_id[tr], h_id[tl]});
+    }
+}
+
+} // namespace
+
+SheetTopology buildSheet(const SimParams& p) {
+  SheetTopology t;
+  const uint32_t W = p.cols, H = p.rows, N = W * H;
+  const float s = p.spacing;
+  t.cols = W;
+  t.rows = H;
+  auto idx = [W](uint32_t i, uint32_t j) { return j * W + i; };
+
+  placeParticles(p, t);
 
   // Constraints in generation order; the order is the original id.
   std::vector<shaderio::Constraint> cs;
@@ -153,32 +195,13 @@ SheetTopology buildSheet(const SimParams& p) {
     }
   }
 
-  // Adjacency (CSR, sorted) from the initial constraints.
-  t.adj_offsets.assign(N + 1, 0);
-  for (auto& c : cs) t.adj_offsets[c.a + 1]++, t.adj_offsets[c.b + 1]++;
-  for (uint32_t i = 0; i < N; ++i) t.adj_offsets[i + 1] += t.adj_offsets[i];
-  t.adj_list.resize(t.adj_offsets[N]);
-  {
-    std::vector<uint32_t> cursor(t.adj_offsets.begin(), t.adj_offsets.end() - 1);
-    for (auto& c : cs) t.adj_list[cursor[c.a]++] = c.b, t.adj_list[cursor[c.b]++] = c.a;
-    for (uint32_t i = 0; i < N; ++i)
-      std::sort(t.adj_list.begin() + t.adj_offsets[i], t.adj_list.begin() + t.adj_offsets[i + 1]);
-  }
+  buildAdjacency(cs, N, t);
 
   // Colour and sort.
   t.colors = sortByColor(cs, colorGreedy(cs, W, H, t.hinge_first));
   t.constraints = std::move(cs);
 
-  // Triangles: two per quad, split along (i,j)-(i+1,j+1), counter-clockwise seen from +Z.
-  for (uint32_t j = 0; j + 1 < H; ++j)
-    for (uint32_t i = 0; i + 1 < W; ++i) {
-      uint32_t tl = idx(i, j), bl = idx(i, j + 1), br = idx(i + 1, j + 1), tr = idx(i + 1, j);
-      uint32_t id = uint32_t(t.triangles.size());
-      t.triangles.push_back({tl, bl, br, id});
-      t.tri_edges.push_back({v_id[tl], h_id[bl]});
-      t.triangles.push_back({tl, br, tr, id + 1});
-      t.tri_edges.push_back({v_id[tr], h_id[tl]});
-    }
+  addTriangles(W, H, h_id, v_id, t);
 
   uint32_t hs = 2;
   while (hs < 2 * N) hs <<= 1;

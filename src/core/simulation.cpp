@@ -232,17 +232,6 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   u.hinge = glm::uvec4(topo_.hinge_first, topo_.hingeCount(), 0u, 0u);
   u.crease = glm::vec4(p.hingeCompliance(), float(double(p.crease_yield) * (3.14159265358979323846 / 180.0)),
                        p.crease_hardening, 0.0f);
-  // The stretch limit (with contact, its places are steps the contact cuts as any), from the grab,
-  // else from the pins that hold the sheet (limitRootSet)
-  if (p.stretch_limit > 0.0f) {
-    u.limit = glm::vec4(p.stretch_limit * p.spacing, p.spacing, 0.0f, 0.0f);
-    const std::vector<uint32_t> pins = pins_ ? pinIndices(p.pins, p.cols, p.rows) : std::vector<uint32_t>{};
-    if (grab_index_ == SIM_NONE && release_index_ == SIM_NONE && !pins.empty()) {
-      u.limit_roots = glm::uvec4(SIM_NONE, SIM_NONE, SIM_NONE, 0u);
-      for (const uint32_t pin : pins)
-        if (u.limit_roots.w < SIM_LIMIT_ROOTS) u.limit_roots[int(u.limit_roots.w++)] = pin;
-    }
-  }
   u.reset_active = reset_frame_ > 0 ? 1u : 0u;
   u.reset_alpha = reset_frame_ > 0 ? float(SIM_RESET_FRAMES - reset_frame_ + 1) / float(SIM_RESET_FRAMES) : 0.0f;
   u.iterations = p.iterations;
@@ -251,14 +240,8 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
     u.contact = glm::vec4(p.contactRadius(), SIM_CONTACT_FRACTION, thickness, SIM_CONTACT_FIXED / thickness);
   }
 
-  const double t0 = double(physics_ticks_) / double(p.tick_hz);
-  const double dts = 1.0 / (double(p.tick_hz) * p.substeps);
-  const float amp = wind_ ? p.wind_strength * p.wind_scale : 0.0f;
   u.grab_index = grab_index_ != SIM_NONE ? grab_index_ : release_index_;
-  if (u.limit.x > 0.0f) {
-    const glm::uvec4 roots = shaderio::limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
-    u.limit.z = float(shaderio::limitLastRing(roots, u.cols, u.rows));
-  }
+  setLimitUniforms(p, u);
   if (grab_index_ != SIM_NONE && closure_ > 0.0f && p.hand_reach > 0.0f) {
     const double dt = double(u.dt);
     const float ball = std::min(p.handBallRadius(), p.hand_reach);
@@ -266,6 +249,40 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
                        float(-std::expm1(-dt / kHandPullSeconds)), float(-std::expm1(-dt / kHandGripSeconds)));
     u.hand_motion = glm::vec4((grab_to_ - grab_from_) / float(p.substeps), p.floor_y + u.hand.x);
   }
+  setSubstepInputs(p, u);
+  // Every triangle is checked for crossing the sheet in the first substep of a tick when contact
+  // starts (a new sheet, a reset, the key turned on) and once every SIM_CONTACT_AUDIT_TICKS ticks;
+  // otherwise those already crossing (crossingChecked in contact.h)
+  const bool audit = !contact_on_last_ || physics_ticks_ % SIM_CONTACT_AUDIT_TICKS == 0;
+  // The settle's sweeps, with the stretch limit on
+  if (u.contact.x > 0.0f)
+    u.contact_check = glm::uvec4(audit ? SIM_CONTACT_CHECK_ALL : 0u, u.limit.x > 0.0f ? p.contact_settle : 0u, 0u, 0u);
+  return u;
+}
+
+// The stretch limit (with contact, its places are steps the contact cuts as any): its reach, its
+// roots (the grab, else the pins that hold the sheet: limitRootSet) and its last ring
+void Simulation::setLimitUniforms(const SimParams& p, shaderio::SimUniforms& u) const {
+  if (!(p.stretch_limit > 0.0f)) return;
+  u.limit = glm::vec4(p.stretch_limit * p.spacing, p.spacing, 0.0f, 0.0f);
+  const std::vector<uint32_t> pins = pins_ ? pinIndices(p.pins, p.cols, p.rows) : std::vector<uint32_t>{};
+  if (grab_index_ == SIM_NONE && release_index_ == SIM_NONE && !pins.empty()) {
+    u.limit_roots = glm::uvec4(SIM_NONE, SIM_NONE, SIM_NONE, 0u);
+    for (const uint32_t pin : pins)
+      if (u.limit_roots.w < SIM_LIMIT_ROOTS) u.limit_roots[int(u.limit_roots.w++)] = pin;
+  }
+  if (u.limit.x > 0.0f) {
+    const glm::uvec4 roots = shaderio::limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
+    u.limit.z = float(shaderio::limitLastRing(roots, u.cols, u.rows));
+  }
+}
+
+// Each substep's wind, and where the grab's target is and was (a toss in the first substep after a
+// release)
+void Simulation::setSubstepInputs(const SimParams& p, shaderio::SimUniforms& u) const {
+  const double t0 = double(physics_ticks_) / double(p.tick_hz);
+  const double dts = 1.0 / (double(p.tick_hz) * p.substeps);
+  const float amp = wind_ ? p.wind_strength * p.wind_scale : 0.0f;
   for (uint32_t s = 0; s < p.substeps; ++s) {
     WindSample w = amp > 0.0f ? windAt(p.wind_kind, t0 + double(s + 1) * dts, amp) : WindSample{};
     u.wind[s] = glm::vec4(w.uniform, 0.0f);
@@ -284,14 +301,6 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
       u.grab_prev[s] = glm::vec4(prev, 1.0f);
     }
   }
-  // Every triangle is checked for crossing the sheet in the first substep of a tick when contact
-  // starts (a new sheet, a reset, the key turned on) and once every SIM_CONTACT_AUDIT_TICKS ticks;
-  // otherwise those already crossing (crossingChecked in contact.h)
-  const bool audit = !contact_on_last_ || physics_ticks_ % SIM_CONTACT_AUDIT_TICKS == 0;
-  // The settle's sweeps, with the stretch limit on
-  if (u.contact.x > 0.0f)
-    u.contact_check = glm::uvec4(audit ? SIM_CONTACT_CHECK_ALL : 0u, u.limit.x > 0.0f ? p.contact_settle : 0u, 0u, 0u);
-  return u;
 }
 
 void Simulation::runPhysicsTick() {

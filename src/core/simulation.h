@@ -113,6 +113,9 @@ public:
 
 private:
   void grabAt(uint32_t i, glm::vec3 position);
+  /// makeUniforms' parts: the stretch limit's, and each substep's wind and grab.
+  void setLimitUniforms(const SimParams& p, shaderio::SimUniforms& u) const;
+  void setSubstepInputs(const SimParams& p, shaderio::SimUniforms& u) const;
   void runPhysicsTick();
   void runResetFrame();
 
