@@ -83,6 +83,61 @@ std::optional<std::string> planMesh(const SimOptions& o, MeshPlan& plan) {
   return std::nullopt;
 }
 
+/// Checks every output of the run (and that no input is one) before it starts.
+std::optional<std::string> addSimOutputs(const CommonOptions& common, const SimOptions& o, const MeshPlan& plan,
+                                         OutputSet& outputs) {
+  if (auto err = outputs.addInput(common.script)) return err;
+  if (auto err = outputs.addInput(common.preset_file)) return err;
+  if (auto err = outputs.add(o.stats)) return err;
+  if (plan.kind != MeshPlan::Sequence) return outputs.add(o.out);
+  for (const std::string& path : plan.frames)
+    if (auto err = outputs.add(path)) return err;
+  return std::nullopt;
+}
+
+/// The run's summary on standard output.
+void printSimRun(const CommonOptions& common, const SimOptions& o, Solver& solver, const SheetStats& st, double median,
+                 double slowest, const std::string& hash) {
+  std::printf("tender sim: preset %s, backend %s, %ux%u = %u particles, %llu ticks\n", common.params.preset.c_str(),
+              solver.name().c_str(), common.params.cols, common.params.rows, st.particles,
+              static_cast<unsigned long long>(o.ticks));
+  std::printf("  constraints %u structural, %u shear, %u bend, %u tri-bend, %u hinge in %u colours; %u torn; %u "
+              "triangles; %u creased\n",
+              st.constraints[0], st.constraints[1], st.constraints[2], st.constraints[3], st.constraints[4], st.colors,
+              st.torn, st.triangles, st.creased);
+  std::printf("  bbox (%.3f %.3f %.3f) .. (%.3f %.3f %.3f), max stretch %.4f, NaN %u, intersecting pairs %lld\n",
+              st.bbox_min.x, st.bbox_min.y, st.bbox_min.z, st.bbox_max.x, st.bbox_max.y, st.bbox_max.z, st.max_stretch,
+              st.nan_count, static_cast<long long>(st.pairs));
+  std::printf("  %.4f ms/tick (median, slowest %.4f), state hash %s\n", median, slowest, hash.c_str());
+  std::fflush(stdout);
+}
+
+/// The scene of a glTF output: the receipt texture, rasterised before the run (a missing font
+/// fails early).
+MeshScene meshScene(const MeshPlan& plan, const SimParams& params) {
+  MeshScene scene;
+  if (plan.kind != MeshPlan::None && plan.kind != MeshPlan::Ply) {
+    scene.uv = buildSheet(params).uv;
+    scene.texture_png = receiptPng(params.preset);
+  }
+  return scene;
+}
+
+/// Stages the stats and the end state's mesh (or the animation of `frames`) once the run is done.
+std::optional<std::string> stageSimOutputs(const SimOptions& o, const MeshPlan& plan, const SimState& state,
+                                           const nlohmann::json& j, const MeshScene& scene,
+                                           std::vector<MeshFrame>& frames, OutputSet& outputs) {
+  if (!o.stats.empty())
+    if (auto err = outputs.stage(o.stats, j.dump(2) + "\n")) return err;
+  if (plan.kind == MeshPlan::Ply) return outputs.stage(o.out, [&](std::FILE* f) { return writePly(f, state); });
+  if (plan.kind != MeshPlan::Gltf && plan.kind != MeshPlan::Animation) return std::nullopt;
+  if (plan.kind == MeshPlan::Gltf) frames = {meshFrame(state, 0.0)};
+  std::string error;
+  auto bytes = encodeGltf(scene, frames, plan.binary, error);
+  if (!bytes) return error;
+  return outputs.stage(o.out, *bytes);
+}
+
 } // namespace
 
 int runSim(const CommonOptions& common, const SimOptions& o) {
@@ -91,21 +146,8 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   MeshPlan plan;
   if (auto err = planMesh(o, plan)) return fail(*err);
   OutputSet outputs;
-  if (auto err = outputs.addInput(common.script)) return fail(*err);
-  if (auto err = outputs.addInput(common.preset_file)) return fail(*err);
-  if (auto err = outputs.add(o.stats)) return fail(*err);
-  if (plan.kind == MeshPlan::Sequence) {
-    for (const std::string& path : plan.frames)
-      if (auto err = outputs.add(path)) return fail(*err);
-  } else if (auto err = outputs.add(o.out)) {
-    return fail(*err);
-  }
-  // The receipt texture of a glTF file, rasterised before the run (a missing font fails early).
-  MeshScene scene;
-  if (plan.kind != MeshPlan::None && plan.kind != MeshPlan::Ply) {
-    scene.uv = buildSheet(common.params).uv;
-    scene.texture_png = receiptPng(common.params.preset);
-  }
+  if (auto err = addSimOutputs(common, o, plan, outputs)) return fail(*err);
+  MeshScene scene = meshScene(plan, common.params);
   std::string error;
   auto script = scriptFor(common.script, common.params, common.backend, error);
   if (!script) return fail(error);
@@ -169,31 +211,10 @@ int runSim(const CommonOptions& common, const SimOptions& o) {
   nlohmann::json j = runStatsJson(st, solver, {common.params.preset, o.ticks, sim.physicsTicks(), std::move(ms)},
                                   backend.gpu != nullptr, &median, &slowest);
 
-  std::printf("tender sim: preset %s, backend %s, %ux%u = %u particles, %llu ticks\n", common.params.preset.c_str(),
-              solver.name().c_str(), common.params.cols, common.params.rows, st.particles,
-              static_cast<unsigned long long>(o.ticks));
-  std::printf("  constraints %u structural, %u shear, %u bend, %u tri-bend, %u hinge in %u colours; %u torn; %u "
-              "triangles; %u creased\n",
-              st.constraints[0], st.constraints[1], st.constraints[2], st.constraints[3], st.constraints[4], st.colors,
-              st.torn, st.triangles, st.creased);
-  std::printf("  bbox (%.3f %.3f %.3f) .. (%.3f %.3f %.3f), max stretch %.4f, NaN %u, intersecting pairs %lld\n",
-              st.bbox_min.x, st.bbox_min.y, st.bbox_min.z, st.bbox_max.x, st.bbox_max.y, st.bbox_max.z, st.max_stretch,
-              st.nan_count, static_cast<long long>(st.pairs));
-  std::printf("  %.4f ms/tick (median, slowest %.4f), state hash %s\n", median, slowest,
-              j["state_hash"].get<std::string>().c_str());
-  std::fflush(stdout);
+  printSimRun(common, o, solver, st, median, slowest, j["state_hash"].get<std::string>());
 
-  if (!o.stats.empty())
-    if (auto err = outputs.stage(o.stats, j.dump(2) + "\n")) return fail(*err);
-  if (plan.kind == MeshPlan::Ply)
-    if (auto err = outputs.stage(o.out, [&](std::FILE* f) { return writePly(f, state); })) return fail(*err);
-  if (plan.kind == MeshPlan::Gltf || plan.kind == MeshPlan::Animation) {
-    if (plan.kind == MeshPlan::Gltf) frames = {meshFrame(state, 0.0)};
-    scene.uv = sim.topology().uv;
-    auto bytes = encodeGltf(scene, frames, plan.binary, error);
-    if (!bytes) return fail(error);
-    if (auto err = outputs.stage(o.out, *bytes)) return fail(*err);
-  }
+  scene.uv = sim.topology().uv;
+  if (auto err = stageSimOutputs(o, plan, state, j, scene, frames, outputs)) return fail(*err);
   if (interrupted()) return fail(interruptMessage() + "; nothing written");
   if (auto err = outputs.commit()) return fail(*err);
   return 0;
