@@ -179,6 +179,85 @@ void frameVertices(const CreaseVertices& v, const std::vector<glm::uvec3>& trian
   }
 }
 
+/// What makes `frames` no glTF file: none, no particles, a particle count that changes, a triangle
+/// beyond the sheet, or frame times that do not increase.
+std::optional<std::string> frameProblem(const std::vector<MeshFrame>& frames) {
+  if (frames.empty()) return "glTF export: no frame to write";
+  const size_t n = frames.front().pos.size();
+  if (n == 0) return "glTF export: the sheet has no particles";
+  for (const MeshFrame& f : frames)
+    if (f.pos.size() != n) return "glTF export: the particle count changed between frames";
+  for (const glm::uvec3& t : frames.back().triangles)
+    if (t.x >= n || t.y >= n || t.z >= n) return "glTF export: a triangle names a particle beyond the sheet";
+  for (size_t k = 1; k < frames.size(); ++k)
+    if (!(float(frames[k].time) > float(frames[k - 1].time))) return "glTF export: frame times must increase";
+  return std::nullopt;
+}
+
+/// The renderer's paper as material 0: white times the receipt, roughness 0.7, no metal, both faces.
+void addPaperMaterial(tinygltf::Model& m, Builder& b, const MeshScene& scene) {
+  tinygltf::Material mat;
+  mat.name = "receipt paper";
+  mat.doubleSided = true;
+  mat.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
+  mat.pbrMetallicRoughness.metallicFactor = 0.0;
+  mat.pbrMetallicRoughness.roughnessFactor = kPaperRoughness;
+  if (!scene.texture_png.empty()) {
+    tinygltf::Image img;
+    img.name = "receipt";
+    img.mimeType = "image/png";
+    img.bufferView = b.view(scene.texture_png.data(), scene.texture_png.size(), 0);
+    m.images.push_back(img);
+    tinygltf::Sampler s;
+    s.magFilter = kLinear;
+    s.minFilter = kLinearMipmapLinear;
+    s.wrapS = kClampToEdge;
+    s.wrapT = kClampToEdge;
+    m.samplers.push_back(s);
+    tinygltf::Texture tex;
+    tex.sampler = 0;
+    tex.source = 0;
+    m.textures.push_back(tex);
+    mat.pbrMetallicRoughness.baseColorTexture.index = 0;
+  }
+  m.materials.push_back(mat);
+}
+
+/// Animation: frame k > 0 is morph target k - 1 (position and normal deltas from the first
+/// frame), shown alone by a step-interpolated weights track.
+void addMorphAnimation(tinygltf::Model& m, Builder& b, const std::vector<MeshFrame>& frames, const CreaseVertices& cv,
+                       const std::vector<std::vector<glm::vec3>>& pos, const std::vector<std::vector<glm::vec3>>& nrm,
+                       const std::vector<glm::vec3>& base_pos, const std::vector<glm::vec3>& base_normal,
+                       tinygltf::Primitive& prim, tinygltf::Mesh& mesh) {
+  const MeshFrame& last = frames.back();
+  const size_t targets = frames.size() - 1;
+  if (targets == 0) return;
+  for (size_t k = 1; k < frames.size(); ++k) {
+    std::vector<glm::vec3> dp, dn;
+    frameVertices(cv, last.triangles, pos[k], nrm[k], dp, dn);
+    for (size_t i = 0; i < dp.size(); ++i) dp[i] -= base_pos[i], dn[i] -= base_normal[i];
+    prim.targets.push_back({{"POSITION", b.vec3(dp)}, {"NORMAL", b.vec3(dn)}});
+  }
+  mesh.weights.assign(targets, 0.0);
+  std::vector<float> times(frames.size());
+  for (size_t k = 0; k < frames.size(); ++k) times[k] = float(frames[k].time);
+  std::vector<float> weights(frames.size() * targets, 0.0f);
+  for (size_t k = 1; k < frames.size(); ++k) weights[k * targets + (k - 1)] = 1.0f;
+  tinygltf::AnimationSampler s;
+  s.input = b.scalars(times, true);
+  s.output = b.scalars(weights, false);
+  s.interpolation = "STEP";
+  tinygltf::AnimationChannel c;
+  c.sampler = 0;
+  c.target_node = 0;
+  c.target_path = "weights";
+  tinygltf::Animation anim;
+  anim.name = "simulation";
+  anim.samplers.push_back(s);
+  anim.channels.push_back(c);
+  m.animations.push_back(anim);
+}
+
 } // namespace
 
 std::optional<MeshFormat> meshFormatFor(const std::string& path) {
@@ -206,27 +285,12 @@ MeshFrame meshFrame(const SimState& state, double time) {
 
 std::optional<std::string> encodeGltf(const MeshScene& scene, const std::vector<MeshFrame>& frames, bool binary,
                                       std::string& error) {
-  if (frames.empty()) {
-    error = "glTF export: no frame to write";
+  if (auto why = frameProblem(frames)) {
+    error = *why;
     return std::nullopt;
   }
-  const MeshFrame& first = frames.front();
-  const size_t n = first.pos.size();
-  if (n == 0) {
-    error = "glTF export: the sheet has no particles";
-    return std::nullopt;
-  }
-  for (const MeshFrame& f : frames)
-    if (f.pos.size() != n) {
-      error = "glTF export: the particle count changed between frames";
-      return std::nullopt;
-    }
   const MeshFrame& last = frames.back();
-  for (const glm::uvec3& t : last.triangles)
-    if (t.x >= n || t.y >= n || t.z >= n) {
-      error = "glTF export: a triangle names a particle beyond the sheet";
-      return std::nullopt;
-    }
+  const size_t n = last.pos.size();
 
   tinygltf::Model m;
   m.asset.version = "2.0";
@@ -254,71 +318,13 @@ std::optional<std::string> encodeGltf(const MeshScene& scene, const std::vector<
     prim.mode = TINYGLTF_MODE_POINTS; // every triangle torn: the particles alone
   }
 
-  // Material: the renderer's paper (white times the receipt, roughness 0.7, no metal, both faces).
-  tinygltf::Material mat;
-  mat.name = "receipt paper";
-  mat.doubleSided = true;
-  mat.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
-  mat.pbrMetallicRoughness.metallicFactor = 0.0;
-  mat.pbrMetallicRoughness.roughnessFactor = kPaperRoughness;
-  if (!scene.texture_png.empty()) {
-    tinygltf::Image img;
-    img.name = "receipt";
-    img.mimeType = "image/png";
-    img.bufferView = b.view(scene.texture_png.data(), scene.texture_png.size(), 0);
-    m.images.push_back(img);
-    tinygltf::Sampler s;
-    s.magFilter = kLinear;
-    s.minFilter = kLinearMipmapLinear;
-    s.wrapS = kClampToEdge;
-    s.wrapT = kClampToEdge;
-    m.samplers.push_back(s);
-    tinygltf::Texture tex;
-    tex.sampler = 0;
-    tex.source = 0;
-    m.textures.push_back(tex);
-    mat.pbrMetallicRoughness.baseColorTexture.index = 0;
-  }
-  m.materials.push_back(mat);
+  addPaperMaterial(m, b, scene);
   prim.material = 0;
 
   tinygltf::Mesh mesh;
   mesh.name = scene.name;
 
-  // Animation: frame k > 0 is morph target k - 1 (position and normal deltas from the first
-  // frame), shown alone by a step-interpolated weights track.
-  const size_t targets = frames.size() - 1;
-  if (targets > 0) {
-    for (size_t k = 1; k < frames.size(); ++k) {
-      std::vector<glm::vec3> dp, dn;
-      frameVertices(cv, last.triangles, pos[k], nrm[k], dp, dn);
-      for (size_t i = 0; i < dp.size(); ++i) dp[i] -= base_pos[i], dn[i] -= base_normal[i];
-      prim.targets.push_back({{"POSITION", b.vec3(dp)}, {"NORMAL", b.vec3(dn)}});
-    }
-    mesh.weights.assign(targets, 0.0);
-    std::vector<float> times(frames.size());
-    for (size_t k = 0; k < frames.size(); ++k) times[k] = float(frames[k].time);
-    for (size_t k = 1; k < times.size(); ++k)
-      if (!(times[k] > times[k - 1])) {
-        error = "glTF export: frame times must increase";
-        return std::nullopt;
-      }
-    std::vector<float> weights(frames.size() * targets, 0.0f);
-    for (size_t k = 1; k < frames.size(); ++k) weights[k * targets + (k - 1)] = 1.0f;
-    tinygltf::AnimationSampler s;
-    s.input = b.scalars(times, true);
-    s.output = b.scalars(weights, false);
-    s.interpolation = "STEP";
-    tinygltf::AnimationChannel c;
-    c.sampler = 0;
-    c.target_node = 0;
-    c.target_path = "weights";
-    tinygltf::Animation anim;
-    anim.name = "simulation";
-    anim.samplers.push_back(s);
-    anim.channels.push_back(c);
-    m.animations.push_back(anim);
-  }
+  addMorphAnimation(m, b, frames, cv, pos, nrm, base_pos, base_normal, prim, mesh);
   mesh.primitives.push_back(prim);
   m.meshes.push_back(mesh);
 
