@@ -190,6 +190,37 @@ private:
   std::FILE* log_ = nullptr;
 };
 
+/// The video's frames (and `limit`, the ticks of its last frame, when given in ticks) at `fps`, with
+/// p / q ticks a frame: --seconds (5 s with neither it, --ticks nor a script) x fps, rounded to the
+/// nearest frame; or --ticks N, or the script's last event and one second after it, the last frame
+/// showing tick N.
+std::optional<std::string> videoLength(const CommonOptions& common, const RenderOptions& o, const InputScript& script,
+                                       Rational fps, u128 p, u128 q, u128& frames, u128& limit) {
+  if (!o.seconds.empty() || (!o.ticks_given && common.script.empty())) {
+    Rational seconds{5, 1};
+    if (!o.seconds.empty())
+      if (auto err = parseDecimal(o.seconds, 3, 1000000, seconds)) return "--seconds: " + *err;
+    frames = (u128(2) * seconds.num * fps.num + u128(seconds.den) * fps.den) / (u128(2) * seconds.den * fps.den);
+    return std::nullopt;
+  }
+  limit = o.ticks_given
+              ? o.ticks
+              : (script.events.empty() ? 0 : script.events.back().tick) + uint64_t(std::ceil(common.params.tick_hz));
+  frames = (limit * q + p - 1) / p;
+  return std::nullopt;
+}
+
+/// ffmpeg's arguments: raw RGBA frames of `size` at `rate` on stdin, H.264 in 4:2:0 out to
+/// `target`, the index first, an MP4 whatever the file's name.
+std::vector<std::string> ffmpegArgs(const std::string& size, const std::string& rate, const std::string& target) {
+  std::vector<std::string> args = {"-hide_banner", "-nostats", "-loglevel", "error", "-y"};
+  args.insert(args.end(), {"-f", "rawvideo", "-pix_fmt", "rgba", "-video_size", size, "-framerate", rate});
+  args.insert(args.end(), {"-i", "pipe:0"});
+  args.insert(args.end(), {"-an", "-c:v", "libx264", "-pix_fmt", "yuv420p", "-movflags", "+faststart"});
+  args.insert(args.end(), {"-f", "mp4", target});
+  return args;
+}
+
 } // namespace
 
 int runVideo(const CommonOptions& common, const RenderOptions& o) {
@@ -203,19 +234,7 @@ int runVideo(const CommonOptions& common, const RenderOptions& o) {
   auto script = scriptFor(common.script, common.params, common.backend, error);
   if (!script) return fail(error);
   u128 frames = 0, limit = ~u128(0); // limit: the ticks of the last frame, when given in ticks
-  if (!o.seconds.empty() || (!o.ticks_given && common.script.empty())) {
-    Rational seconds{5, 1};
-    if (!o.seconds.empty())
-      if (auto err = parseDecimal(o.seconds, 3, 1000000, seconds)) return fail("--seconds: " + *err);
-    // seconds x fps, rounded to the nearest frame.
-    frames = (u128(2) * seconds.num * fps.num + u128(seconds.den) * fps.den) / (u128(2) * seconds.den * fps.den);
-  } else {
-    // --ticks N, or the script's last event and one second after it; the last frame shows tick N.
-    limit = o.ticks_given ? o.ticks
-                          : (script->events.empty() ? 0 : script->events.back().tick) +
-                                uint64_t(std::ceil(common.params.tick_hz));
-    frames = (limit * q + p - 1) / p;
-  }
+  if (auto err = videoLength(common, o, *script, fps, p, q, frames, limit)) return fail(*err);
   if (frames == 0) return fail("the video has no frames (its length is below one frame)");
   auto ticksBefore = [&](uint64_t frame) { return uint64_t(std::min(u128(frame + 1) * p / q, limit)); };
   if (frames > kMaxFrames) return fail("a video of more than " + std::to_string(kMaxFrames) + " frames is too long");
@@ -245,14 +264,7 @@ int runVideo(const CommonOptions& common, const RenderOptions& o) {
   Progress progress("tender render", "frame", uint64_t(frames));
   auto staged = outputs.stageAt(o.video, [&](const std::string& target) -> std::optional<std::string> {
     Encoder encoder;
-    std::vector<std::string> args = {"-hide_banner", "-nostats", "-loglevel", "error", "-y"};
-    // In: raw RGBA frames on stdin.
-    args.insert(args.end(), {"-f", "rawvideo", "-pix_fmt", "rgba", "-video_size", size, "-framerate", rate});
-    args.insert(args.end(), {"-i", "pipe:0"});
-    // Out: H.264 in 4:2:0, the index first, an MP4 whatever the file's name.
-    args.insert(args.end(), {"-an", "-c:v", "libx264", "-pix_fmt", "yuv420p", "-movflags", "+faststart"});
-    args.insert(args.end(), {"-f", "mp4", target});
-    if (auto err = encoder.start(ffmpeg, args)) return err;
+    if (auto err = encoder.start(ffmpeg, ffmpegArgs(size, rate, target))) return err;
     std::optional<std::string> encoder_error;
     render::FrameSequence seq;
     seq.frames = uint64_t(frames);
