@@ -40,24 +40,26 @@ echo "ok: three HUD clicks, no grab; one click on the sheet, one grab"
 
 # Parameter edits in the HUD are recorded as set events and replay bitwise: collision off and
 # damping typed in (live), then a grid of 24 columns (rebuilt). The panel opens from its title at
-# (473, 57); its rows sit 25 pixels apart from the preset's at y = 86.
+# (473, 57); its rows sit 25 pixels apart from the preset's at y = 86. The demo feeds ImGui the
+# keys a frame at a time (KeyQueue), so each edit gets a second, ten frames of a busy CI machine,
+# before the mouse moves on.
 start_demo --backend cpu --ui-scale 1 --width 800 --height 600 --record "$tmp/hud.txt"
 sleep 3
 alive "start-up before the HUD edits"
 xdotool mousemove --sync 473 57 click 1
-sleep 0.5
+sleep 1
 xdotool mousemove --sync 478 236 click 1 # collision
-sleep 0.3
+sleep 1
 xdotool mousemove --sync 570 161 keydown ctrl click 1 keyup ctrl # damping: type a value
-sleep 0.3
+sleep 1
 xdotool key ctrl+a type --delay 50 "0.97"
 xdotool key Return
-sleep 0.3
+sleep 1
 xdotool mousemove --sync 518 261 click 1 # cols
-sleep 0.2
+sleep 1
 xdotool key ctrl+a type --delay 50 "24"
 xdotool key Return
-sleep 0.3
+sleep 1
 xdotool mousemove --sync 516 286 click 1 # Rebuild sheet
 sleep 1.5
 alive "HUD edits"

@@ -144,6 +144,9 @@ void DemoApp::initImGui(float scale) {
   ImGui::GetIO().IniFilename = nullptr;
   hud_ = std::make_unique<demo::Hud>(scale);
   ImGui_ImplGlfw_InitForVulkan(window_, true); // chains to the callbacks installed above
+  // The keyboard reaches ImGui through the key queue instead (KeyQueue): onKey and onChar queue it.
+  glfwSetKeyCallback(window_, onKey);
+  glfwSetCharCallback(window_, onChar);
 
   VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16};
   VkDescriptorPoolCreateInfo dp{};
@@ -321,6 +324,7 @@ int DemoApp::run() {
   catchInterrupts();
   while (!glfwWindowShouldClose(window_) && !interrupted()) {
     glfwPollEvents();
+    keys_.feed(window_);
     int w = 0, h = 0;
     glfwGetFramebufferSize(window_, &w, &h);
     if (w == 0 || h == 0) { // minimised: nothing to draw, the simulation waits

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <deque>
 #include <memory>
 #include <optional>
 
@@ -54,6 +55,24 @@ struct Input {
   glm::vec3 plane_point{0.0f}, plane_normal{0.0f};
   std::optional<glm::vec3> pending_move;
   bool resized = false;
+};
+
+/// A key change (key >= 0) or a typed character (key < 0) waiting for ImGui's frame.
+struct KeyInput {
+  int key = -1, scancode = 0, action = 0, mods = 0;
+  unsigned codepoint = 0;
+};
+
+/// The keyboard as ImGui is fed it. Debian's ImGui (1.86, before its input queue) reads a key's
+/// state once a frame and handles a frame's characters before its shortcut keys, so on a CPU
+/// device's 10 FPS a Return tapped within one frame would be lost, and Ctrl+A followed by typing
+/// within one frame would select what was typed. The events wait here and are fed a frame at a
+/// time as ImGui 1.87's queue trickles them: at most one change of a key a frame, and never a
+/// character and a press of a key ImGui acts on in the same frame.
+struct KeyQueue {
+  std::deque<KeyInput> waiting;
+  bool feeding = false; ///< feed() is calling ImGui, which calls onKey back: let it pass
+  void feed(GLFWwindow* w);
 };
 
 class DemoApp {
@@ -118,6 +137,7 @@ private:
   static void onCursor(GLFWwindow* w, double x, double y);
   static void onScroll(GLFWwindow* w, double dx, double dy);
   static void onKey(GLFWwindow* w, int key, int scancode, int action, int mods);
+  static void onChar(GLFWwindow* w, unsigned codepoint);
   static void onResize(GLFWwindow* w, int width, int height);
 
   CommonOptions common_;
@@ -143,6 +163,7 @@ private:
   bool follow_on_ = false;
   float follow_clock_ = 0.0f; ///< seconds since the follow last looked at the sheet
   Input input_;
+  KeyQueue keys_;
   bool show_fps_ = false;
   std::string device_notice_; ///< the HUD's line on a CPU device (init)
   OutputSet record_;          // --record: written when the session ends

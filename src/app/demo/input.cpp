@@ -134,10 +134,45 @@ void DemoApp::onCursor(GLFWwindow* w, double x, double y) {
 
 void DemoApp::onScroll(GLFWwindow* w, double, double dy) { appOf(w)->input_.scroll += dy; }
 
-void DemoApp::onKey(GLFWwindow* w, int key, int, int action, int) {
+void KeyQueue::feed(GLFWwindow* w) {
+  // ImGui acts on a key press only when the key is one of its own (Enter, Backspace, the arrows,
+  // A for Ctrl+A, ...); characters and the presses of other keys may share a frame.
+  const ImGuiIO& io = ImGui::GetIO();
+  auto imguiKey = [&](int key) {
+    return std::find(std::begin(io.KeyMap), std::end(io.KeyMap), key) != std::end(io.KeyMap);
+  };
+  std::vector<int> changed;
+  bool typed = false, pressed = false; // a character; a press of one of ImGui's keys
+  feeding = true;
+  for (; !waiting.empty(); waiting.pop_front()) {
+    const KeyInput& e = waiting.front();
+    if (e.key < 0) {
+      if (pressed) break;
+      ImGui_ImplGlfw_CharCallback(w, e.codepoint);
+      typed = true;
+      continue;
+    }
+    bool own_press = e.action != GLFW_RELEASE && imguiKey(e.key);
+    if ((typed && own_press) || std::find(changed.begin(), changed.end(), e.key) != changed.end()) break;
+    ImGui_ImplGlfw_KeyCallback(w, e.key, e.scancode, e.action, e.mods);
+    changed.push_back(e.key);
+    pressed = pressed || own_press;
+  }
+  feeding = false;
+}
+
+void DemoApp::onChar(GLFWwindow* w, unsigned codepoint) {
+  KeyInput e;
+  e.codepoint = codepoint;
+  appOf(w)->keys_.waiting.push_back(e);
+}
+
+void DemoApp::onKey(GLFWwindow* w, int key, int scancode, int action, int mods) {
+  DemoApp& app = *appOf(w);
+  if (app.keys_.feeding) return;
+  if (app.imgui_ready_) app.keys_.waiting.push_back({key, scancode, action, mods, 0});
   if (action != GLFW_PRESS) return;
   if (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureKeyboard) return;
-  DemoApp& app = *appOf(w);
   if (!app.sim_) return;
   ScriptEvent e;
   e.toggle = Toggle::Flip;
