@@ -30,13 +30,24 @@
 #include "gpu/gpu_solver.h"
 #endif
 
-int main(int argc, char** argv) {
-  using namespace tender;
-  using namespace tender::bench;
+namespace {
+
+using namespace tender;
+using namespace tender::bench;
+
+/// A run the command line asked for, checked before anything runs.
+struct BenchRun {
   BenchOptions o;
-  o.backends = vulkanBuilt() ? "cpu,gpu" : "cpu";
-  setProgramName("tender-bench");
-  CLI::App app{"tender-bench: how the solvers scale with the size of the sheet."};
+  std::vector<Size> sizes;
+  std::vector<std::string> backends;
+  OutputSet outputs;
+  uint32_t cpu_threads = 0; ///< the preset's CPU solver threads, for the host's copy bandwidth
+  bool anyGpu() const {
+    return std::any_of(backends.begin(), backends.end(), [](const std::string& b) { return b != "cpu"; });
+  }
+};
+
+void addOptions(CLI::App& app, BenchOptions& o, std::string& max_cpu_particles, std::string& batches) {
   app.set_version_flag("--version", std::string("tender-bench ") + TENDER_VERSION);
   app.add_option("--sizes", o.sizes, "grid sizes, WxH comma-separated")->capture_default_str();
   app.add_option("--backends", o.backends, "cpu, gpu, gpu-percolor (GPU without the fused small-sheet path)")
@@ -53,90 +64,63 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--json", o.json, "write the results as JSON here");
   app.add_option("--csv", o.csv, "write the results as CSV here");
-  std::string max_cpu_particles = std::to_string(o.max_cpu_particles);
   app.add_option("--max-cpu-particles", max_cpu_particles, "skip CPU cases with more particles")->capture_default_str();
   app.add_option("--max-seconds", o.max_seconds, "time budget of one case's timed ticks (at least 3 run)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
-  std::string batches;
   app.add_option("--batch", batches,
                  "fleets of these many sheets per size and backend (comma-separated, e.g. 1,16,256,4096): "
                  "sheet-ticks per second against single-sheet runs");
   app.add_flag("--no-peak", o.no_peak, "skip the copy-bandwidth measurement (no percent of peak in the results)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::Success& e) { // --help, --version
-    return finishOutput(app.exit(e));
-  } catch (const CLI::ParseError& e) {
-    return fail(e.what());
-  }
+}
 
-  if (auto err = emptyValue(app)) return fail(*err);
-  // Validate everything before running anything: options, outputs, the device.
-  if (!std::isfinite(o.max_seconds)) return fail("--max-seconds: not a number");
+/// The preset with its --set overrides, checked; gives the CPU solver's threads.
+std::optional<std::string> checkPreset(BenchRun& run) {
+  auto p = presetParams(run.o.preset);
+  if (!p) {
+    std::string names;
+    for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
+    return "unknown preset '" + run.o.preset + "' (one of " + names + ")";
+  }
+  for (const std::string& s : run.o.sets) {
+    // The grid is --sizes': a `--set cols/rows` would run a sheet the table does not name
+    const std::string key = s.substr(0, s.find('='));
+    if (key == "cols" || key == "rows") return "--set " + key + ": the grid is set by --sizes (WxH)";
+    if (auto err = applyOverride(*p, s)) return err;
+  }
+  if (auto err = validate(*p, "cpu")) return err;
+  run.cpu_threads = p->threads;
+  return std::nullopt;
+}
+
+/// Checks every option and output before anything runs.
+std::optional<std::string> checkRun(BenchRun& run, const std::string& max_cpu_particles, const std::string& batches) {
+  BenchOptions& o = run.o;
+  if (!std::isfinite(o.max_seconds)) return "--max-seconds: not a number";
   if (auto err = parseWhole(max_cpu_particles, 0, uint64_t(1) << 40, o.max_cpu_particles))
-    return fail("--max-cpu-particles: " + *err);
-  OutputSet outputs;
+    return "--max-cpu-particles: " + *err;
   for (const std::string& path : {o.json, o.csv})
-    if (auto err = outputs.add(path)) return fail(*err);
+    if (auto err = run.outputs.add(path)) return err;
   for (const std::string& item : batches.empty() ? std::vector<std::string>{} : split(batches, ',')) {
     uint64_t b = 0;
-    if (auto err = parseWhole(item, 1, kMaxBatchSheets, b)) return fail("--batch '" + item + "': " + *err);
+    if (auto err = parseWhole(item, 1, kMaxBatchSheets, b)) return "--batch '" + item + "': " + *err;
     o.batches.push_back(uint32_t(b));
   }
-  uint32_t cpu_threads = 0;
-  std::vector<Size> sizes;
-  if (auto err = parseSizes(o.sizes, sizes)) return fail(*err);
-  std::vector<std::string> backends = split(o.backends, ',');
-  if (backends.empty()) return fail("--backends is empty");
-  for (const std::string& b : backends) {
+  if (auto err = parseSizes(o.sizes, run.sizes)) return err;
+  run.backends = split(o.backends, ',');
+  if (run.backends.empty()) return "--backends is empty";
+  for (const std::string& b : run.backends) {
     if (b != "cpu" && b != "gpu" && b != "gpu-percolor")
-      return fail("unknown backend '" + b + "' (cpu, gpu or gpu-percolor)");
-    if (b != "cpu" && !vulkanBuilt()) return fail("this build has no GPU backend (try --backends cpu)");
+      return "unknown backend '" + b + "' (cpu, gpu or gpu-percolor)";
+    if (b != "cpu" && !vulkanBuilt()) return "this build has no GPU backend (try --backends cpu)";
   }
-  {
-    auto p = presetParams(o.preset);
-    if (!p) {
-      std::string names;
-      for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
-      return fail("unknown preset '" + o.preset + "' (one of " + names + ")");
-    }
-    for (const std::string& s : o.sets) {
-      // The grid is --sizes': a `--set cols/rows` would run a sheet the table does not name
-      const std::string key = s.substr(0, s.find('='));
-      if (key == "cols" || key == "rows") return fail("--set " + key + ": the grid is set by --sizes (WxH)");
-      if (auto err = applyOverride(*p, s)) return fail(*err);
-    }
-    if (auto err = validate(*p, "cpu")) return fail(*err);
-    cpu_threads = p->threads;
-  }
-#ifdef TENDER_HAS_GPU
-  // The device's context, kept for the dispatch cost (released before the cases run).
-  std::unique_ptr<gpu::VulkanContext> device_ctx;
-  if (std::any_of(backends.begin(), backends.end(), [](const std::string& b) { return b != "cpu"; })) {
-    gpu::ContextOptions co;
-    co.device = o.device;
-    auto ctx = gpu::VulkanContext::create(co);
-    if (!ctx) return fail(ctx.error() + " (try --backends cpu)");
-    device_ctx = std::move(ctx.value());
-  }
-#endif
+  return checkPreset(run);
+}
 
-  nlohmann::json out;
-  out["tool"] = "tender-bench";
-  out["version"] = TENDER_VERSION;
-  out["machine"] = {{"cpu_model", cpuModel()}, {"cores", std::thread::hardware_concurrency()}};
-  out["preset"] = o.preset;
-  out["ticks"] = o.ticks;
-  out["warmup"] = o.warmup;
-  out["sets"] = o.sets;
-  out["results"] = nlohmann::json::array();
-
-  // The peaks: copy bandwidth over the CPU solver's threads and on the device.
-  Progress progress;
+/// The peaks: copy bandwidth over the CPU solver's threads and on the device.
+Peaks measurePeaks(const BenchRun& run, nlohmann::json& out, Progress& progress) {
   Peaks peaks;
   out["peak_bandwidth"] = nlohmann::json::object();
-  out["dispatch_cost"] = nlohmann::json::object();
   auto record = [&](const char* key, const bench::PeakBandwidth& b) {
     out["peak_bandwidth"][key] = {{"gbps", b.gbps},
                                   {"buffer_bytes", b.buffer_bytes},
@@ -148,15 +132,15 @@ int main(int argc, char** argv) {
                   humanBytes(b.buffer_bytes).c_str(), b.repetitions);
     progress.update(buf, true);
   };
-  const bool any_cpu = std::find(backends.begin(), backends.end(), "cpu") != backends.end();
-  if (!o.no_peak && any_cpu) {
-    peaks.cpu = bench::measureHostCopy(cpu_threads);
+  if (run.o.no_peak) return peaks;
+  if (std::find(run.backends.begin(), run.backends.end(), "cpu") != run.backends.end()) {
+    peaks.cpu = bench::measureHostCopy(run.cpu_threads);
     record("cpu", *peaks.cpu);
   }
 #ifdef TENDER_HAS_GPU
-  if (!o.no_peak && std::any_of(backends.begin(), backends.end(), [](const std::string& b) { return b != "cpu"; })) {
+  if (run.anyGpu()) {
     std::string error;
-    peaks.gpu = bench::measureDeviceCopy(o.device, error);
+    peaks.gpu = bench::measureDeviceCopy(run.o.device, error);
     if (peaks.gpu) {
       record("gpu", *peaks.gpu);
     } else {
@@ -164,34 +148,41 @@ int main(int argc, char** argv) {
       progress.update("peak gpu: skipped (" + error + ")", true);
     }
   }
-  // What one empty dispatch and its barrier cost on the device (a fraction of a second: measured
-  // with --no-peak too).
-  if (device_ctx) {
-    std::string error;
-    if (auto cost = bench::measureDispatchCost(*device_ctx, error)) {
-      out["dispatch_cost"]["gpu"] = {{"dispatch_us", cost->us},
-                                     {"chain", cost->chain},
-                                     {"repetitions", cost->repetitions},
-                                     {"samples_us", cost->samples_us},
-                                     {"device", device_ctx->properties().deviceName},
-                                     {"method", cost->method}};
-      char buf[160];
-      std::snprintf(buf, sizeof(buf), "dispatch gpu: %.2f us per empty dispatch + barrier (median of %u chains of %u, ",
-                    cost->us, cost->repetitions, cost->chain);
-      progress.update(buf + std::string(device_ctx->properties().deviceName) + ")", true);
-    } else {
-      out["dispatch_cost"]["gpu"] = {{"skipped", error}};
-      progress.update("dispatch gpu: skipped (" + error + ")", true);
-    }
-    device_ctx.reset();
+#endif
+  return peaks;
+}
+
+#ifdef TENDER_HAS_GPU
+/// What one empty dispatch and its barrier cost on the device (a fraction of a second: measured
+/// with --no-peak too).
+void recordDispatchCost(gpu::VulkanContext& ctx, nlohmann::json& out, Progress& progress) {
+  std::string error;
+  if (auto cost = bench::measureDispatchCost(ctx, error)) {
+    out["dispatch_cost"]["gpu"] = {{"dispatch_us", cost->us},
+                                   {"chain", cost->chain},
+                                   {"repetitions", cost->repetitions},
+                                   {"samples_us", cost->samples_us},
+                                   {"device", ctx.properties().deviceName},
+                                   {"method", cost->method}};
+    char buf[160];
+    std::snprintf(buf, sizeof(buf), "dispatch gpu: %.2f us per empty dispatch + barrier (median of %u chains of %u, ",
+                  cost->us, cost->repetitions, cost->chain);
+    progress.update(buf + std::string(ctx.properties().deviceName) + ")", true);
+  } else {
+    out["dispatch_cost"]["gpu"] = {{"skipped", error}};
+    progress.update("dispatch gpu: skipped (" + error + ")", true);
   }
+}
 #endif
 
-  const size_t total = sizes.size() * backends.size() * (1 + o.batches.size());
+/// Every size on every backend, and its fleets.
+void runCases(const BenchRun& run, const Peaks& peaks, nlohmann::json& out, Progress& progress) {
+  const BenchOptions& o = run.o;
+  const size_t total = run.sizes.size() * run.backends.size() * (1 + o.batches.size());
   size_t index = 0;
   out["batches"] = nlohmann::json::array();
-  for (const Size& size : sizes)
-    for (const std::string& backend : backends) {
+  for (const Size& size : run.sizes)
+    for (const std::string& backend : run.backends) {
       auto label = [&](const std::string& what) {
         return "[" + std::to_string(++index) + "/" + std::to_string(total) + "] " + size.text() + " " + backend + what;
       };
@@ -207,13 +198,64 @@ int main(int argc, char** argv) {
           out["batches"].push_back(
               runBatchCase(o, size, backend, b, single_ms, label(" batch " + std::to_string(b)), progress));
     }
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  BenchRun run;
+  run.o.backends = vulkanBuilt() ? "cpu,gpu" : "cpu";
+  setProgramName("tender-bench");
+  CLI::App app{"tender-bench: how the solvers scale with the size of the sheet."};
+  std::string max_cpu_particles = std::to_string(run.o.max_cpu_particles), batches;
+  addOptions(app, run.o, max_cpu_particles, batches);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) { // --help, --version
+    return finishOutput(app.exit(e));
+  } catch (const CLI::ParseError& e) {
+    return fail(e.what());
+  }
+  if (auto err = emptyValue(app)) return fail(*err);
+  // Validate everything before running anything: options, outputs, the device.
+  if (auto err = checkRun(run, max_cpu_particles, batches)) return fail(*err);
+#ifdef TENDER_HAS_GPU
+  // The device's context, kept for the dispatch cost (released before the cases run).
+  std::unique_ptr<gpu::VulkanContext> device_ctx;
+  if (run.anyGpu()) {
+    gpu::ContextOptions co;
+    co.device = run.o.device;
+    auto ctx = gpu::VulkanContext::create(co);
+    if (!ctx) return fail(ctx.error() + " (try --backends cpu)");
+    device_ctx = std::move(ctx.value());
+  }
+#endif
+
+  const BenchOptions& o = run.o;
+  nlohmann::json out;
+  out["tool"] = "tender-bench";
+  out["version"] = TENDER_VERSION;
+  out["machine"] = {{"cpu_model", cpuModel()}, {"cores", std::thread::hardware_concurrency()}};
+  out["preset"] = o.preset;
+  out["ticks"] = o.ticks;
+  out["warmup"] = o.warmup;
+  out["sets"] = o.sets;
+  out["results"] = nlohmann::json::array();
+  Progress progress;
+  const Peaks peaks = measurePeaks(run, out, progress);
+  out["dispatch_cost"] = nlohmann::json::object();
+#ifdef TENDER_HAS_GPU
+  if (device_ctx) recordDispatchCost(*device_ctx, out, progress);
+  device_ctx.reset();
+#endif
+  runCases(run, peaks, out, progress);
 
   printTable(out["results"]);
   if (!o.batches.empty()) printBatchTable(out["batches"]);
   if (!o.json.empty())
-    if (auto err = outputs.stage(o.json, out.dump(2) + "\n")) return fail(*err);
+    if (auto err = run.outputs.stage(o.json, out.dump(2) + "\n")) return fail(*err);
   if (!o.csv.empty())
-    if (auto err = outputs.stage(o.csv, csvText(out["results"]))) return fail(*err);
-  if (auto err = outputs.commit()) return fail(*err);
+    if (auto err = run.outputs.stage(o.csv, csvText(out["results"]))) return fail(*err);
+  if (auto err = run.outputs.commit()) return fail(*err);
   return finishOutput(0); // the tables must reach standard output
 }
