@@ -206,20 +206,33 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   std::unique_ptr<VulkanContext> ctx(new VulkanContext());
   ctx->validation_ = o.validation;
   ctx->quiet_ = o.quiet;
+  if (auto err = ctx->createInstance(o)) return R::failure(*err);
+  if (auto err = ctx->choosePhysicalDevice(o)) return R::failure(*err);
+  if (auto err = ctx->createDevice(o)) return R::failure(*err);
+  VkCommandPoolCreateInfo pci{};
+  pci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pci.queueFamilyIndex = ctx->queue_family_;
+  VK_CHECK(vkCreateCommandPool(ctx->device_, &pci, nullptr, &ctx->pool_));
+  VkFenceCreateInfo fci{};
+  fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  VK_CHECK(vkCreateFence(ctx->device_, &fci, nullptr, &ctx->once_fence_));
+  return R(std::move(ctx));
+}
 
-  // Instance: layers, extensions, the debug messenger chained for creation-time messages.
+// Instance: layers, extensions, the debug messenger chained for creation-time messages.
+std::optional<std::string> VulkanContext::createInstance(const ContextOptions& o) {
   std::vector<const char*> layers, inst_exts;
   for (auto& e : o.instance_extensions) inst_exts.push_back(e.c_str());
   if (o.validation) {
-    if (!hasLayer(kValidationLayer))
-      return R::failure("validation requested but VK_LAYER_KHRONOS_validation is not installed");
+    if (!hasLayer(kValidationLayer)) return "validation requested but VK_LAYER_KHRONOS_validation is not installed";
     layers.push_back(kValidationLayer);
   }
   const bool debug_utils = o.validation && hasInstanceExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   if (debug_utils) inst_exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   for (auto* e : inst_exts)
     if (std::strcmp(e, VK_EXT_DEBUG_UTILS_EXTENSION_NAME) != 0 && !hasInstanceExtension(e))
-      return R::failure(std::string("Vulkan instance extension ") + e + " is not available");
+      return std::string("Vulkan instance extension ") + e + " is not available";
 
   VkDebugUtilsMessengerCreateInfoEXT dbg{};
   dbg.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
@@ -227,7 +240,7 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   dbg.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
   dbg.pfnUserCallback = &VulkanContext::debugCallback;
-  dbg.pUserData = ctx.get();
+  dbg.pUserData = this;
 
   VkValidationFeatureEnableEXT sync_feature = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
   VkValidationFeaturesEXT features{};
@@ -252,28 +265,30 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
     ici.pNext = &features;
   else if (debug_utils)
     ici.pNext = &dbg;
-  VkResult r = vkCreateInstance(&ici, nullptr, &ctx->instance_);
+  VkResult r = vkCreateInstance(&ici, nullptr, &instance_);
   if (r != VK_SUCCESS) {
-    ctx->instance_ = VK_NULL_HANDLE;
-    return R::failure("no Vulkan driver found (vkCreateInstance: " + vkResultName(r) + ")");
+    instance_ = VK_NULL_HANDLE;
+    return "no Vulkan driver found (vkCreateInstance: " + vkResultName(r) + ")";
   }
   if (debug_utils) {
     auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-        vkGetInstanceProcAddr(ctx->instance_, "vkCreateDebugUtilsMessengerEXT"));
-    if (create_messenger) VK_CHECK(create_messenger(ctx->instance_, &dbg, nullptr, &ctx->messenger_));
+        vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+    if (create_messenger) VK_CHECK(create_messenger(instance_, &dbg, nullptr, &messenger_));
   }
+  return std::nullopt;
+}
 
-  // Physical device: the given index, or the best-ranked usable one.
-  auto pds = physicalDevices(ctx->instance_);
-  if (pds.empty()) return R::failure("no Vulkan device found");
+// Physical device: the given index, or the best-ranked usable one.
+std::optional<std::string> VulkanContext::choosePhysicalDevice(const ContextOptions& o) {
+  auto pds = physicalDevices(instance_);
+  if (pds.empty()) return "no Vulkan device found";
   int chosen = -1;
   if (o.device >= 0) {
     if (o.device >= int(pds.size()))
-      return R::failure("no Vulkan device " + std::to_string(o.device) + " (there are " + std::to_string(pds.size()) +
-                        "; see `tender devices`)");
+      return "no Vulkan device " + std::to_string(o.device) + " (there are " + std::to_string(pds.size()) +
+             "; see `tender devices`)";
     DeviceInfo d = describe(pds[size_t(o.device)], uint32_t(o.device));
-    if (!d.usable)
-      return R::failure("Vulkan device " + std::to_string(o.device) + " (" + d.name + ") lacks Vulkan 1.3 compute");
+    if (!d.usable) return "Vulkan device " + std::to_string(o.device) + " (" + d.name + ") lacks Vulkan 1.3 compute";
     chosen = o.device;
   } else {
     int best_rank = 1 << 30;
@@ -285,31 +300,32 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
         chosen = int(i);
       }
     }
-    if (chosen < 0) return R::failure("no Vulkan 1.3 device with a compute queue found");
+    if (chosen < 0) return "no Vulkan 1.3 device with a compute queue found";
   }
-  ctx->physical_ = pds[size_t(chosen)];
-  ctx->info_ = describe(ctx->physical_, uint32_t(chosen));
-  vkGetPhysicalDeviceProperties(ctx->physical_, &ctx->props_);
-  vkGetPhysicalDeviceMemoryProperties(ctx->physical_, &ctx->mem_props_);
-  auto family = findQueueFamily(ctx->physical_, o.graphics);
+  physical_ = pds[size_t(chosen)];
+  info_ = describe(physical_, uint32_t(chosen));
+  vkGetPhysicalDeviceProperties(physical_, &props_);
+  vkGetPhysicalDeviceMemoryProperties(physical_, &mem_props_);
+  auto family = findQueueFamily(physical_, o.graphics);
   if (!family)
-    return R::failure("Vulkan device " + ctx->info_.name + " has no " + (o.graphics ? "graphics+compute" : "compute") +
-                      " queue");
-  ctx->queue_family_ = *family;
+    return "Vulkan device " + info_.name + " has no " + (o.graphics ? "graphics+compute" : "compute") + " queue";
+  queue_family_ = *family;
   {
     uint32_t n = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(ctx->physical_, &n, nullptr);
+    vkGetPhysicalDeviceQueueFamilyProperties(physical_, &n, nullptr);
     std::vector<VkQueueFamilyProperties> fams(n);
-    vkGetPhysicalDeviceQueueFamilyProperties(ctx->physical_, &n, fams.data());
-    ctx->timestamp_bits_ = fams[*family].timestampValidBits;
+    vkGetPhysicalDeviceQueueFamilyProperties(physical_, &n, fams.data());
+    timestamp_bits_ = fams[*family].timestampValidBits;
   }
-  ctx->timestamp_period_ = ctx->props_.limits.timestampPeriod;
+  timestamp_period_ = props_.limits.timestampPeriod;
+  return std::nullopt;
+}
 
-  // Device: Vulkan 1.3 synchronization2, plus the requested extensions.
+// Device: Vulkan 1.3 synchronization2, plus the requested extensions.
+std::optional<std::string> VulkanContext::createDevice(const ContextOptions& o) {
   std::vector<const char*> dev_exts;
   for (auto& e : o.device_extensions) {
-    if (!hasDeviceExtension(ctx->physical_, e))
-      return R::failure("Vulkan device extension " + e + " is not available on " + ctx->info_.name);
+    if (!hasDeviceExtension(physical_, e)) return "Vulkan device extension " + e + " is not available on " + info_.name;
     dev_exts.push_back(e.c_str());
   }
   VkPhysicalDeviceVulkan13Features f13{};
@@ -320,8 +336,8 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   VkPhysicalDeviceFeatures2 f2{};
   f2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
   f2.pNext = &f12;
-  vkGetPhysicalDeviceFeatures2(ctx->physical_, &f2);
-  if (!f13.synchronization2) return R::failure("Vulkan device " + ctx->info_.name + " lacks synchronization2");
+  vkGetPhysicalDeviceFeatures2(physical_, &f2);
+  if (!f13.synchronization2) return "Vulkan device " + info_.name + " lacks synchronization2";
   VkPhysicalDeviceVulkan13Features en13{};
   en13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
   en13.synchronization2 = VK_TRUE;
@@ -341,12 +357,12 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   en2.features.fillModeNonSolid = f2.features.fillModeNonSolid;
   en2.features.depthClamp = f2.features.depthClamp;
   en2.features.shaderInt64 = f2.features.shaderInt64;
-  ctx->device_addresses_ = f12.bufferDeviceAddress && f2.features.shaderInt64;
+  device_addresses_ = f12.bufferDeviceAddress && f2.features.shaderInt64;
 
   float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{};
   qci.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
-  qci.queueFamilyIndex = ctx->queue_family_;
+  qci.queueFamilyIndex = queue_family_;
   qci.queueCount = 1;
   qci.pQueuePriorities = &priority;
   VkDeviceCreateInfo dci{};
@@ -356,22 +372,13 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   dci.pQueueCreateInfos = &qci;
   dci.enabledExtensionCount = uint32_t(dev_exts.size());
   dci.ppEnabledExtensionNames = dev_exts.data();
-  r = vkCreateDevice(ctx->physical_, &dci, nullptr, &ctx->device_);
+  VkResult r = vkCreateDevice(physical_, &dci, nullptr, &device_);
   if (r != VK_SUCCESS) {
-    ctx->device_ = VK_NULL_HANDLE;
-    return R::failure("cannot create the Vulkan device on " + ctx->info_.name + " (" + vkResultName(r) + ")");
+    device_ = VK_NULL_HANDLE;
+    return "cannot create the Vulkan device on " + info_.name + " (" + vkResultName(r) + ")";
   }
-  vkGetDeviceQueue(ctx->device_, ctx->queue_family_, 0, &ctx->queue_);
-
-  VkCommandPoolCreateInfo pci{};
-  pci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
-  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pci.queueFamilyIndex = ctx->queue_family_;
-  VK_CHECK(vkCreateCommandPool(ctx->device_, &pci, nullptr, &ctx->pool_));
-  VkFenceCreateInfo fci{};
-  fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-  VK_CHECK(vkCreateFence(ctx->device_, &fci, nullptr, &ctx->once_fence_));
-  return R(std::move(ctx));
+  vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+  return std::nullopt;
 }
 
 VkPipeline VulkanContext::sharedPipeline(const std::string& name,

@@ -185,6 +185,10 @@ public:
 
 private:
   VulkanContext() = default;
+  /// The steps of create(); each gives an error message, or nothing when done.
+  std::optional<std::string> createInstance(const ContextOptions& o);
+  std::optional<std::string> choosePhysicalDevice(const ContextOptions& o);
+  std::optional<std::string> createDevice(const ContextOptions& o);
   Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags flags, bool map);
   static VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                       VkDebugUtilsMessageTypeFlagsEXT types,

@@ -12,6 +12,35 @@ bool g_glfw_started = false;
 } // namespace
 
 bool DemoApp::init() {
+  if (!openWindow() || !createContext() || !createRenderer()) return false;
+  recreateSwapchain();
+
+  float xs = 1.0f, ys = 1.0f;
+  glfwGetWindowContentScale(window_, &xs, &ys);
+  initImGui(options_.ui_scale > 0.0f ? options_.ui_scale : std::max(xs, 1.0f));
+
+  createSolver();
+  if (!backend_.solver) return false;
+  std::string error;
+  auto replay = scriptFor(options_.replay, common_.params, common_.backend, error);
+  if (!replay) {
+    fail(error);
+    return false;
+  }
+  sim_->setScript(*replay);
+  if (auto err = record_.addInput(options_.replay)) {
+    fail(*err);
+    return false;
+  }
+  if (auto err = record_.add(options_.record)) {
+    fail(*err);
+    return false;
+  }
+  record_text_ = "# tender input script recorded by tender-demo, preset " + common_.params.preset + "\n";
+  return true;
+}
+
+bool DemoApp::openWindow() {
   glfwSetErrorCallback([](int code, const char* text) {
     g_glfw_error = text ? text : std::to_string(code);
     if (g_glfw_started) std::fprintf(stderr, "tender-demo: GLFW %d: %s\n", code, g_glfw_error.c_str());
@@ -47,7 +76,10 @@ bool DemoApp::init() {
   glfwSetScrollCallback(window_, onScroll);
   glfwSetKeyCallback(window_, onKey);
   glfwSetFramebufferSizeCallback(window_, onResize);
+  return true;
+}
 
+bool DemoApp::createContext() {
   gpu::ContextOptions co;
   co.device = common_.device;
   co.validation = common_.validation;
@@ -70,7 +102,10 @@ bool DemoApp::init() {
     return false;
   }
   swapchain_ = std::make_unique<demo::Swapchain>(*ctx_, surface_, options_.vsync);
+  return true;
+}
 
+bool DemoApp::createRenderer() {
   render::RendererOptions ro;
   ro.color_format = swapchain_->format();
   ro.final_layout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
@@ -111,30 +146,6 @@ bool DemoApp::init() {
     fi.flags = VK_FENCE_CREATE_SIGNALED_BIT;
     VK_CHECK(vkCreateFence(ctx_->device(), &fi, nullptr, &f.done));
   }
-  recreateSwapchain();
-
-  float xs = 1.0f, ys = 1.0f;
-  glfwGetWindowContentScale(window_, &xs, &ys);
-  initImGui(options_.ui_scale > 0.0f ? options_.ui_scale : std::max(xs, 1.0f));
-
-  createSolver();
-  if (!backend_.solver) return false;
-  std::string error;
-  auto replay = scriptFor(options_.replay, common_.params, common_.backend, error);
-  if (!replay) {
-    fail(error);
-    return false;
-  }
-  sim_->setScript(*replay);
-  if (auto err = record_.addInput(options_.replay)) {
-    fail(*err);
-    return false;
-  }
-  if (auto err = record_.add(options_.record)) {
-    fail(*err);
-    return false;
-  }
-  record_text_ = "# tender input script recorded by tender-demo, preset " + common_.params.preset + "\n";
   return true;
 }
 
@@ -317,7 +328,6 @@ int DemoApp::run() {
   uint64_t frames = 0;
   float fps = 0.0f, fps_time = 0.0f;
   uint32_t fps_frames = 0;
-  std::string device = ctx_->info().name;
 
   // Ctrl-C, SIGTERM or SIGHUP end the session as a window close does (the recording and the summary
   // are written), then say so.
@@ -357,28 +367,9 @@ int DemoApp::run() {
       updateFollow(dt);
       backend_.solver->computeNormals();
     }
-    hs.seconds = sim_start ? std::chrono::duration<double>(now - *sim_start).count() : 0.0;
-    // "Initialising…" stays for a moment, then fades out over half a second.
-    hs.init_alpha = sim_start ? float(std::clamp(1.0 - (hs.seconds - 0.4) / 0.5, 0.0, 1.0)) : 1.0f;
-    hs.fps = fps;
-    hs.show_fps = show_fps_;
-    hs.paused = sim_->paused();
-    hs.wind = sim_->wind();
-    hs.pins = sim_->pins();
-    hs.device = device;
-    hs.notice = device_notice_;
     PassTimes times = backend_.solver->passTimes();
-    hs.times = &times;
-    hs.follow = follow_on_;
-    if (input_.grabbing && sim_->grabbed() != SIM_NONE) {
-      // The grab target on the screen, in window pixels
-      int ww = 0, wh = 0;
-      glfwGetWindowSize(window_, &ww, &wh);
-      if (auto v = camera_.viewPoint(sim_->grabTarget(), aspect()))
-        hs.grab_point = (*v * 0.5f + 0.5f) * glm::vec2(float(ww), float(wh));
-      hs.closure = sim_->closure();
-    }
-
+    hs.seconds = sim_start ? std::chrono::duration<double>(now - *sim_start).count() : 0.0;
+    fillHud(hs, sim_start.has_value(), fps, times);
     demo::HudActions actions = hud_->draw(hs, panel_params_);
     render::SceneView view = render::defaultSceneView(sim_->params());
     view.camera = camera_;
@@ -386,8 +377,33 @@ int DemoApp::run() {
     handleActions(actions);
     ++frames;
   }
+  return finish(frames, std::chrono::duration<double>(Clock::now() - start).count());
+}
+
+void DemoApp::fillHud(demo::HudState& hs, bool started, float fps, const PassTimes& times) const {
+  // "Initialising…" stays for a moment, then fades out over half a second.
+  hs.init_alpha = started ? float(std::clamp(1.0 - (hs.seconds - 0.4) / 0.5, 0.0, 1.0)) : 1.0f;
+  hs.fps = fps;
+  hs.show_fps = show_fps_;
+  hs.paused = sim_->paused();
+  hs.wind = sim_->wind();
+  hs.pins = sim_->pins();
+  hs.device = ctx_->info().name;
+  hs.notice = device_notice_;
+  hs.times = &times;
+  hs.follow = follow_on_;
+  if (input_.grabbing && sim_->grabbed() != SIM_NONE) {
+    // The grab target on the screen, in window pixels
+    int ww = 0, wh = 0;
+    glfwGetWindowSize(window_, &ww, &wh);
+    if (auto v = camera_.viewPoint(sim_->grabTarget(), aspect()))
+      hs.grab_point = (*v * 0.5f + 0.5f) * glm::vec2(float(ww), float(wh));
+    hs.closure = sim_->closure();
+  }
+}
+
+int DemoApp::finish(uint64_t frames, double seconds) {
   ctx_->waitIdle();
-  double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   SimState state;
   backend_.solver->readback(state);
   std::printf("tender-demo: %llu frames in %.1f s (%.1f FPS), %llu physics ticks, %u grabs\n",

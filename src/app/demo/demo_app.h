@@ -83,6 +83,15 @@ public:
 
 private:
   bool init();
+  /// The steps of init(): GLFW's window and its callbacks; the Vulkan context, its surface and the
+  /// swapchain; the renderer (fitted to a CPU device) and the frames' command buffers.
+  bool openWindow();
+  bool createContext();
+  bool createRenderer();
+  /// What the HUD shows this frame, besides hs.seconds and init_progress (`times` must outlive it).
+  void fillHud(demo::HudState& hs, bool started, float fps, const PassTimes& times) const;
+  /// After the frame loop: the summary, the recording, and the exit status.
+  int finish(uint64_t frames, double seconds);
   void initImGui(float scale);
   void createSolver();
   void attachPaper();

@@ -80,32 +80,51 @@ void drawHand(ImDrawList* dl, ImVec2 p, float u, float closure) {
 
 HudActions Hud::draw(const HudState& s, SimParams& params) {
   HudActions a;
-  ImGuiIO& io = ImGui::GetIO();
-  const ImVec2 size = io.DisplaySize;
+  const ImVec2 size = ImGui::GetIO().DisplaySize;
   const float m = 20.0f * scale_;
   ImDrawList* dl = ImGui::GetBackgroundDrawList();
-  const float body = body_->FontSize;
-
   // Title, top-left: 20 px semibold #444.
   textAt(dl, title_, title_->FontSize, {m, m * 0.8f}, rgba(0x444444), "Tender");
-
-  if (s.init_alpha > 0.0f) {
-    // Loading: "Initialising…" centred with a progress bar, fading out once the simulation runs.
-    ImDrawList* fg = ImGui::GetForegroundDrawList();
-    const float al = s.init_alpha;
-    // The crumple page's words; the tender page's otherwise
-    const bool crumple = params.release == ReleaseMode::DragVelocity;
-    const char* text = crumple ? "Initializing receipt paper\xe2\x80\xa6" : "Initialising\xe2\x80\xa6";
-    ImVec2 ts = title_->CalcTextSizeA(title_->FontSize, FLT_MAX, 0.0f, text);
-    ImVec2 c{size.x * 0.5f, size.y * 0.5f};
-    fg->AddRectFilled({0.0f, 0.0f}, size, rgba(0xe4e0dc, al));
-    fg->AddText(title_, title_->FontSize, {c.x - ts.x * 0.5f, c.y - ts.y - 8.0f * scale_}, rgba(0x444444, al), text);
-    float w = 220.0f * scale_, h = 6.0f * scale_;
-    fg->AddRectFilled({c.x - w * 0.5f, c.y}, {c.x + w * 0.5f, c.y + h}, rgba(0x000000, 0.12f * al), h);
-    fg->AddRectFilled({c.x - w * 0.5f, c.y}, {c.x - w * 0.5f + w * s.init_progress, c.y + h}, rgba(0x444444, al), h);
-  }
+  if (s.init_alpha > 0.0f) drawLoading(s, params);
   if (s.init_progress < 1.0f) return a;
+  drawCorners(s);
+  const ImVec2 buttons = drawButtons(s, a);
+  drawHints(s, params, buttons);
+  drawPanel(s, params, a);
+  // While grabbing: a small hand at the grab point (palm, four fingers, a thumb)
+  if (s.grab_point)
+    drawHand(ImGui::GetForegroundDrawList(), {s.grab_point->x, s.grab_point->y}, 9.0f * scale_, s.closure);
+  // Paused: 50% overlay with "PAUSED" centred.
+  if (s.paused) {
+    ImDrawList* fg = ImGui::GetForegroundDrawList();
+    fg->AddRectFilled({0.0f, 0.0f}, size, rgba(0x000000, 0.5f));
+    ImVec2 ts = big_->CalcTextSizeA(big_->FontSize, FLT_MAX, 0.0f, "PAUSED");
+    fg->AddText(big_, big_->FontSize, {(size.x - ts.x) * 0.5f, (size.y - ts.y) * 0.5f}, rgba(0xffffff), "PAUSED");
+  }
+  return a;
+}
 
+void Hud::drawLoading(const HudState& s, const SimParams& params) {
+  // Loading: "Initialising…" centred with a progress bar, fading out once the simulation runs.
+  const ImVec2 size = ImGui::GetIO().DisplaySize;
+  ImDrawList* fg = ImGui::GetForegroundDrawList();
+  const float al = s.init_alpha;
+  // The crumple page's words; the tender page's otherwise
+  const bool crumple = params.release == ReleaseMode::DragVelocity;
+  const char* text = crumple ? "Initializing receipt paper\xe2\x80\xa6" : "Initialising\xe2\x80\xa6";
+  ImVec2 ts = title_->CalcTextSizeA(title_->FontSize, FLT_MAX, 0.0f, text);
+  ImVec2 c{size.x * 0.5f, size.y * 0.5f};
+  fg->AddRectFilled({0.0f, 0.0f}, size, rgba(0xe4e0dc, al));
+  fg->AddText(title_, title_->FontSize, {c.x - ts.x * 0.5f, c.y - ts.y - 8.0f * scale_}, rgba(0x444444, al), text);
+  float w = 220.0f * scale_, h = 6.0f * scale_;
+  fg->AddRectFilled({c.x - w * 0.5f, c.y}, {c.x + w * 0.5f, c.y + h}, rgba(0x000000, 0.12f * al), h);
+  fg->AddRectFilled({c.x - w * 0.5f, c.y}, {c.x - w * 0.5f + w * s.init_progress, c.y + h}, rgba(0x444444, al), h);
+}
+
+void Hud::drawCorners(const HudState& s) {
+  const ImVec2 size = ImGui::GetIO().DisplaySize;
+  const float m = 20.0f * scale_, body = body_->FontSize;
+  ImDrawList* dl = ImGui::GetBackgroundDrawList();
   // FPS, top-right, hidden until I.
   if (s.show_fps) {
     char fps[32];
@@ -116,8 +135,12 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
   // How the demo runs on a CPU device, top-left, under the title (the parameters sit top-right)
   if (!s.notice.empty())
     textAt(dl, body_, body, {m, m * 0.8f + title_->FontSize + 0.4f * body}, rgba(0x666666), s.notice.c_str());
+}
 
+ImVec2 Hud::drawButtons(const HudState& s, HudActions& a) {
   // Buttons for wind, reset and pins, bottom-right.
+  const ImVec2 size = ImGui::GetIO().DisplaySize;
+  const float m = 20.0f * scale_;
   ImGui::SetNextWindowPos({size.x - m, size.y - m}, ImGuiCond_Always, {1.0f, 1.0f});
   ImGui::Begin("##buttons", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
@@ -138,7 +161,13 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("the camera keeps a tossed sheet in view (F)");
   const ImVec2 buttons = ImGui::GetWindowPos();
   ImGui::End();
+  return buttons;
+}
 
+void Hud::drawHints(const HudState& s, const SimParams& params, ImVec2 buttons) {
+  const ImVec2 size = ImGui::GetIO().DisplaySize;
+  const float m = 20.0f * scale_, body = body_->FontSize;
+  ImDrawList* dl = ImGui::GetBackgroundDrawList();
   // Controls hint, bottom-left; above the buttons' row when the window is too narrow for both.
   const char* hint =
       "R to Reset \xc2\xb7 W to toggle Wind \xc2\xb7 I to toggle FPS \xc2\xb7 P to toggle Pins "
@@ -154,19 +183,21 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
   const bool crumple = params.release == ReleaseMode::DragVelocity;
   const double shown = crumple ? kCrumpleInstructionSeconds : kInstructionSeconds;
   double fade = 1.0 - std::clamp((s.seconds - shown) / kFadeSeconds, 0.0, 1.0);
-  if (fade > 0.0) {
-    const char* text =
-        crumple ? "Click and drag to crumple" : "Click and drag to interact \xc2\xb7 Right-drag to orbit";
-    ImVec2 ts = body_->CalcTextSizeA(body, FLT_MAX, 0.0f, text);
-    // Above the buttons (and the hint) when the window is too narrow for them side by side
-    float y = size.y - m * 2.6f;
-    if ((size.x + ts.x) * 0.5f > buttons.x - 0.5f * m) y = std::min(y, hint_y - 0.6f * m - ts.y);
-    textAt(dl, body_, body, {(size.x - ts.x) * 0.5f, y}, rgba(0x555555, float(fade)), text);
-  }
+  if (fade <= 0.0) return;
+  const char* text = crumple ? "Click and drag to crumple" : "Click and drag to interact \xc2\xb7 Right-drag to orbit";
+  ImVec2 ts = body_->CalcTextSizeA(body, FLT_MAX, 0.0f, text);
+  // Above the buttons (and the hint) when the window is too narrow for them side by side
+  float y = size.y - m * 2.6f;
+  if ((size.x + ts.x) * 0.5f > buttons.x - 0.5f * m) y = std::min(y, hint_y - 0.6f * m - ts.y);
+  textAt(dl, body_, body, {(size.x - ts.x) * 0.5f, y}, rgba(0x555555, float(fade)), text);
+}
 
+void Hud::drawPanel(const HudState& s, SimParams& params, HudActions& a) {
   // The parameter panel, collapsed at first, under the FPS counter: anchored to the top-right
   // corner in every frame, so a resized window keeps it there.
-  ImGui::SetNextWindowPos({size.x - m, m + body * 1.8f}, ImGuiCond_Always, {1.0f, 0.0f});
+  const ImVec2 size = ImGui::GetIO().DisplaySize;
+  const float m = 20.0f * scale_;
+  ImGui::SetNextWindowPos({size.x - m, m + body_->FontSize * 1.8f}, ImGuiCond_Always, {1.0f, 0.0f});
   ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize({320.0f * scale_, 0.0f}, ImGuiCond_FirstUseEver);
   if (ImGui::Begin("Parameters", nullptr, ImGuiWindowFlags_NoSavedSettings)) {
@@ -201,33 +232,22 @@ HudActions Hud::draw(const HudState& s, SimParams& params) {
     if (ImGui::Button("Rebuild sheet")) a.rebuild = true;
     if (!s.device.empty()) ImGui::TextDisabled("%s", s.device.c_str());
     if (s.triangles > 0) ImGui::Text("%u triangles", s.triangles);
-    if (s.times && !s.times->ms.empty() &&
-        ImGui::CollapsingHeader("GPU time per pass", ImGuiTreeNodeFlags_DefaultOpen)) {
-      // What the last tick measured: each pass, or for the fused tick the one dispatch that runs
-      // them all (the passes it fuses have no time of their own)
-      double total = 0.0;
-      for (auto& [name, ms] : s.times->ms) {
-        if (ms <= 0.0) continue;
-        ImGui::Text("%-10s %7.3f ms", name == "fused_tick" ? "fused tick" : name.c_str(), ms);
-        total += ms;
-      }
-      ImGui::Text("%-10s %7.3f ms", "total", total);
-    }
+    if (s.times && !s.times->ms.empty() && ImGui::CollapsingHeader("GPU time per pass", ImGuiTreeNodeFlags_DefaultOpen))
+      passTimes(*s.times);
   }
   ImGui::End();
+}
 
-  // While grabbing: a small hand at the grab point (palm, four fingers, a thumb)
-  if (s.grab_point)
-    drawHand(ImGui::GetForegroundDrawList(), {s.grab_point->x, s.grab_point->y}, 9.0f * scale_, s.closure);
-
-  // Paused: 50% overlay with "PAUSED" centred.
-  if (s.paused) {
-    ImDrawList* fg = ImGui::GetForegroundDrawList();
-    fg->AddRectFilled({0.0f, 0.0f}, size, rgba(0x000000, 0.5f));
-    ImVec2 ts = big_->CalcTextSizeA(big_->FontSize, FLT_MAX, 0.0f, "PAUSED");
-    fg->AddText(big_, big_->FontSize, {(size.x - ts.x) * 0.5f, (size.y - ts.y) * 0.5f}, rgba(0xffffff), "PAUSED");
+void Hud::passTimes(const PassTimes& times) {
+  // What the last tick measured: each pass, or for the fused tick the one dispatch that runs them
+  // all (the passes it fuses have no time of their own)
+  double total = 0.0;
+  for (auto& [name, ms] : times.ms) {
+    if (ms <= 0.0) continue;
+    ImGui::Text("%-10s %7.3f ms", name == "fused_tick" ? "fused tick" : name.c_str(), ms);
+    total += ms;
   }
-  return a;
+  ImGui::Text("%-10s %7.3f ms", "total", total);
 }
 
 } // namespace tender::demo

@@ -9,6 +9,7 @@
 #include "shaderio.h"
 
 struct ImFont;
+struct ImVec2;
 
 namespace tender::demo {
 
@@ -48,6 +49,16 @@ public:
   HudActions draw(const HudState& state, SimParams& params);
 
 private:
+  void drawLoading(const HudState& s, const SimParams& params);
+  /// FPS top-right, the device notice top-left.
+  void drawCorners(const HudState& s);
+  /// The buttons' row, bottom-right; gives its window's position.
+  ImVec2 drawButtons(const HudState& s, HudActions& a);
+  /// The controls hint and the instruction line, clear of the buttons.
+  void drawHints(const HudState& s, const SimParams& params, ImVec2 buttons);
+  void drawPanel(const HudState& s, SimParams& params, HudActions& a);
+  static void passTimes(const PassTimes& times);
+
   float scale_ = 1.0f;
   ImFont* body_ = nullptr;
   ImFont* title_ = nullptr;
