@@ -114,6 +114,110 @@ std::string cpuModel() {
   return "unknown";
 }
 
+namespace {
+
+/// The tick's memory layout and pair lists, for its traffic (bench/traffic.h); recorded in `r`.
+struct SolverShape {
+  Layout layout = Layout::Cpu;
+  bool candidate_lists = false;
+};
+
+SolverShape describeSolver(const Backend& made, Simulation& sim, nlohmann::json& r) {
+  SolverShape shape;
+  if (CpuSolver* cpu = made.cpu) {
+    r["threads"] = cpu->threadCount();
+    shape.candidate_lists = cpu->usesCandidateLists();
+    r["candidate_lists"] = shape.candidate_lists;
+  } else {
+    r["threads"] = 0;
+  }
+#ifdef TENDER_HAS_GPU
+  if (gpu::GpuSolver* gpu_solver = made.gpu) {
+    r["device"] = std::string(gpu_solver->context().properties().deviceName);
+    const bool fused = gpu_solver->usesFusedPath(sim.makeUniforms());
+    r["fused"] = fused;
+    r["fused_workgroup"] = gpu_solver->fusedWorkgroup();
+    shape.layout = fused ? Layout::GpuFused : Layout::Gpu;
+    shape.candidate_lists = gpu_solver->usesCandidateLists();
+    r["candidate_lists"] = shape.candidate_lists;
+  }
+#else
+  (void)sim;
+#endif
+  return shape;
+}
+
+/// Each timed tick's milliseconds, and each pass's.
+struct TickTimes {
+  std::vector<double> ms;
+  std::map<std::string, std::vector<double>> pass_ms;
+};
+
+TickTimes timeTicks(const BenchOptions& o, Simulation& sim, Solver& solver, const std::string& label,
+                    Progress& progress) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  auto show = [&](const char* phase, uint32_t done, uint32_t total) {
+    if (!progress.live()) return;
+    char buf[160];
+    std::snprintf(buf, sizeof(buf), "%s: %s %u/%u (%.1f s)", label.c_str(), phase, done, total, elapsed());
+    progress.update(buf, false);
+  };
+  for (uint32_t t = 0; t < o.warmup; ++t) {
+    sim.tick();
+    solver.finish();
+    show("warm-up", t + 1, o.warmup);
+    if (elapsed() > o.max_seconds / 2) break; // a slow size gets a short warm-up
+  }
+  TickTimes times;
+  const auto timed_start = Clock::now();
+  for (uint32_t t = 0; t < o.ticks; ++t) {
+    const auto t0 = Clock::now();
+    sim.tick();
+    solver.finish();
+    times.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    for (auto& [name, v] : solver.passTimes().ms) times.pass_ms[name].push_back(v);
+    show("tick", t + 1, o.ticks);
+    // Stop a slow size once the time budget is spent (it still gets 3 ticks).
+    if (t + 1 >= 3 && std::chrono::duration<double>(Clock::now() - timed_start).count() > o.max_seconds) break;
+  }
+  return times;
+}
+
+/// Bandwidth: the bytes a tick must move over the median tick (and each timed pass over its own
+/// median), against the measured copy bandwidth of the device that ran it. Gives the progress
+/// line's tail.
+std::string recordTraffic(nlohmann::json& r, Simulation& sim, const SolverShape& shape,
+                          const std::optional<PeakBandwidth>& peak) {
+  const double median = r["ms_median"].get<double>();
+  const nlohmann::json& passes = r["pass_ms"];
+  uint64_t bytes = 0;
+  nlohmann::json pass_bytes = nlohmann::json::object(), pass_gbps = nlohmann::json::object();
+  for (const PassTraffic& t : tickTraffic(sim.topology(), sim.makeUniforms(), shape.layout, shape.candidate_lists)) {
+    bytes += t.bytes();
+    pass_bytes[t.name] = {{"read", t.read}, {"write", t.write}};
+    if (passes.contains(t.name) && passes[t.name].get<double>() > 0.0 && t.bytes() > 0)
+      pass_gbps[t.name] = double(t.bytes()) / (passes[t.name].get<double>() * 1e6);
+  }
+  const double gbps = median > 0.0 ? double(bytes) / (median * 1e6) : 0.0;
+  r["bytes_per_tick"] = bytes;
+  r["pass_bytes"] = pass_bytes;
+  r["achieved_gbps"] = gbps;
+  r["pass_gbps"] = pass_gbps;
+  char buf[100];
+  std::snprintf(buf, sizeof(buf), "%.1f MB/tick, %.2f GB/s", double(bytes) / 1e6, gbps);
+  std::string tail = buf;
+  if (peak && peak->gbps > 0.0) {
+    r["peak_gbps"] = peak->gbps;
+    r["peak_pct"] = 100.0 * gbps / peak->gbps;
+    tail += " = " + std::to_string(int(std::lround(100.0 * gbps / peak->gbps))) + "% of peak";
+  }
+  return tail;
+}
+
+} // namespace
+
 nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& size, const std::string& backend,
                        const std::string& label, Progress& progress) {
   nlohmann::json r = caseRecord(size, backend);
@@ -139,57 +243,9 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
     return skip(e.what());
   }
   Solver* solver = made.solver.get();
-  bool candidate_lists = false;
-  if (CpuSolver* cpu = made.cpu) {
-    r["threads"] = cpu->threadCount();
-    candidate_lists = cpu->usesCandidateLists();
-    r["candidate_lists"] = candidate_lists;
-  } else {
-    r["threads"] = 0;
-  }
-#ifdef TENDER_HAS_GPU
-  bench::Layout layout = bench::Layout::Cpu;
-  if (gpu::GpuSolver* gpu_solver = made.gpu) {
-    r["device"] = std::string(gpu_solver->context().properties().deviceName);
-    const bool fused = gpu_solver->usesFusedPath(sim->makeUniforms());
-    r["fused"] = fused;
-    r["fused_workgroup"] = gpu_solver->fusedWorkgroup();
-    layout = fused ? bench::Layout::GpuFused : bench::Layout::Gpu;
-    candidate_lists = gpu_solver->usesCandidateLists();
-    r["candidate_lists"] = candidate_lists;
-  }
-#else
-  const bench::Layout layout = bench::Layout::Cpu;
-#endif
-
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
-  auto show = [&](const char* phase, uint32_t done, uint32_t total) {
-    if (!progress.live()) return;
-    char buf[160];
-    std::snprintf(buf, sizeof(buf), "%s: %s %u/%u (%.1f s)", label.c_str(), phase, done, total, elapsed());
-    progress.update(buf, false);
-  };
-  for (uint32_t t = 0; t < o.warmup; ++t) {
-    sim->tick();
-    solver->finish();
-    show("warm-up", t + 1, o.warmup);
-    if (elapsed() > o.max_seconds / 2) break; // a slow size gets a short warm-up
-  }
-  std::vector<double> ms;
-  std::map<std::string, std::vector<double>> pass_ms;
-  const auto timed_start = Clock::now();
-  for (uint32_t t = 0; t < o.ticks; ++t) {
-    const auto t0 = Clock::now();
-    sim->tick();
-    solver->finish();
-    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-    for (auto& [name, v] : solver->passTimes().ms) pass_ms[name].push_back(v);
-    show("tick", t + 1, o.ticks);
-    // Stop a slow size once the time budget is spent (it still gets 3 ticks).
-    if (t + 1 >= 3 && std::chrono::duration<double>(Clock::now() - timed_start).count() > o.max_seconds) break;
-  }
+  const SolverShape shape = describeSolver(made, *sim, r);
+  const TickTimes times = timeTicks(o, *sim, *solver, label, progress);
+  const std::vector<double>& ms = times.ms;
   solver->computeNormals();
   SimState state;
   solver->readback(state);
@@ -200,48 +256,23 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   r["ticks_measured"] = ms.size();
   r["ms_median"] = median;
   r["ms_p95"] = percentile(ms, 0.95);
-  r["ms_mean"] = [&] {
-    double s = 0.0;
-    for (double v : ms) s += v;
-    return s / double(ms.size());
-  }();
+  double sum = 0.0;
+  for (double v : ms) sum += v;
+  r["ms_mean"] = sum / double(ms.size());
   r["ms_min"] = *std::min_element(ms.begin(), ms.end());
   r["particle_substeps_per_s"] = median > 0.0 ? double(p.particleCount()) * p.substeps * 1000.0 / median : 0.0;
   r["dispatches_per_tick"] = solver->dispatchesPerTick();
   r["memory_bytes"] = solver->memoryBytes();
   nlohmann::json passes = nlohmann::json::object();
-  for (auto& [name, v] : pass_ms) passes[name] = percentile(v, 0.5);
+  for (auto& [name, v] : times.pass_ms) passes[name] = percentile(v, 0.5);
   r["pass_ms"] = passes;
-
-  // Bandwidth: the bytes a tick must move over the median tick (and each timed pass over its own
-  // median), against the measured copy bandwidth of the device that ran it.
-  uint64_t bytes = 0;
-  nlohmann::json pass_bytes = nlohmann::json::object(), pass_gbps = nlohmann::json::object();
-  for (const bench::PassTraffic& t :
-       bench::tickTraffic(sim->topology(), sim->makeUniforms(), layout, candidate_lists)) {
-    bytes += t.bytes();
-    pass_bytes[t.name] = {{"read", t.read}, {"write", t.write}};
-    if (passes.contains(t.name) && passes[t.name].get<double>() > 0.0 && t.bytes() > 0)
-      pass_gbps[t.name] = double(t.bytes()) / (passes[t.name].get<double>() * 1e6);
-  }
-  const double gbps = median > 0.0 ? double(bytes) / (median * 1e6) : 0.0;
-  r["bytes_per_tick"] = bytes;
-  r["pass_bytes"] = pass_bytes;
-  r["achieved_gbps"] = gbps;
-  r["pass_gbps"] = pass_gbps;
-  const std::optional<bench::PeakBandwidth>& peak = backend == "cpu" ? peaks.cpu : peaks.gpu;
-  std::string vs_peak;
-  if (peak && peak->gbps > 0.0) {
-    r["peak_gbps"] = peak->gbps;
-    r["peak_pct"] = 100.0 * gbps / peak->gbps;
-    vs_peak = " = " + std::to_string(int(std::lround(100.0 * gbps / peak->gbps))) + "% of peak";
-  }
+  const std::string traffic = recordTraffic(r, *sim, shape, backend == "cpu" ? peaks.cpu : peaks.gpu);
   r["torn"] = st.torn;
   r["nan_count"] = st.nan_count;
   r["state_hash"] = hashHex(st.state_hash);
   char buf[300];
-  std::snprintf(buf, sizeof(buf), "%s: %.3f ms/tick median, %.3f p95 (%zu ticks); %.1f MB/tick, %.2f GB/s%s",
-                label.c_str(), median, percentile(ms, 0.95), ms.size(), double(bytes) / 1e6, gbps, vs_peak.c_str());
+  std::snprintf(buf, sizeof(buf), "%s: %.3f ms/tick median, %.3f p95 (%zu ticks); %s", label.c_str(), median,
+                percentile(ms, 0.95), ms.size(), traffic.c_str());
   progress.update(buf, true);
   return r;
 }

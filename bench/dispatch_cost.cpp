@@ -32,6 +32,41 @@ struct Objects {
   }
 };
 
+/// The mask of a timestamp's bits that count on the context's queue (the rest may hold anything).
+uint64_t timestampMask(const gpu::VulkanContext& ctx) {
+  uint32_t family_count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(ctx.physicalDevice(), &family_count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(family_count);
+  vkGetPhysicalDeviceQueueFamilyProperties(ctx.physicalDevice(), &family_count, families.data());
+  const uint32_t bits = ctx.queueFamily() < family_count ? families[ctx.queueFamily()].timestampValidBits : 64;
+  return bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
+}
+
+/// The empty shader's pipeline and a pool of 2 x `repetitions` timestamps.
+void createObjects(Objects& o, std::span<const uint32_t> code, uint32_t repetitions) {
+  VkShaderModuleCreateInfo mci{};
+  mci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+  mci.codeSize = code.size_bytes();
+  mci.pCode = code.data();
+  VK_CHECK(vkCreateShaderModule(o.device, &mci, nullptr, &o.module));
+  VkPipelineLayoutCreateInfo lci{};
+  lci.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  VK_CHECK(vkCreatePipelineLayout(o.device, &lci, nullptr, &o.layout));
+  VkComputePipelineCreateInfo pci{};
+  pci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+  pci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  pci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  pci.stage.module = o.module;
+  pci.stage.pName = "main";
+  pci.layout = o.layout;
+  VK_CHECK(vkCreateComputePipelines(o.device, VK_NULL_HANDLE, 1, &pci, nullptr, &o.pipeline));
+  VkQueryPoolCreateInfo qci{};
+  qci.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+  qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  qci.queryCount = 2 * repetitions;
+  VK_CHECK(vkCreateQueryPool(o.device, &qci, nullptr, &o.queries));
+}
+
 } // namespace
 
 std::optional<DispatchCost> measureDispatchCost(gpu::VulkanContext& ctx, std::string& error, uint32_t chain,
@@ -49,41 +84,14 @@ std::optional<DispatchCost> measureDispatchCost(gpu::VulkanContext& ctx, std::st
     error = "the empty shader is not built in";
     return std::nullopt;
   }
-  // Bits of a timestamp that count (the rest may hold anything).
-  uint32_t family_count = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(ctx.physicalDevice(), &family_count, nullptr);
-  std::vector<VkQueueFamilyProperties> families(family_count);
-  vkGetPhysicalDeviceQueueFamilyProperties(ctx.physicalDevice(), &family_count, families.data());
-  const uint32_t bits = ctx.queueFamily() < family_count ? families[ctx.queueFamily()].timestampValidBits : 64;
-  const uint64_t mask = bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
-
+  const uint64_t mask = timestampMask(ctx);
   try {
     Objects o;
     o.device = ctx.device();
-    VkShaderModuleCreateInfo mci{};
-    mci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-    mci.codeSize = code.size_bytes();
-    mci.pCode = code.data();
-    VK_CHECK(vkCreateShaderModule(o.device, &mci, nullptr, &o.module));
-    VkPipelineLayoutCreateInfo lci{};
-    lci.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-    VK_CHECK(vkCreatePipelineLayout(o.device, &lci, nullptr, &o.layout));
-    VkComputePipelineCreateInfo pci{};
-    pci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-    pci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    pci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    pci.stage.module = o.module;
-    pci.stage.pName = "main";
-    pci.layout = o.layout;
-    VK_CHECK(vkCreateComputePipelines(o.device, VK_NULL_HANDLE, 1, &pci, nullptr, &o.pipeline));
-    VkQueryPoolCreateInfo qci{};
-    qci.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
-    qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    qci.queryCount = 2 * repetitions;
-    VK_CHECK(vkCreateQueryPool(o.device, &qci, nullptr, &o.queries));
-
+    createObjects(o, code, repetitions);
+    const uint32_t query_count = 2 * repetitions;
     ctx.submitOnce([&](VkCommandBuffer cmd) {
-      vkCmdResetQueryPool(cmd, o.queries, 0, qci.queryCount);
+      vkCmdResetQueryPool(cmd, o.queries, 0, query_count);
       vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.pipeline);
       auto dispatches = [&](uint32_t count) {
         for (uint32_t k = 0; k < count; ++k) {
@@ -98,8 +106,8 @@ std::optional<DispatchCost> measureDispatchCost(gpu::VulkanContext& ctx, std::st
         vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, o.queries, 2 * r + 1);
       }
     });
-    std::vector<uint64_t> ts(qci.queryCount);
-    VK_CHECK(vkGetQueryPoolResults(o.device, o.queries, 0, qci.queryCount, ts.size() * sizeof(uint64_t), ts.data(),
+    std::vector<uint64_t> ts(query_count);
+    VK_CHECK(vkGetQueryPoolResults(o.device, o.queries, 0, query_count, ts.size() * sizeof(uint64_t), ts.data(),
                                    sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
     DispatchCost cost;
     cost.chain = chain;

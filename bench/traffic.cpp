@@ -33,6 +33,59 @@ constexpr uint64_t kSplitConstraint = 3 * kIndex + sizeof(float);
 constexpr uint64_t kCoord = sizeof(glm::ivec4);
 constexpr uint64_t kSortedPos = 3 * sizeof(float);
 
+/// The hash and collide passes' traffic with the candidate lists in use.
+void listTraffic(uint64_t n, bool cpu, bool fused, PassTraffic& hash, PassTraffic& collide) {
+  // The candidate lists in use (a substep that rebuilds them runs the hash and the search
+  // below): each particle reads the position its list was built at and its current one (the
+  // travel test; fused: the current one in shared memory), then its list's count and its
+  // position (fused: shared memory), and writes delta. The entries and their positions depend
+  // on how close the sheet comes to itself and are not counted.
+  const uint64_t base = cpu ? kSortedPos : kPos; // CpuCollision's candidate bases hold xyz only
+  hash.read += n * (base + (fused ? 0 : kPos));
+  collide.read += n * (kIndex + (fused ? 0 : kPos));
+  collide.write += n * kPos;
+}
+
+/// The CPU's spatial hash and collision, without lists.
+void hashTrafficCpu(uint64_t n, uint64_t buckets, uint64_t adjacency, PassTraffic& hash, PassTraffic& collide) {
+  // hash (CpuCollision::buildHash), step by step:
+  hash.read += n * kPos;                     // cell of each particle: read pos,
+  hash.write += n * (kCoord + kIndex);       //   write particle_coord_, particle_cell_
+  hash.read += n * 2 * kIndex;               // count: read particle_cell_ and a count per particle,
+  hash.write += n * kIndex;                  //   write the count back
+  hash.read += buckets * kIndex;             // exclusive scan: read cell_count_,
+  hash.write += (2 * buckets + 1) * kIndex;  //   write cell_start_ (shifted by one) and clear cell_count_
+  hash.read += n * 2 * kIndex;               // scatter: read particle_cell_ and its cursor in cell_start_,
+  hash.write += n * 3 * kIndex;              //   write the cursor, particle_slot_ and cell_particles_
+  hash.read += n * (kIndex + kPos + kCoord); // gather in bucket order: read cell_particles_, pos, particle_coord_,
+  hash.write += n * (kSortedPos + kCoord);   //   write sorted_x_/y_/z_, sorted_coord_
+  // collide: read every particle's hash-ordered position and cell and its slot
+  // (cell_particles_), the bucket starts (27 lookups per particle spread over the whole table)
+  // and its adjacency (offsets and list); write delta (in hash order).
+  collide.read += n * (kSortedPos + kCoord + kIndex) + (buckets + 1) * kIndex + (n + 1) * kIndex + adjacency * kIndex;
+  collide.write += n * kPos;
+}
+
+/// The GPU's spatial hash and collision, without lists.
+void hashTrafficGpu(uint64_t n, uint64_t buckets, PassTraffic& hash, PassTraffic& collide) {
+  // hash, the GPU passes (scan_add runs when the scan has more than one block).
+  const uint64_t scans = buckets > SIM_SCAN_BLOCK ? 2 : 1;
+  hash.read += n * (kPos + kIndex);       // hash_count: read pos and (atomic) the bucket's count,
+  hash.write += n * 2 * kIndex;           //   write particle_cell and the count
+  hash.read += scans * buckets * kIndex;  // scan (+ scan_add): read cell_count (cell_start),
+  hash.write += scans * buckets * kIndex; //   write cell_start; the block sums are negligible
+  hash.read += n * 3 * kIndex;            // hash_scatter: read particle_cell, bucket start, (atomic) count,
+  hash.write += n * 2 * kIndex;           //   write the count and cell_scatter
+  hash.read += n * (3 * kIndex + kPos);   // hash_sort: read particle_cell, the bucket start, the bucket's
+                                          //   cell_scatter entries (each once overall) and pos,
+  hash.write += n * (kIndex + kPos);      //   write cell_particles and cell_pos (position and index)
+  // collide: read pos, the bucket starts (27 lookups per particle spread over the whole table),
+  // every bucket entry (cell_pos: position and index in one record) and the particle's
+  // adjacency mask over its grid stencil (the adjacency list only for rare far neighbours); write delta.
+  collide.read += n * kPos + (buckets + 1) * kIndex + n * kPos + n * kIndex;
+  collide.write += n * kPos;
+}
+
 } // namespace
 
 std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::SimUniforms& u, Layout layout,
@@ -67,51 +120,12 @@ std::vector<PassTraffic> tickTraffic(const SheetTopology& topo, const shaderio::
       project.write += fused ? 0 : c.count * 2 * kPos;
     }
 
-  if (collision && candidate_lists) {
-    // The candidate lists in use (a substep that rebuilds them runs the hash and the search
-    // below): each particle reads the position its list was built at and its current one (the
-    // travel test; fused: the current one in shared memory), then its list's count and its
-    // position (fused: shared memory), and writes delta. The entries and their positions depend
-    // on how close the sheet comes to itself and are not counted.
-    const uint64_t base = cpu ? kSortedPos : kPos; // CpuCollision's candidate bases hold xyz only
-    hash.read += n * (base + (fused ? 0 : kPos));
-    collide.read += n * (kIndex + (fused ? 0 : kPos));
-    collide.write += n * kPos;
-  } else if (collision && cpu) {
-    // hash (CpuCollision::buildHash), step by step:
-    hash.read += n * kPos;                     // cell of each particle: read pos,
-    hash.write += n * (kCoord + kIndex);       //   write particle_coord_, particle_cell_
-    hash.read += n * 2 * kIndex;               // count: read particle_cell_ and a count per particle,
-    hash.write += n * kIndex;                  //   write the count back
-    hash.read += buckets * kIndex;             // exclusive scan: read cell_count_,
-    hash.write += (2 * buckets + 1) * kIndex;  //   write cell_start_ (shifted by one) and clear cell_count_
-    hash.read += n * 2 * kIndex;               // scatter: read particle_cell_ and its cursor in cell_start_,
-    hash.write += n * 3 * kIndex;              //   write the cursor, particle_slot_ and cell_particles_
-    hash.read += n * (kIndex + kPos + kCoord); // gather in bucket order: read cell_particles_, pos, particle_coord_,
-    hash.write += n * (kSortedPos + kCoord);   //   write sorted_x_/y_/z_, sorted_coord_
-    // collide: read every particle's hash-ordered position and cell and its slot
-    // (cell_particles_), the bucket starts (27 lookups per particle spread over the whole table)
-    // and its adjacency (offsets and list); write delta (in hash order).
-    collide.read += n * (kSortedPos + kCoord + kIndex) + (buckets + 1) * kIndex + (n + 1) * kIndex + adjacency * kIndex;
-    collide.write += n * kPos;
-  } else if (collision) {
-    // hash, the GPU passes (scan_add runs when the scan has more than one block).
-    const uint64_t scans = buckets > SIM_SCAN_BLOCK ? 2 : 1;
-    hash.read += n * (kPos + kIndex);       // hash_count: read pos and (atomic) the bucket's count,
-    hash.write += n * 2 * kIndex;           //   write particle_cell and the count
-    hash.read += scans * buckets * kIndex;  // scan (+ scan_add): read cell_count (cell_start),
-    hash.write += scans * buckets * kIndex; //   write cell_start; the block sums are negligible
-    hash.read += n * 3 * kIndex;            // hash_scatter: read particle_cell, bucket start, (atomic) count,
-    hash.write += n * 2 * kIndex;           //   write the count and cell_scatter
-    hash.read += n * (3 * kIndex + kPos);   // hash_sort: read particle_cell, the bucket start, the bucket's
-                                            //   cell_scatter entries (each once overall) and pos,
-    hash.write += n * (kIndex + kPos);      //   write cell_particles and cell_pos (position and index)
-    // collide: read pos, the bucket starts (27 lookups per particle spread over the whole table),
-    // every bucket entry (cell_pos: position and index in one record) and the particle's
-    // adjacency mask over its grid stencil (the adjacency list only for rare far neighbours); write delta.
-    collide.read += n * kPos + (buckets + 1) * kIndex + n * kPos + n * kIndex;
-    collide.write += n * kPos;
-  }
+  if (collision && candidate_lists)
+    listTraffic(n, cpu, fused, hash, collide);
+  else if (collision && cpu)
+    hashTrafficCpu(n, buckets, adjacency, hash, collide);
+  else if (collision)
+    hashTrafficGpu(n, buckets, hash, collide);
 
   // floor: read pos, prev and (with collision) delta (on the CPU through particle_slot_); write pos, prev.
   floor.read += n * (collision ? 3 : 2) * kPos + (collision && cpu && !candidate_lists ? n * kIndex : 0);
