@@ -6,22 +6,37 @@
 
 namespace tender::render {
 
+namespace {
+
+/// Writes every channel; with `blend`, over what is there by the source's alpha.
+VkPipelineColorBlendAttachmentState blendAttachment(bool blend) {
+  VkPipelineColorBlendAttachmentState ba{};
+  ba.colorWriteMask = 0xf;
+  ba.blendEnable = blend;
+  ba.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
+  ba.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+  ba.colorBlendOp = VK_BLEND_OP_ADD;
+  ba.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+  ba.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+  ba.alphaBlendOp = VK_BLEND_OP_ADD;
+  return ba;
+}
+
+} // namespace
+
 VkPipeline createPipeline(VkDevice dev, VkPipelineLayout layout, const PipelineDesc& d) {
   VkShaderModule vs = createShaderModule(dev, gpu::renderShader(d.vert));
   VkShaderModule fs = d.frag ? createShaderModule(dev, gpu::renderShader(d.frag)) : VK_NULL_HANDLE;
   VkPipelineShaderStageCreateInfo stages[2]{};
-  stages[0] = {
-      VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT, vs, "main", nullptr};
-  stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-               nullptr,
-               0,
-               VK_SHADER_STAGE_FRAGMENT_BIT,
-               fs,
-               "main",
-               nullptr};
-
+  for (VkPipelineShaderStageCreateInfo& st : stages) {
+    st.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    st.pName = "main";
+  }
+  stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+  stages[0].module = vs;
+  stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+  stages[1].module = fs;
   VkPipelineVertexInputStateCreateInfo vi{};
-
   vi.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
   VkPipelineInputAssemblyStateCreateInfo ia{};
   ia.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO;
@@ -47,15 +62,7 @@ VkPipeline createPipeline(VkDevice dev, VkPipelineLayout layout, const PipelineD
   ds.depthTestEnable = d.depth_test;
   ds.depthWriteEnable = d.depth_write;
   ds.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
-  VkPipelineColorBlendAttachmentState ba{};
-  ba.colorWriteMask = 0xf;
-  ba.blendEnable = d.blend;
-  ba.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
-  ba.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
-  ba.colorBlendOp = VK_BLEND_OP_ADD;
-  ba.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
-  ba.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
-  ba.alphaBlendOp = VK_BLEND_OP_ADD;
+  const VkPipelineColorBlendAttachmentState ba = blendAttachment(d.blend);
   VkPipelineColorBlendStateCreateInfo cb{};
   cb.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO;
   cb.attachmentCount = d.frag ? 1 : 0;
@@ -67,7 +74,6 @@ VkPipeline createPipeline(VkDevice dev, VkPipelineLayout layout, const PipelineD
   dy.pDynamicStates = dyn;
 
   VkGraphicsPipelineCreateInfo ci{};
-
   ci.sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO;
   ci.stageCount = d.frag ? 2 : 1;
   ci.pStages = stages;

@@ -4,10 +4,10 @@
 
 namespace tender::render {
 
-void ShadowPass::create(gpu::VulkanContext& ctx, uint32_t map_size) {
-  size = map_size;
-  VkDevice dev = ctx.device();
-  // Render pass: one depth attachment, left readable by the scene pass.
+namespace {
+
+/// The shadow pass: one depth attachment, left readable by the scene pass.
+VkRenderPass createDepthPass(VkDevice dev) {
   VkAttachmentDescription a{};
   a.format = kDepthFormat;
   a.samples = VK_SAMPLE_COUNT_1_BIT;
@@ -44,7 +44,17 @@ void ShadowPass::create(gpu::VulkanContext& ctx, uint32_t map_size) {
   ci.pSubpasses = &sp;
   ci.dependencyCount = 2;
   ci.pDependencies = deps;
+  VkRenderPass pass = VK_NULL_HANDLE;
   VK_CHECK(vkCreateRenderPass(dev, &ci, nullptr, &pass));
+  return pass;
+}
+
+} // namespace
+
+void ShadowPass::create(gpu::VulkanContext& ctx, uint32_t map_size) {
+  size = map_size;
+  VkDevice dev = ctx.device();
+  pass = createDepthPass(dev);
 
   // Comparison sampler; bilinear comparisons where the format allows them.
   VkFormatProperties fp;
