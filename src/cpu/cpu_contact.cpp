@@ -43,6 +43,26 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   const float radius = u.contact.x, thickness = u.contact.z, scale = u.contact.w;
   bound.resize(n);
   push.resize(n);
+  const auto [travel_lo, travel_hi] = gatherFrame(pos, prev, u, s);
+  if (edges_key_ != count) listEdges(triangles, count);
+  keepLists(pos, triangles, count, radius, travel_lo, travel_hi);
+  sums_.assign(n, glm::ivec4(0));
+  findCrossings(pos, triangles, count, s == 0 && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u, thickness, scale);
+  lowerNearest(pos, radius, thickness, scale);
+  const uint32_t none = std::bit_cast<uint32_t>(radius * radius);
+  uint64_t contacts = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    contacts += nearest2_[i] < none ? 1u : 0u;
+    bound[i] = free_[i] ? INFINITY : slideBound(std::bit_cast<float>(nearest2_[i]), radius, u.contact.y);
+    push[i] =
+        glm::vec4(contactPushWithin(contactAverage(sums_[i], scale), std::bit_cast<float>(nearest2_[i]), radius), 0.0f);
+  }
+  contacts_ = contacts;
+}
+
+std::pair<vec3, vec3> CpuContact::gatherFrame(const std::vector<glm::vec4>& pos, const std::vector<glm::vec4>& prev,
+                                              const SimUniforms& u, uint32_t s) {
+  const uint32_t n = uint32_t(pos.size());
   // What the GPU's contact_clear gathers, in orderedBits (the same bits in any order): the frame's
   // inputs (every particle's last step, lowest and highest, and their lowest start above the floor)
   // and the box of every particle's travel since the lists were built
@@ -75,23 +95,28 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   frame_ = all.lo.x > all.hi.x ? vec3(0.0f)
                                : contactFrame(orderedCorner(all.lo), orderedCorner(all.hi),
                                               std::bit_cast<float>(all.lowest), contactFrameScale(u.verlet, s));
-  if (edges_key_ != count) {
-    edges_.clear();
-    for (uint32_t t = 0; t < count; ++t) {
-      const uvec4 tri = triangles[t];
-      for (uvec2 e : {uvec2(tri.x, tri.y), uvec2(tri.y, tri.z), uvec2(tri.z, tri.x)})
-        edges_.push_back(uvec2(std::min(e.x, e.y), std::max(e.x, e.y)));
-    }
-    std::sort(edges_.begin(), edges_.end(), [](uvec2 a, uvec2 b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
-    edges_.erase(std::unique(edges_.begin(), edges_.end()), edges_.end());
-    edges_key_ = count;
-    lists_ = false;
+  return {orderedCorner(all.travel_lo), orderedCorner(all.travel_hi)};
+}
+
+void CpuContact::listEdges(const std::vector<uvec4>& triangles, uint32_t count) {
+  edges_.clear();
+  for (uint32_t t = 0; t < count; ++t) {
+    const uvec4 tri = triangles[t];
+    for (uvec2 e : {uvec2(tri.x, tri.y), uvec2(tri.y, tri.z), uvec2(tri.z, tri.x)})
+      edges_.push_back(uvec2(std::min(e.x, e.y), std::max(e.x, e.y)));
   }
-  const float r = radius, r2 = r * r;
+  std::sort(edges_.begin(), edges_.end(), [](uvec2 a, uvec2 b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
+  edges_.erase(std::unique(edges_.begin(), edges_.end()), edges_.end());
+  edges_key_ = count;
+  lists_ = false;
+}
+
+void CpuContact::keepLists(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
+                           float radius, vec3 travel_lo, vec3 travel_hi) {
+  const uint32_t n = uint32_t(pos.size());
   // The pair lists hold every pair that can be closer than r while the particles' travel since
   // they were built stays within contactTravel of one point (listsOutgrown)
-  const bool usable = lists_kept_ != Lists::Rebuilt && lists_ && list_radius_ == radius && based;
-  const vec3 travel_lo = orderedCorner(all.travel_lo), travel_hi = orderedCorner(all.travel_hi);
+  const bool usable = lists_kept_ != Lists::Rebuilt && lists_ && list_radius_ == radius && base_.size() == n;
   const bool finite = length2(travel_hi - travel_lo) < 1e30f;
   bool fresh = usable && !listsOutgrown(travel_lo, travel_hi, radius);
   // or the travels within it once the sheet's turn since is taken out (finite travels only)
@@ -113,10 +138,12 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   const bool repairable = usable && lists_kept_ == Lists::Repaired && finite &&
                           vf_.size() + ee_.size() <= 2 * built_pairs_ + n / kRepairShare;
   if (!fresh && !(repairable && repairLists(pos, triangles, count, radius))) buildLists(pos, triangles, count, radius);
-  sums_.assign(n, glm::ivec4(0));
-  findCrossings(pos, triangles, count, s == 0 && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u, thickness, scale);
+}
+
+void CpuContact::lowerNearest(const std::vector<glm::vec4>& pos, float radius, float thickness, float scale) {
+  const float r2 = radius * radius;
   const uint32_t none = std::bit_cast<uint32_t>(r2);
-  nearest2_.assign(n, lists_ ? none : 0u); // positions gone wrong (no lists): nothing moves
+  nearest2_.assign(pos.size(), lists_ ? none : 0u); // positions gone wrong (no lists): nothing moves
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
   auto vf = [](vec3 p, vec3 a, vec3 b, vec3 c) { return pointTriangle(p, a, b, c); };
   auto ee = [](vec3 a, vec3 b, vec3 c, vec3 d) { return segmentSegment(a, b, c, d); };
@@ -141,14 +168,6 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   };
   nearest(vf_, vf);
   nearest(ee_, ee);
-  uint64_t contacts = 0;
-  for (uint32_t i = 0; i < n; ++i) {
-    contacts += nearest2_[i] < none ? 1u : 0u;
-    bound[i] = free_[i] ? INFINITY : slideBound(std::bit_cast<float>(nearest2_[i]), radius, u.contact.y);
-    push[i] =
-        glm::vec4(contactPushWithin(contactAverage(sums_[i], scale), std::bit_cast<float>(nearest2_[i]), radius), 0.0f);
-  }
-  contacts_ = contacts;
 }
 
 // Each pair's half-spaces, weighed at `start` as computeBounds weighed it; `visit` sees each of its

@@ -9,6 +9,7 @@
 /// (their excesses are integer sums), so the bits are the same whatever the thread count or order
 /// and whatever the lists hold beyond the pairs closer than the radius.
 #include <cstdint>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -123,6 +124,18 @@ private:
   /// the sums (`gap`: how far beyond, `scale`: their fixed point); the last call's free_ is was_free_.
   void findCrossings(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                      bool all, float gap, float scale);
+  /// The substep's contact frame (frame_) from every particle's last step; gives the lowest and
+  /// highest travel since the lists were built.
+  std::pair<glm::vec3, glm::vec3> gatherFrame(const std::vector<glm::vec4>& pos, const std::vector<glm::vec4>& prev,
+                                              const shaderio::SimUniforms& u, uint32_t s);
+  /// The mesh's edges (edges_) from the first `count` triangles; the lists must be built again.
+  void listEdges(const std::vector<glm::uvec4>& triangles, uint32_t count);
+  /// Keeps the pair lists for this substep's positions: as they are, repaired or built anew.
+  void keepLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
+                 float radius, glm::vec3 travel_lo, glm::vec3 travel_hi);
+  /// Each particle's nearest pair's squared distance under the radius (nearest2_), and the pushes
+  /// of the pairs closer than `thickness` into sums_.
+  void lowerNearest(const std::vector<glm::vec4>& pos, float radius, float thickness, float scale);
   /// Lists the particle-triangle and edge-edge pairs closer than contactReach at `pos`.
   void buildLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                   float radius);
@@ -132,6 +145,12 @@ private:
   /// False (nothing changed) when too many did.
   bool repairLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                    float radius);
+  /// Marks the particles that travelled more than contactTravel from the travel most share
+  /// (moved_, dirty_) and gives that travel, or nothing when none or too many did.
+  std::optional<glm::vec3> markMoved(const std::vector<glm::vec4>& pos, float radius);
+  /// Lists anew the pairs closer than `reach` with a moved particle into added_vf and added_ee.
+  void searchMoved(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
+                   float reach, float inv_cell, std::vector<glm::uvec4>& added_vf, std::vector<glm::uvec4>& added_ee);
   /// Each particle's travel since its base in the frame of the sheet's turn since, into travel_:
   /// R^T (x - c) - (b - c') for the rotation R that best carries the bases (b, centroid c') onto
   /// the positions (x, centroid c), so that a sheet swinging about its pins travels as little as

@@ -172,8 +172,30 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
   // whose base the repair moves so that its d is `middle`: then |d_i(t0) - d_j(t0)| < 2T too, the
   // pair falls by less than 4T, and the repair looks as far as contactRepairReach. A pair both
   // keep stays until one of its particles goes beyond T, when a repair drops it and looks again.
-  const uint32_t n = uint32_t(pos.size()), edge_count = uint32_t(edges_.size());
-  const float travel = contactTravel(radius), reach = contactRepairReach(radius), reach2 = reach * reach;
+  const std::optional<vec3> middle = markMoved(pos, radius);
+  if (!middle) return false;
+  const float reach = contactRepairReach(radius), inv_cell = listCell(pos, reach);
+  if (!(inv_cell > 0.0f)) return false;
+  auto touched = [&](uvec4 q) { return (moved_[q.x] | moved_[q.y] | moved_[q.z] | moved_[q.w]) != 0; };
+  vf_.erase(std::remove_if(vf_.begin(), vf_.end(), touched), vf_.end());
+  ee_.erase(std::remove_if(ee_.begin(), ee_.end(), touched), ee_.end());
+  std::vector<uvec4> added_vf, added_ee;
+  searchMoved(pos, triangles, count, reach, inv_cell, added_vf, added_ee);
+  // The same lists whatever the threads' order
+  std::sort(added_vf.begin(), added_vf.end(), less4);
+  std::sort(added_ee.begin(), added_ee.end(), less4);
+  vf_.insert(vf_.end(), added_vf.begin(), added_vf.end());
+  ee_.insert(ee_.end(), added_ee.begin(), added_ee.end());
+  // A moved particle's base goes where its travel is `middle`: by as much as its travel is not
+  for (uint32_t i = 0; i < uint32_t(pos.size()); ++i)
+    if (moved_[i]) base_[i] = glm::vec4(vec3(base_[i]) + (travel_[i] - *middle), pos[i].w);
+  ++repairs_done_;
+  return true;
+}
+
+std::optional<vec3> CpuContact::markMoved(const std::vector<glm::vec4>& pos, float radius) {
+  const uint32_t n = uint32_t(pos.size());
+  const float travel = contactTravel(radius);
   // Each particle's travel: since its base, or in the frame of the sheet's turn (turnedTravel)
   if (travel_.size() != n) {
     travel_.resize(n);
@@ -187,7 +209,7 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
     std::nth_element(travels_.begin(), travels_.begin() + n / 2, travels_.end());
     middle[c] = travels_[n / 2];
   }
-  if (!(length2(middle) < 1e30f)) return false;
+  if (!(length2(middle) < 1e30f)) return std::nullopt;
   moved_.assign(n, 0);
   dirty_.clear();
   for (uint32_t i = 0; i < n; ++i)
@@ -195,14 +217,15 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
       moved_[i] = 1;
       dirty_.push_back(i);
     }
-  if (dirty_.empty() || dirty_.size() > n / kRepairShare) return false;
-  const float inv_cell = listCell(pos, reach);
-  if (!(inv_cell > 0.0f)) return false;
+  if (dirty_.empty() || dirty_.size() > n / kRepairShare) return std::nullopt;
+  return middle;
+}
+
+void CpuContact::searchMoved(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
+                             float reach, float inv_cell, std::vector<uvec4>& added_vf, std::vector<uvec4>& added_ee) {
+  const uint32_t n = uint32_t(pos.size()), edge_count = uint32_t(edges_.size());
+  const float reach2 = reach * reach;
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
-  auto touched = [&](uvec4 q) { return (moved_[q.x] | moved_[q.y] | moved_[q.z] | moved_[q.w]) != 0; };
-  vf_.erase(std::remove_if(vf_.begin(), vf_.end(), touched), vf_.end());
-  ee_.erase(std::remove_if(ee_.begin(), ee_.end(), touched), ee_.end());
-  std::vector<uvec4> added_vf, added_ee;
   // Calls look(k, found) for each of `dirty_` in parallel and gathers what they find into `added`
   auto search = [&](std::vector<uvec4>& added, auto&& look) {
     gatherPairs(pool_, uint32_t(dirty_.size()), kGrainRepair, 1, added,
@@ -253,16 +276,6 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
         found.push_back(j < k ? uvec4(f, e) : uvec4(e, f));
     });
   });
-  // The same lists whatever the threads' order
-  std::sort(added_vf.begin(), added_vf.end(), less4);
-  std::sort(added_ee.begin(), added_ee.end(), less4);
-  vf_.insert(vf_.end(), added_vf.begin(), added_vf.end());
-  ee_.insert(ee_.end(), added_ee.begin(), added_ee.end());
-  // A moved particle's base goes where its travel is `middle`: by as much as its travel is not
-  for (uint32_t i = 0; i < n; ++i)
-    if (moved_[i]) base_[i] = glm::vec4(vec3(base_[i]) + (travel_[i] - middle), pos[i].w);
-  ++repairs_done_;
-  return true;
 }
 
 void CpuContact::clusterBases(float radius) {

@@ -204,6 +204,46 @@ uint64_t stretched(const float* pos, const uint32_t* ca, const uint32_t* cb, con
   return over;
 }
 
+/// The buckets of the 27 cells around a particle's cell (dz, dy, dx order), looked up when first
+/// needed and reused while the cell repeats (the particles come in bucket order).
+struct NeighbourBuckets {
+  uint32_t first[27], last[27];
+  ivec4 cell[27];
+  ivec3 cached_cell{0};
+  bool cached = false;
+  uint32_t known = 0;    // bit b: bucket b is looked up for the current cell
+  uint32_t nonempty = 0; // bit b: bucket b holds particles (among the known)
+
+  /// The non-empty buckets a particle at `pi` in cell `ci` visits: on a side within `reach` (in
+  /// cell units) on every axis, all three sides of an axis when unsure.
+  [[gnu::always_inline]] uint32_t visit(vec3 pi, ivec3 ci, const SimUniforms& u, float reach, const uint32_t* start) {
+    if (!cached || ci != cached_cell) {
+      cached_cell = ci;
+      cached = true;
+      known = nonempty = 0;
+    }
+    uint32_t visit = (1u << 27) - 1u;
+    const vec3 scaled = pi * u.inv_cell;
+    for (int a = 0; a < 3; ++a) {
+      const float f = scaled[a] - float(ci[a]);
+      const bool sure = std::fabs(scaled[a]) < 1024.0f && f >= 0.0f && f <= 1.0f; // rounding well inside the margin
+      const uint32_t sides = 2u | (!sure || !(f >= reach) ? 1u : 0u) | (!sure || !(1.0f - f >= reach) ? 4u : 0u);
+      visit &= kAxisMasks[a][sides];
+    }
+    for (uint32_t missing = visit & ~known; missing; missing &= missing - 1u) {
+      const int b = __builtin_ctz(missing);
+      const ivec3 c = ci + ivec3(b % 3 - 1, b / 3 % 3 - 1, b / 9 - 1);
+      const uint32_t h = hashCell(c, u.hash_mask);
+      first[b] = start[h];
+      last[b] = start[h + 1];
+      cell[b] = ivec4(c, 0);
+      nonempty |= start[h] < start[h + 1] ? 1u << b : 0u;
+    }
+    known |= visit;
+    return visit & nonempty;
+  }
+};
+
 bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_t end, float search, bool build) {
   const float r = u.collision_radius, r2 = r * r, search2 = search * search;
   bool fits = true;
@@ -212,14 +252,7 @@ bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_
   const ivec4* coords = g.cell;
   const uint32_t* start = g.cell_start;
 
-  // Buckets of the 27 cells around the current cell (dz, dy, dx order), looked up when first
-  // needed and reused while the cell repeats.
-  uint32_t bucket_first[27], bucket_last[27];
-  ivec4 bucket_cell[27];
-  ivec3 cached_cell(0);
-  bool cached = false;
-  uint32_t known = 0;    // bit b: bucket b is looked up for the current cell
-  uint32_t nonempty = 0; // bit b: bucket b holds particles (among the known)
+  NeighbourBuckets buckets;
   // A neighbour cell on one side can hold a particle within `search` only when the particle is
   // closer than that to that side of its own cell (`search` never exceeds a cell). The test is
   // in cell units with a generous margin, so no contributing cell is ever skipped.
@@ -233,32 +266,7 @@ bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_
     const uint32_t i = slots[k];
     const vec3 pi(sx[k], sy[k], sz[k]);
     const ivec3 ci(coords[k]);
-    if (!cached || ci != cached_cell) {
-      cached_cell = ci;
-      cached = true;
-      known = nonempty = 0;
-    }
-    // The buckets this particle visits: on a side within reach on every axis (all three sides
-    // of an axis when unsure), and non-empty.
-    uint32_t visit = (1u << 27) - 1u;
-    const vec3 scaled = pi * u.inv_cell;
-    for (int a = 0; a < 3; ++a) {
-      const float f = scaled[a] - float(ci[a]);
-      const bool sure = std::fabs(scaled[a]) < 1024.0f && f >= 0.0f && f <= 1.0f; // rounding well inside the margin
-      const uint32_t sides = 2u | (!sure || !(f >= reach) ? 1u : 0u) | (!sure || !(1.0f - f >= reach) ? 4u : 0u);
-      visit &= kAxisMasks[a][sides];
-    }
-    for (uint32_t missing = visit & ~known; missing; missing &= missing - 1u) {
-      const int b = __builtin_ctz(missing);
-      const ivec3 c = ci + ivec3(b % 3 - 1, b / 3 % 3 - 1, b / 9 - 1);
-      const uint32_t h = hashCell(c, u.hash_mask);
-      bucket_first[b] = start[h];
-      bucket_last[b] = start[h + 1];
-      bucket_cell[b] = ivec4(c, 0);
-      nonempty |= start[h] < start[h + 1] ? 1u << b : 0u;
-    }
-    known |= visit;
-    visit &= nonempty;
+    uint32_t visit = buckets.visit(pi, ci, u, reach, start);
     const Adjacency adjacency(g.adj_list + g.adj_offsets[i], g.adj_offsets[i + 1] - g.adj_offsets[i]);
     vec3 sum(0.0f);
     uint32_t hit_count = 0;
@@ -269,7 +277,7 @@ bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_
     auto flush = [&] {
       for (uint32_t t = 0; t < hit_count; ++t) {
         const uint32_t m = hit_slot[t];
-        if (m == k || coords[m] != bucket_cell[hit_bucket[t]] || adjacency.contains(slots[m])) continue;
+        if (m == k || coords[m] != buckets.cell[hit_bucket[t]] || adjacency.contains(slots[m])) continue;
         const vec3 pj(sx[m], sy[m], sz[m]);
         if (candidates) found = addCandidate(candidates, found, slots[m]);
         const vec3 d = pi - pj;
@@ -281,7 +289,7 @@ bool gather(const GatherArrays& g, const SimUniforms& u, uint32_t begin, uint32_
     while (visit) { // ascending bucket index: dz, dy, dx order
       const uint32_t b = uint32_t(__builtin_ctz(visit));
       visit &= visit - 1u;
-      const uint32_t first = bucket_first[b], last = bucket_last[b];
+      const uint32_t first = buckets.first[b], last = buckets.last[b];
       for (uint32_t m = first; m < last; m += 4) {
         // d = pi - pj; the same dot3(d, d) < search2 test as the scalar maths, four at a time
         const __m128 dx = _mm_sub_ps(px, _mm_loadu_ps(sx + m));
