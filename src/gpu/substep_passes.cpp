@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <iterator>
+#include <optional>
 
 namespace tender::gpu {
 
@@ -141,32 +142,86 @@ void recordScan(PassSink& sink, const SimPipelines& pipes, uint32_t mode, uint32
   sink.barrier();
 }
 
+/// How many elements a row's pass covers when it covers them all at once with the push
+/// {0, count}; nothing for the rows recorded otherwise.
+std::optional<uint32_t> wholeCount(Elements e, const SheetTopology& topo, const SheetLayout& sizes) {
+  const uint32_t n = topo.particleCount();
+  switch (e) {
+  case Elements::PARTICLES:
+    return n;
+  case Elements::HINGES:
+    return topo.hingeCount();
+  case Elements::CONSTRAINTS:
+    return topo.constraintCount();
+  case Elements::TRIANGLES:
+    return topo.triangleCount();
+  case Elements::CONTACT_SLOTS:
+    return std::max(n, sizes.contact_edges);
+  case Elements::CONTACT_BUCKETS:
+    return sizes.contact_buckets + 1;
+  case Elements::CONTACT_BOXES:
+    return topo.triangleCount() + sizes.contact_edges;
+  case Elements::CONTACT_QUERIES:
+    return n + sizes.contact_edges;
+  default:
+    return std::nullopt;
+  }
+}
+
+/// The exclusive scan a row runs: its mode, where its values start, how many, where its block sums go.
+struct ScanRange {
+  uint32_t mode, offset, count, sums;
+};
+
+std::optional<ScanRange> scanRange(Elements e, const SheetTopology& topo, const SheetLayout& sizes) {
+  const uint32_t n = topo.particleCount();
+  switch (e) {
+  case Elements::HASH_CELLS:
+    return ScanRange{SIM_SCAN_HASH, 0, topo.hash_size, sizes.hash_sums};
+  case Elements::TEAR_SLOTS:
+    return ScanRange{SIM_SCAN_SCRATCH, 0, sizes.tear_slots, sizes.tear_sums};
+  case Elements::CONTACT_CELLS:
+    return ScanRange{SIM_SCAN_SCRATCH, sizes.contact_counts, sizes.contact_buckets + 1, sizes.contact_sums};
+  case Elements::CONTACT_ACTIVE_CELLS:
+    return ScanRange{SIM_SCAN_SCRATCH, sizes.contact_active, n + sizes.contact_edges + 1, sizes.contact_active_sums};
+  case Elements::CONTACT_HALF_CELLS:
+    return ScanRange{SIM_SCAN_SCRATCH, sizes.contact_half, n + 1, sizes.contact_half_sums};
+  default:
+    return std::nullopt;
+  }
+}
+
+/// Pass k of a row over the colours: colour k % colours of iteration k / colours. An empty colour,
+/// or one that does not project in this iteration (projectsInIteration), records nothing; nor, in
+/// the shorten stage, does a colour with no edge (shortensColour). True when it recorded.
+bool recordColour(PassSink& sink, const ComputePipeline& p, const SheetTopology& topo, const Dispatch& d, uint32_t s,
+                  uint32_t k) {
+  const uint32_t c = k % topo.colorCount(), iteration = k / topo.colorCount();
+  const ColorRange& range = topo.colors[c];
+  if (range.count == 0) return false;
+  const uint32_t kind = topo.constraints[range.first].kind_id;
+  if (d.stage == SIM_STAGE_shorten ? !shortensColour(kind) : !projectsInIteration(kind, iteration)) return false;
+  record(sink, p, d.grid, range.count, SimPush{iteration, range.count, s, c}, s, d.gate, iteration);
+  return true;
+}
+
 /// Records one row of SIM_DISPATCHES for pass `k` of its stage, then a barrier.
 void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,
                     const Dispatch& d, uint32_t s, uint32_t k, uint32_t sweeps = 0) {
   const ComputePipeline& p = pipes.*d.kernel;
-  const uint32_t n = topo.particleCount(), m = topo.constraintCount();
-  switch (d.elements) {
-  case Elements::PARTICLES:
-    record(sink, p, d.grid, n, SimPush{0, n, s, 0}, s, d.gate);
-    break;
-  case Elements::COLOUR: {
-    // Pass k: colour k % colours of iteration k / colours; an empty colour, or one that does not
-    // project in this iteration (projectsInIteration), records nothing
-    // (the shorten stage: a colour with no edge records nothing, shortensColour)
-    const uint32_t c = k % topo.colorCount(), iteration = k / topo.colorCount();
-    const ColorRange& range = topo.colors[c];
-    if (range.count == 0) return;
-    const uint32_t kind = topo.constraints[range.first].kind_id;
-    if (d.stage == SIM_STAGE_shorten ? !shortensColour(kind) : !projectsInIteration(kind, iteration)) return;
-    record(sink, p, d.grid, range.count, SimPush{iteration, range.count, s, c}, s, d.gate, iteration);
-    break;
+  const uint32_t n = topo.particleCount();
+  if (const std::optional<uint32_t> count = wholeCount(d.elements, topo, sizes)) {
+    record(sink, p, d.grid, *count, SimPush{0, *count, s, 0}, s, d.gate);
+    sink.barrier();
+    return;
   }
-  case Elements::HINGES:
-    record(sink, p, d.grid, topo.hingeCount(), SimPush{0, topo.hingeCount(), s, 0}, s, d.gate);
-    break;
-  case Elements::CONSTRAINTS:
-    record(sink, p, d.grid, m, SimPush{0, m, s, 0}, s, d.gate);
+  if (const std::optional<ScanRange> scan = scanRange(d.elements, topo, sizes)) {
+    recordScan(sink, pipes, scan->mode, scan->offset, scan->count, scan->sums, d.grid, s, d.gate);
+    return;
+  }
+  switch (d.elements) {
+  case Elements::COLOUR:
+    if (!recordColour(sink, p, topo, d, s, k)) return;
     break;
   case Elements::ONE:
     record(sink, p, d.grid, 1, SimPush{0, n, s, 0}, s, d.gate);
@@ -184,52 +239,14 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
   case Elements::HASH_ARGS:
     record(sink, p, d.grid, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0}, s, d.gate);
     break;
-  case Elements::HASH_CELLS:
-    recordScan(sink, pipes, SIM_SCAN_HASH, 0, topo.hash_size, sizes.hash_sums, d.grid, s, d.gate);
-    return;
-  case Elements::TEAR_SLOTS:
-    recordScan(sink, pipes, SIM_SCAN_SCRATCH, 0, sizes.tear_slots, sizes.tear_sums, d.grid, s, d.gate);
-    return;
   case Elements::INDIRECT:
     sink.pass(p, d.grid, 0, nullptr, 0, s, d.gate, 0);
     break;
-  case Elements::TRIANGLES:
-    record(sink, p, d.grid, topo.triangleCount(), SimPush{0, topo.triangleCount(), s, 0}, s, d.gate);
-    break;
-  case Elements::CONTACT_SLOTS: {
-    const uint32_t slots = std::max(n, sizes.contact_edges);
-    record(sink, p, d.grid, slots, SimPush{0, slots, s, 0}, s, d.gate);
-    break;
-  }
-  case Elements::CONTACT_BUCKETS:
-    record(sink, p, d.grid, sizes.contact_buckets + 1, SimPush{0, sizes.contact_buckets + 1, s, 0}, s, d.gate);
-    break;
-  case Elements::CONTACT_BOXES: {
-    const uint32_t boxes = topo.triangleCount() + sizes.contact_edges;
-    record(sink, p, d.grid, boxes, SimPush{0, boxes, s, 0}, s, d.gate);
-    break;
-  }
-  case Elements::CONTACT_QUERIES: {
-    const uint32_t queries = n + sizes.contact_edges;
-    record(sink, p, d.grid, queries, SimPush{0, queries, s, 0}, s, d.gate);
-    break;
-  }
-  case Elements::CONTACT_CELLS:
-    recordScan(sink, pipes, SIM_SCAN_SCRATCH, sizes.contact_counts, sizes.contact_buckets + 1, sizes.contact_sums,
-               d.grid, s, d.gate);
-    return;
   case Elements::CONTACT_ACTIVE: {
     const uint32_t flags = n + sizes.contact_edges + 1;
     record(sink, p, d.grid, flags, SimPush{sizes.contact_active, flags, s, 0}, s, d.gate);
     break;
   }
-  case Elements::CONTACT_ACTIVE_CELLS:
-    recordScan(sink, pipes, SIM_SCAN_SCRATCH, sizes.contact_active, n + sizes.contact_edges + 1,
-               sizes.contact_active_sums, d.grid, s, d.gate);
-    return;
-  case Elements::CONTACT_HALF_CELLS:
-    recordScan(sink, pipes, SIM_SCAN_SCRATCH, sizes.contact_half, n + 1, sizes.contact_half_sums, d.grid, s, d.gate);
-    return;
   case Elements::SWEEPS:
     // Each sweep, the colours with structural edges (shortensColour), a barrier after each
     for (uint32_t sweep = 0; sweep < sweeps; ++sweep)
@@ -239,6 +256,8 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
         record(sink, p, d.grid, range.count, SimPush{sweep, range.count, s, c}, s, d.gate, sweep);
         sink.barrier();
       }
+    return;
+  default: // wholeCount's and scanRange's rows, recorded above
     return;
   }
   sink.barrier();
