@@ -123,29 +123,30 @@ struct FlushTypes {
   }
 };
 
-} // namespace
+/// Where a module's sections end and what the rules need from them.
+struct Sections {
+  std::vector<uint32_t> entries, arithmetic; // the entry points; the float arithmetic's results
+  std::unordered_set<uint32_t> decorated;    // the ids already NoContraction
+  size_t after_caps = 5, after_modes = 5, preamble_end = 5, functions = 0;
+};
 
-std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const FloatRules& rules) {
-  if (code.size() < 5) return {code.begin(), code.end()};
-  const bool flush_in_shader = rules.denormals == Denormals::FlushInShader;
-  std::vector<uint32_t> entries, arithmetic;
-  std::unordered_set<uint32_t> decorated;
-  FlushTypes types;
-  types.bound = code[3];
-  size_t after_caps = 5, after_modes = 5, preamble_end = 5, functions = code.size();
+/// One pass over the module's words: its sections and its float, uint and bool types. False when the
+/// words are not a module this can fix.
+bool scanSections(std::span<const uint32_t> code, Sections& s, FlushTypes& types) {
+  s.functions = code.size();
   bool in_preamble = true;
   for (size_t w = 5; w < code.size();) {
     const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
-    if (count == 0 || w + count > code.size()) return {code.begin(), code.end()}; // not ours to fix
-    if (op == kOpCapability) after_caps = w + count;
-    if (op == kOpEntryPoint && count >= 3) entries.push_back(code[w + 2]);
-    if (op == kOpEntryPoint || op == kOpExecutionMode || op == kOpExecutionModeId) after_modes = w + count;
-    if (op == kOpDecorate && count >= 3 && code[w + 2] == kDecorationNoContraction) decorated.insert(code[w + 1]);
+    if (count == 0 || w + count > code.size()) return false;
+    if (op == kOpCapability) s.after_caps = w + count;
+    if (op == kOpEntryPoint && count >= 3) s.entries.push_back(code[w + 2]);
+    if (op == kOpEntryPoint || op == kOpExecutionMode || op == kOpExecutionModeId) s.after_modes = w + count;
+    if (op == kOpDecorate && count >= 3 && code[w + 2] == kDecorationNoContraction) s.decorated.insert(code[w + 1]);
     if (in_preamble && isPreamble(op))
-      preamble_end = w + count;
+      s.preamble_end = w + count;
     else
       in_preamble = false;
-    if (op == 54 /*Function*/ && functions == code.size()) functions = w;
+    if (op == 54 /*Function*/ && s.functions == code.size()) s.functions = w;
     if (op == 22 /*TypeFloat*/ && count == 3 && code[w + 2] == 32) types.f32 = code[w + 1];
     if (op == 21 /*TypeInt*/ && count == 4 && code[w + 2] == 32 && code[w + 3] == 0) types.u32 = code[w + 1];
     if (op == 20 /*TypeBool*/ && count == 2) types.boolean = code[w + 1];
@@ -155,19 +156,16 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
       if (component == types.u32) types.vec_u[n] = code[w + 1];
       if (component == types.boolean) types.vec_b[n] = code[w + 1];
     }
-    if (isFloatArithmetic(op) && count >= 3) arithmetic.push_back(code[w + 2]);
+    if (isFloatArithmetic(op) && count >= 3) s.arithmetic.push_back(code[w + 2]);
     w += count;
   }
-  // A float loaded from the host's memory (a buffer, a uniform, a push constant, a buffer reached by
-  // device address) or made from bits is flushed too: a denormal the host wrote reads as zero, as
-  // the CPU's DAZ reads it.
-  std::unordered_map<uint32_t, uint32_t> pointer_class; // pointer type or pointer -> storage class
-  auto fromHost = [&](uint32_t pointer) {
-    auto it = pointer_class.find(pointer);
-    return it != pointer_class.end() &&
-           (it->second == 2 || it->second == 9 || it->second == 12 || it->second == 5349 /*PhysicalStorageBuffer*/);
-  };
-  for (size_t w = 5; flush_in_shader && w < code.size();) {
+  return true;
+}
+
+/// The storage class of each pointer type and pointer (variables and access chains).
+std::unordered_map<uint32_t, uint32_t> pointerClasses(std::span<const uint32_t> code) {
+  std::unordered_map<uint32_t, uint32_t> pointer_class;
+  for (size_t w = 5; w < code.size();) {
     const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
     if (op == 32 /*TypePointer*/ && count == 4) pointer_class[code[w + 1]] = code[w + 2];
     // Variable, AccessChain, InBoundsAccessChain, PtrAccessChain: the class of their pointer type
@@ -175,18 +173,56 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
       if (auto it = pointer_class.find(code[w + 1]); it != pointer_class.end()) pointer_class[code[w + 2]] = it->second;
     w += count;
   }
+  return pointer_class;
+}
+
+/// Appends %result = the zero of %in's sign where %in's exponent is 0 (a denormal), else %in.
+void appendFlush(std::vector<uint32_t>& out, FlushTypes& types, uint32_t type, uint32_t result, uint32_t in,
+                 uint32_t width) {
+  const FlushTypes::Width& t = types.width(width);
+  const uint32_t bits = types.fresh(), exponent = types.fresh(), tiny = types.fresh(), sign = types.fresh(),
+                 zero = types.fresh();
+  // clang-format off
+  out.insert(out.end(), {word(4, 124 /*Bitcast*/),    t.uint_type, bits,     in,
+                         word(5, 199 /*BitwiseAnd*/), t.uint_type, exponent, bits,     t.exponent,
+                         word(5, 170 /*IEqual*/),     t.bool_type, tiny,     exponent, t.zero,
+                         word(5, 199 /*BitwiseAnd*/), t.uint_type, sign,     bits,     t.sign,
+                         word(4, 124 /*Bitcast*/),    type,        zero,     sign,
+                         word(6, 169 /*Select*/),     type,        result,   tiny,     zero, in});
+  // clang-format on
+}
+
+} // namespace
+
+std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const FloatRules& rules) {
+  if (code.size() < 5) return {code.begin(), code.end()};
+  const bool flush_in_shader = rules.denormals == Denormals::FlushInShader;
+  Sections sec;
+  FlushTypes types;
+  types.bound = code[3];
+  if (!scanSections(code, sec, types)) return {code.begin(), code.end()}; // not ours to fix
+  // A float loaded from the host's memory (a buffer, a uniform, a push constant, a buffer reached by
+  // device address) or made from bits is flushed too: a denormal the host wrote reads as zero, as
+  // the CPU's DAZ reads it.
+  const std::unordered_map<uint32_t, uint32_t> pointer_class =
+      flush_in_shader ? pointerClasses(code) : std::unordered_map<uint32_t, uint32_t>{};
+  auto fromHost = [&](uint32_t pointer) {
+    auto it = pointer_class.find(pointer);
+    return it != pointer_class.end() &&
+           (it->second == 2 || it->second == 9 || it->second == 12 || it->second == 5349 /*PhysicalStorageBuffer*/);
+  };
   // The component count of the float result of the instruction at w when it is flushed, else 0
   auto flushedWidth = [&](size_t w) -> uint32_t {
     const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
     const bool flushed =
-        flush_in_shader && w >= functions && count >= 3 &&
+        flush_in_shader && w >= sec.functions && count >= 3 &&
         (canMakeDenormal(op) || op == 124 /*Bitcast*/ || (op == 61 /*Load*/ && count >= 4 && fromHost(code[w + 3])));
     return flushed ? types.floatWidth(code[w + 1]) : 0;
   };
   // Each flushed result %r is computed into a new id %raw, and %r becomes the flushed value: every
   // use of %r (and each decoration of the instruction) follows unchanged.
   std::unordered_map<uint32_t, uint32_t> raw; // %r -> %raw
-  for (size_t w = functions; w < code.size(); w += code[w] >> 16)
+  for (size_t w = sec.functions; w < code.size(); w += code[w] >> 16)
     if (const uint32_t n = flushedWidth(w)) {
       raw[code[w + 2]] = types.fresh();
       types.width(n); // declares the types and constants of its flush
@@ -198,12 +234,12 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
   std::vector<uint32_t> caps, modes, decorations;
   auto mode = [&](uint32_t cap, uint32_t m) {
     caps.insert(caps.end(), {word(2, kOpCapability), cap});
-    for (uint32_t e : entries) modes.insert(modes.end(), {word(4, kOpExecutionMode), e, m, 32u});
+    for (uint32_t e : sec.entries) modes.insert(modes.end(), {word(4, kOpExecutionMode), e, m, 32u});
   };
   if (rules.rounding_rte) mode(kCapRoundingModeRTE, kModeRoundingModeRTE);
   if (rules.denormals == Denormals::FlushToZero) mode(kCapDenormFlushToZero, kModeDenormFlushToZero);
-  for (uint32_t id : arithmetic)
-    if (decorated.insert(id).second)
+  for (uint32_t id : sec.arithmetic)
+    if (sec.decorated.insert(id).second)
       decorations.insert(decorations.end(), {word(3, kOpDecorate), renamed(id), kDecorationNoContraction});
   // Splice the runs in at their sections (capabilities < modes < decorations < types < functions)
   std::vector<uint32_t> out;
@@ -212,34 +248,22 @@ std::vector<uint32_t> applyFloatRules(std::span<const uint32_t> code, const Floa
   out.insert(out.end(), code.begin(), code.begin() + 5);
   for (size_t w = 5; w < code.size();) {
     const uint32_t count = code[w] >> 16, op = code[w] & 0xFFFFu;
-    if (w == after_caps) out.insert(out.end(), caps.begin(), caps.end());
-    if (w == after_modes) out.insert(out.end(), modes.begin(), modes.end());
-    if (w == preamble_end) out.insert(out.end(), decorations.begin(), decorations.end());
-    if (w == functions) out.insert(out.end(), types.declarations.begin(), types.declarations.end());
+    if (w == sec.after_caps) out.insert(out.end(), caps.begin(), caps.end());
+    if (w == sec.after_modes) out.insert(out.end(), modes.begin(), modes.end());
+    if (w == sec.preamble_end) out.insert(out.end(), decorations.begin(), decorations.end());
+    if (w == sec.functions) out.insert(out.end(), types.declarations.begin(), types.declarations.end());
     const size_t at = out.size();
     out.insert(out.end(), code.begin() + long(w), code.begin() + long(w + count));
     if ((op == kOpDecorate || op == 332 /*DecorateId*/ || op == 5632 /*DecorateString*/) && count >= 2)
       out[at + 1] = renamed(out[at + 1]);
     if (const uint32_t n = flushedWidth(w)) {
-      // %r = the zero of %raw's sign where %raw's exponent is 0 (a denormal), else %raw
-      const uint32_t type = code[w + 1], result = code[w + 2], in = raw[result];
-      const FlushTypes::Width& t = types.width(n);
-      const uint32_t bits = types.fresh(), exponent = types.fresh(), tiny = types.fresh(), sign = types.fresh(),
-                     zero = types.fresh();
-      out[at + 2] = in;
-      // clang-format off
-      out.insert(out.end(), {word(4, 124 /*Bitcast*/),    t.uint_type, bits,     in,
-                             word(5, 199 /*BitwiseAnd*/), t.uint_type, exponent, bits,     t.exponent,
-                             word(5, 170 /*IEqual*/),     t.bool_type, tiny,     exponent, t.zero,
-                             word(5, 199 /*BitwiseAnd*/), t.uint_type, sign,     bits,     t.sign,
-                             word(4, 124 /*Bitcast*/),    type,        zero,     sign,
-                             word(6, 169 /*Select*/),     type,        result,   tiny,     zero, in});
-      // clang-format on
+      out[at + 2] = raw[code[w + 2]];
+      appendFlush(out, types, code[w + 1], code[w + 2], out[at + 2], n);
     }
     w += count;
   }
-  if (functions == code.size()) out.insert(out.end(), types.declarations.begin(), types.declarations.end());
-  if (preamble_end == code.size()) out.insert(out.end(), decorations.begin(), decorations.end());
+  if (sec.functions == code.size()) out.insert(out.end(), types.declarations.begin(), types.declarations.end());
+  if (sec.preamble_end == code.size()) out.insert(out.end(), decorations.begin(), decorations.end());
   out[3] = types.bound; // the ids the flushes took
   return out;
 }

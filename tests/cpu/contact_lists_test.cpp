@@ -206,16 +206,131 @@ TEST(ContactLists, TwoLayersClosingInHaveTheirListsBuiltBeforeTheyMeet) {
   EXPECT_GE(kept.listBuilds(), 8u);
 }
 
+// A half-space a pair closer than the radius sets particle j of it (slideConstraint).
+struct Half {
+  glm::uvec4 q;
+  ContactPair c;
+  bool edge;
+  uint32_t j;
+  shaderio::SlideHalf h;
+};
+
+// What computeBounds must give, from every particle-triangle and edge-edge pair weighed once
+// without lists or a grid, with the half-spaces of the pairs for slide.
+struct BruteBounds {
+  std::vector<float> bound;
+  std::vector<glm::vec4> push;
+  std::vector<Half> halves;
+  uint32_t pushed = 0; // particles with a push
+};
+
+BruteBounds bruteForceBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles,
+                             const std::vector<glm::uvec2>& edges, const shaderio::SimUniforms& u) {
+  const uint32_t n = uint32_t(pos.size());
+  const float radius = u.contact.x, thickness = radius * SIM_CONTACT_THICKNESS, r2 = radius * radius;
+  auto at = [&](uint32_t i) { return vec3(pos[i]); };
+  std::vector<float> nearest2(n, r2);
+  std::vector<glm::ivec4> sums(n, glm::ivec4(0));
+  BruteBounds want;
+  auto weigh = [&](glm::uvec4 q, ContactPair c, bool edge) {
+    if (!(c.d2 < r2)) return;
+    for (uint32_t j = 0; j < 4; ++j) {
+      const shaderio::SlideHalf h =
+          shaderio::slideConstraint(at(q.x), at(q.y), at(q.z), at(q.w), c, edge, radius, u.contact.y, j);
+      if (h.h.w >= 0.0f) want.halves.push_back(Half{q, c, edge, j, h});
+    }
+    for (uint32_t i : {q.x, q.y, q.z, q.w}) nearest2[i] = std::min(nearest2[i], c.d2);
+    if (!(c.d2 < thickness * thickness)) return;
+    for (uint32_t j = 0; j < 4; ++j) {
+      const glm::ivec3 f = shaderio::contactFixed(
+          shaderio::contactPush(pos[q.x], pos[q.y], pos[q.z], pos[q.w], c, thickness, j), u.contact.w);
+      sums[q[j]] += glm::ivec4(f, 1);
+    }
+  };
+  for (uint32_t v = 0; v < n; ++v)
+    for (const glm::uvec4& t : triangles)
+      if (v != t.x && v != t.y && v != t.z)
+        weigh(glm::uvec4(v, t.x, t.y, t.z), shaderio::pointTriangle(at(v), at(t.x), at(t.y), at(t.z)), false);
+  for (size_t a = 0; a < edges.size(); ++a)
+    for (size_t b = a + 1; b < edges.size(); ++b) {
+      const glm::uvec2 e = edges[a], f = edges[b];
+      if (e.x != f.x && e.x != f.y && e.y != f.x && e.y != f.y)
+        weigh(glm::uvec4(e, f), shaderio::segmentSegment(at(e.x), at(e.y), at(f.x), at(f.y)), true);
+    }
+  want.bound.resize(n);
+  want.push.resize(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    want.bound[i] = shaderio::slideBound(nearest2[i], radius, u.contact.y);
+    want.push[i] = glm::vec4(
+        shaderio::contactPushWithin(shaderio::contactAverage(sums[i], u.contact.w), nearest2[i], radius), 0.0f);
+    want.pushed += sums[i].w > 0 ? 1u : 0u;
+  }
+  return want;
+}
+
+// What slide must give for the steps from `pos` to `moved`: what each step passes on to the
+// other side of its pairs (a tenth of its excess, weighed by the other particles' parts in the
+// pair's nearest point, to those that can move), each step with the mean of what it is passed, its
+// excess (the mean, in fixed point) and its share.
+struct BruteSlide {
+  std::vector<glm::vec4> passed, excess;
+  std::vector<float> share;
+  uint32_t passing = 0, cut = 0; // half-spaces that pass something on; particles cut
+};
+
+BruteSlide bruteForceSlide(const std::vector<Half>& halves, const std::vector<glm::vec4>& pos,
+                           const std::vector<glm::vec4>& moved, vec3 frame, const shaderio::SimUniforms& u) {
+  const uint32_t n = uint32_t(pos.size());
+  auto raw = [&](uint32_t i) { return vec3(moved[i]) - (vec3(pos[i]) + frame); };
+  std::vector<glm::ivec4> passed_sums(n, glm::ivec4(0));
+  BruteSlide want;
+  for (const Half& a : halves) {
+    const vec3 e = shaderio::slideExcess(a.h, raw(a.q[a.j]));
+    if (e == vec3(0.0f)) continue;
+    ++want.passing;
+    for (uint32_t k = 0; k < 4; ++k) {
+      const bool other = a.edge ? (k < 2) != (a.j < 2) : (k == 0) != (a.j == 0);
+      if (!other || !(moved[a.q[k]].w > 0.0f)) continue;
+      const float wk = std::abs(a.c.w[int(k)]);
+      passed_sums[a.q[k]] += glm::ivec4(shaderio::contactFixed(e * (-SIM_CONTACT_PASS_FRACTION * wk), u.contact.w), 1);
+    }
+  }
+  want.passed.resize(n);
+  for (uint32_t i = 0; i < n; ++i)
+    want.passed[i] = glm::vec4(shaderio::contactAverage(passed_sums[i], u.contact.w), 0.0f);
+  auto step = [&](uint32_t i) {
+    glm::vec3 x = vec3(moved[i]) + vec3(want.passed[i]);
+    x.y = std::max(x.y, std::min(moved[i].y, u.floor_y));
+    return x - (vec3(pos[i]) + frame);
+  };
+  std::vector<glm::ivec4> excess_sums(n, glm::ivec4(0));
+  for (const Half& a : halves) {
+    const uint32_t i = a.q[a.j];
+    const vec3 e = shaderio::slideExcess(a.h, step(i));
+    if (e != vec3(0.0f)) excess_sums[i] += glm::ivec4(shaderio::contactFixed(e, u.contact.w), 1);
+  }
+  want.excess.resize(n);
+  want.share.assign(n, 1.0f);
+  for (uint32_t i = 0; i < n; ++i)
+    want.excess[i] = glm::vec4(shaderio::contactAverage(excess_sums[i], u.contact.w), 0.0f);
+  for (const Half& a : halves) {
+    const uint32_t i = a.q[a.j];
+    want.share[i] = std::min(want.share[i], shaderio::slideShare(a.h, step(i) + vec3(want.excess[i])));
+  }
+  for (uint32_t i = 0; i < n; ++i) want.cut += want.share[i] < 1.0f || excess_sums[i].w > 0 ? 1u : 0u;
+  return want;
+}
+
 // Three layers of a side x side grid 0.4 radius apart (closer than the thickness: every particle
 // pushed), at each call shaken about their rest and one particle in `carried` carried up to half a
 // radius in its layer's plane (the lists repaired or built whole): the bounds and pushes are those
 // of every particle-triangle and edge-edge pair weighed once, found without a grid, and so are what
 // each particle's step is passed by its pairs and the excess and share of that step beyond its pairs'
-// half-spaces (slide). A small sheet
-// has a small hash table, where two cells of one box are likelier to share a bucket.
+// half-spaces (slide). A small sheet has a small hash table, where two cells of one box are likelier
+// to share a bucket.
 void expectBruteForceContact(uint32_t side, uint32_t carried, uint32_t calls) {
   const uint32_t n = 3 * side * side;
-  const float radius = 0.1f, thickness = radius * SIM_CONTACT_THICKNESS, r2 = radius * radius;
+  const float radius = 0.1f;
   const auto [rest, triangles] = stackedLayers(side, 3, 0.4f * radius, glm::vec2(0.05f, 0.0f));
   std::vector<glm::uvec2> edges;
   for (const glm::uvec4& t : triangles)
@@ -229,8 +344,8 @@ void expectBruteForceContact(uint32_t side, uint32_t carried, uint32_t calls) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
   std::vector<glm::vec4> pos = rest, prev;
-  std::vector<float> bound, want_bound(n);
-  std::vector<glm::vec4> push, want_push(n);
+  std::vector<float> bound;
+  std::vector<glm::vec4> push;
   for (uint32_t call = 0; call < calls; ++call) {
     prev = pos;
     for (uint32_t i = 0; i < n; ++i) {
@@ -247,101 +362,16 @@ void expectBruteForceContact(uint32_t side, uint32_t carried, uint32_t calls) {
     std::vector<glm::vec4> passed, excess;
     std::vector<float> share;
     contact.slide(pos, moved, u, passed, excess, share);
-    auto at = [&](uint32_t i) { return vec3(pos[i]); };
-    // Every pair once, without lists or a grid
-    std::vector<float> nearest2(n, r2);
-    std::vector<glm::ivec4> sums(n, glm::ivec4(0));
-    struct Half {
-      glm::uvec4 q;
-      ContactPair c;
-      bool edge;
-      uint32_t j;
-      shaderio::SlideHalf h;
-    };
-    std::vector<Half> halves;
-    auto weigh = [&](glm::uvec4 q, ContactPair c, bool edge) {
-      if (!(c.d2 < r2)) return;
-      for (uint32_t j = 0; j < 4; ++j) {
-        const shaderio::SlideHalf h =
-            shaderio::slideConstraint(at(q.x), at(q.y), at(q.z), at(q.w), c, edge, radius, u.contact.y, j);
-        if (h.h.w >= 0.0f) halves.push_back(Half{q, c, edge, j, h});
-      }
-      for (uint32_t i : {q.x, q.y, q.z, q.w}) nearest2[i] = std::min(nearest2[i], c.d2);
-      if (!(c.d2 < thickness * thickness)) return;
-      for (uint32_t j = 0; j < 4; ++j) {
-        const glm::ivec3 f = shaderio::contactFixed(
-            shaderio::contactPush(pos[q.x], pos[q.y], pos[q.z], pos[q.w], c, thickness, j), u.contact.w);
-        sums[q[j]] += glm::ivec4(f, 1);
-      }
-    };
-    for (uint32_t v = 0; v < n; ++v)
-      for (const glm::uvec4& t : triangles)
-        if (v != t.x && v != t.y && v != t.z)
-          weigh(glm::uvec4(v, t.x, t.y, t.z), shaderio::pointTriangle(at(v), at(t.x), at(t.y), at(t.z)), false);
-    for (size_t a = 0; a < edges.size(); ++a)
-      for (size_t b = a + 1; b < edges.size(); ++b) {
-        const glm::uvec2 e = edges[a], f = edges[b];
-        if (e.x != f.x && e.x != f.y && e.y != f.x && e.y != f.y)
-          weigh(glm::uvec4(e, f), shaderio::segmentSegment(at(e.x), at(e.y), at(f.x), at(f.y)), true);
-      }
-    uint32_t pushed = 0;
-    for (uint32_t i = 0; i < n; ++i) {
-      want_bound[i] = shaderio::slideBound(nearest2[i], radius, u.contact.y);
-      want_push[i] = glm::vec4(
-          shaderio::contactPushWithin(shaderio::contactAverage(sums[i], u.contact.w), nearest2[i], radius), 0.0f);
-      pushed += sums[i].w > 0 ? 1u : 0u;
-    }
-    // The half-spaces: what each step passes on to the other side of its pairs (a tenth of its
-    // excess, weighed by the other particles' parts in the pair's nearest point, to those that can
-    // move), each step with the mean of what it is passed, its excess (the mean, in fixed point) and
-    // its share
-    auto raw = [&](uint32_t i) { return vec3(moved[i]) - (vec3(pos[i]) + contact.frame()); };
-    std::vector<glm::ivec4> passed_sums(n, glm::ivec4(0));
-    uint32_t passing = 0;
-    for (const Half& a : halves) {
-      const vec3 e = shaderio::slideExcess(a.h, raw(a.q[a.j]));
-      if (e == vec3(0.0f)) continue;
-      ++passing;
-      for (uint32_t k = 0; k < 4; ++k) {
-        const bool other = a.edge ? (k < 2) != (a.j < 2) : (k == 0) != (a.j == 0);
-        if (!other || !(moved[a.q[k]].w > 0.0f)) continue;
-        const float wk = std::abs(a.c.w[int(k)]);
-        passed_sums[a.q[k]] +=
-            glm::ivec4(shaderio::contactFixed(e * (-SIM_CONTACT_PASS_FRACTION * wk), u.contact.w), 1);
-      }
-    }
-    std::vector<glm::vec4> want_passed(n);
-    for (uint32_t i = 0; i < n; ++i)
-      want_passed[i] = glm::vec4(shaderio::contactAverage(passed_sums[i], u.contact.w), 0.0f);
-    auto step = [&](uint32_t i) {
-      glm::vec3 x = vec3(moved[i]) + vec3(want_passed[i]);
-      x.y = std::max(x.y, std::min(moved[i].y, u.floor_y));
-      return x - (vec3(pos[i]) + contact.frame());
-    };
-    std::vector<glm::ivec4> excess_sums(n, glm::ivec4(0));
-    for (const Half& a : halves) {
-      const uint32_t i = a.q[a.j];
-      const vec3 e = shaderio::slideExcess(a.h, step(i));
-      if (e != vec3(0.0f)) excess_sums[i] += glm::ivec4(shaderio::contactFixed(e, u.contact.w), 1);
-    }
-    std::vector<glm::vec4> want_excess(n);
-    std::vector<float> want_share(n, 1.0f);
-    for (uint32_t i = 0; i < n; ++i)
-      want_excess[i] = glm::vec4(shaderio::contactAverage(excess_sums[i], u.contact.w), 0.0f);
-    uint32_t cut = 0;
-    for (const Half& a : halves) {
-      const uint32_t i = a.q[a.j];
-      want_share[i] = std::min(want_share[i], shaderio::slideShare(a.h, step(i) + vec3(want_excess[i])));
-    }
-    for (uint32_t i = 0; i < n; ++i) cut += want_share[i] < 1.0f || excess_sums[i].w > 0 ? 1u : 0u;
-    ASSERT_TRUE(sameBytes(passed, want_passed)) << side << " x " << side << ", call " << call;
-    ASSERT_GT(passing, n / 8) << side << " x " << side << ", call " << call;
-    ASSERT_TRUE(sameBytes(excess, want_excess)) << side << " x " << side << ", call " << call;
-    ASSERT_TRUE(sameBytes(share, want_share)) << side << " x " << side << ", call " << call;
-    ASSERT_GT(cut, n / 8) << side << " x " << side << ", call " << call;
-    ASSERT_TRUE(sameBytes(bound, want_bound)) << side << " x " << side << ", call " << call;
-    ASSERT_TRUE(sameBytes(push, want_push)) << side << " x " << side << ", call " << call;
-    ASSERT_GT(pushed, n / 2) << side << " x " << side << ", call " << call;
+    const BruteBounds want = bruteForceBounds(pos, triangles, edges, u);
+    const BruteSlide slid = bruteForceSlide(want.halves, pos, moved, contact.frame(), u);
+    ASSERT_TRUE(sameBytes(passed, slid.passed)) << side << " x " << side << ", call " << call;
+    ASSERT_GT(slid.passing, n / 8) << side << " x " << side << ", call " << call;
+    ASSERT_TRUE(sameBytes(excess, slid.excess)) << side << " x " << side << ", call " << call;
+    ASSERT_TRUE(sameBytes(share, slid.share)) << side << " x " << side << ", call " << call;
+    ASSERT_GT(slid.cut, n / 8) << side << " x " << side << ", call " << call;
+    ASSERT_TRUE(sameBytes(bound, want.bound)) << side << " x " << side << ", call " << call;
+    ASSERT_TRUE(sameBytes(push, want.push)) << side << " x " << side << ", call " << call;
+    ASSERT_GT(want.pushed, n / 2) << side << " x " << side << ", call " << call;
   }
   std::printf("%u x %u x 3: lists built whole %u times, repaired %u times\n", side, side, contact.listBuilds(),
               contact.listRepairs());

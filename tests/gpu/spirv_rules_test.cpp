@@ -189,83 +189,97 @@ TEST(SpirvRules, NoSimShaderLoadsAVectorAndOneOfItsComponentsByDeviceAddress) {
 // billions, then a scatter far out of bounds). So a kernel loads a vector it reaches by device address
 // whole, at most once per chain, or one component of it alone: never two components apart. Loads
 // through a pointer held in a variable (a fleet's `u`, loaded again at each use) count as one chain.
+namespace {
+
+// The components of each vector a shader loads through a chain from a device address (a
+// pointer to PhysicalStorageBuffer), by the vector's chain, with its path for the messages.
+struct VectorLoads {
+  std::map<std::vector<uint32_t>, std::set<uint32_t>> components;
+  std::map<std::vector<uint32_t>, std::string> paths;
+};
+
+VectorLoads deviceAddressVectorLoads(const std::vector<Instruction>& code) {
+  VectorLoads loads;
+  std::unordered_map<uint32_t, const Instruction*> type;    // type id -> its declaration
+  std::unordered_map<uint32_t, uint32_t> type_of, constant; // value id -> type id, constant value
+  std::unordered_map<uint32_t, uint32_t> loaded_from;       // value id -> the variable it was loaded from
+  std::unordered_map<uint32_t, uint32_t> root_type;         // a chain's root -> its pointer type
+  std::unordered_map<uint32_t, std::string> name;           // OpName, for the messages
+  std::map<std::pair<uint32_t, uint32_t>, std::string> member_name;
+  std::unordered_map<uint32_t, std::vector<uint32_t>> chain; // access chain -> root and indices
+  std::unordered_set<uint32_t> variables;
+  for (const Instruction& in : code) {
+    if (in.op >= 19 && in.op <= 39 && in.words.size() >= 2) type[in.words[1]] = &in; // OpType*
+    if (in.op == 59 /*Variable*/) variables.insert(in.words[2]);
+    if (in.op == 43 /*Constant*/ && in.words.size() == 4) constant[in.words[2]] = in.words[3];
+    if (in.op == 5 /*Name*/) name[in.words[1]] = reinterpret_cast<const char*>(&in.words[2]);
+    if (in.op == 6 /*MemberName*/)
+      member_name[{in.words[1], in.words[2]}] = reinterpret_cast<const char*>(&in.words[3]);
+  }
+  // The type that index `index` of a value of type `t` has
+  auto member = [&](uint32_t t, uint32_t index) -> uint32_t {
+    const Instruction* d = type.count(t) ? type[t] : nullptr;
+    if (!d) return 0;
+    if (d->op == 30 /*Struct*/) return constant.count(index) ? d->words[2 + constant[index]] : 0;
+    if (d->op == 23 || d->op == 24 || d->op == 28 || d->op == 29) return d->words[2]; // vector, matrix, arrays
+    return 0;
+  };
+  for (const Instruction& in : code) {
+    if (in.op == 55 /*FunctionParameter*/ || in.op == 120 /*ConvertUToPtr*/ || in.op == 124 /*Bitcast*/)
+      type_of[in.words[2]] = in.words[1];
+    if (in.op == 61 /*Load*/) {
+      type_of[in.words[2]] = in.words[1];
+      if (variables.count(in.words[3])) loaded_from[in.words[2]] = in.words[3];
+    }
+    if (in.op != 65 && in.op != 66) continue; // (InBounds)AccessChain
+    const uint32_t ptr_type = in.words[1], base = in.words[3];
+    if (!type.count(ptr_type) || type[ptr_type]->words[2] != 5349 /*PhysicalStorageBuffer*/) continue;
+    std::vector<uint32_t> c;
+    if (chain.count(base)) { // a chain from a chain
+      c = chain[base];
+    } else if (loaded_from.count(base)) { // the pointer a variable holds, as its root
+      c = {loaded_from[base]};
+      root_type[loaded_from[base]] = type_of[base];
+    } else {
+      c = {base};
+      root_type[base] = type_of[base];
+    }
+    c.insert(c.end(), in.words.begin() + 4, in.words.end());
+    chain[in.words[2]] = c;
+  }
+  // Every load through a chain whose last step takes a constant component of a vector
+  for (const Instruction& in : code) {
+    if (in.op != 61 || !chain.count(in.words[3])) continue;
+    const std::vector<uint32_t>& c = chain[in.words[3]];
+    if (c.size() < 2) continue;
+    // The root's pointee type, then every index but the last
+    const uint32_t root = root_type[c[0]];
+    uint32_t t = type.count(root) && type[root]->op == 32 ? type[root]->words[3] : 0;
+    std::string path = name.count(c[0]) ? name[c[0]] : name.count(t) ? name[t] : "%" + std::to_string(c[0]);
+    for (size_t k = 1; k + 1 < c.size() && t; ++k) {
+      if (type.count(t) && type[t]->op == 30 && constant.count(c[k]))
+        path += "." + member_name[{t, constant[c[k]]}];
+      else
+        path += "[]";
+      t = member(t, c[k]);
+    }
+    if (!t || !type.count(t) || type[t]->op != 23 /*Vector*/ || !constant.count(c.back())) continue;
+    const std::vector<uint32_t> vector(c.begin(), c.end() - 1);
+    loads.components[vector].insert(constant[c.back()]);
+    loads.paths[vector] = path;
+  }
+  return loads;
+}
+
+} // namespace
+
 TEST(SpirvRules, NoSimShaderLoadsTwoComponentsOfAVectorApartByDeviceAddress) {
   uint32_t vectors = 0;
   for (std::string_view key : simShaderKeys()) {
-    std::unordered_map<uint32_t, const Instruction*> type;    // type id -> its declaration
-    std::unordered_map<uint32_t, uint32_t> type_of, constant; // value id -> type id, constant value
-    std::unordered_map<uint32_t, uint32_t> loaded_from;       // value id -> the variable it was loaded from
-    std::unordered_map<uint32_t, uint32_t> root_type;         // a chain's root -> its pointer type
-    std::unordered_map<uint32_t, std::string> name;           // OpName, for the messages
-    std::map<std::pair<uint32_t, uint32_t>, std::string> member_name;
-    std::unordered_map<uint32_t, std::vector<uint32_t>> chain;      // access chain -> root and indices
-    std::map<std::vector<uint32_t>, std::set<uint32_t>> components; // a vector's chain -> components loaded
-    std::map<std::vector<uint32_t>, std::string> paths;
-    const std::vector<Instruction> code = instructions(simShader(key));
-    std::unordered_set<uint32_t> variables;
-    for (const Instruction& in : code) {
-      if (in.op >= 19 && in.op <= 39 && in.words.size() >= 2) type[in.words[1]] = &in; // OpType*
-      if (in.op == 59 /*Variable*/) variables.insert(in.words[2]);
-      if (in.op == 43 /*Constant*/ && in.words.size() == 4) constant[in.words[2]] = in.words[3];
-      if (in.op == 5 /*Name*/) name[in.words[1]] = reinterpret_cast<const char*>(&in.words[2]);
-      if (in.op == 6 /*MemberName*/)
-        member_name[{in.words[1], in.words[2]}] = reinterpret_cast<const char*>(&in.words[3]);
-    }
-    // The type that index `index` of a value of type `t` has
-    auto member = [&](uint32_t t, uint32_t index) -> uint32_t {
-      const Instruction* d = type.count(t) ? type[t] : nullptr;
-      if (!d) return 0;
-      if (d->op == 30 /*Struct*/) return constant.count(index) ? d->words[2 + constant[index]] : 0;
-      if (d->op == 23 || d->op == 24 || d->op == 28 || d->op == 29) return d->words[2]; // vector, matrix, arrays
-      return 0;
-    };
-    for (const Instruction& in : code) {
-      if (in.op == 55 /*FunctionParameter*/ || in.op == 120 /*ConvertUToPtr*/ || in.op == 124 /*Bitcast*/)
-        type_of[in.words[2]] = in.words[1];
-      if (in.op == 61 /*Load*/) {
-        type_of[in.words[2]] = in.words[1];
-        if (variables.count(in.words[3])) loaded_from[in.words[2]] = in.words[3];
-      }
-      if (in.op != 65 && in.op != 66) continue; // (InBounds)AccessChain
-      const uint32_t ptr_type = in.words[1], base = in.words[3];
-      if (!type.count(ptr_type) || type[ptr_type]->words[2] != 5349 /*PhysicalStorageBuffer*/) continue;
-      std::vector<uint32_t> c;
-      if (chain.count(base)) { // a chain from a chain
-        c = chain[base];
-      } else if (loaded_from.count(base)) { // the pointer a variable holds, as its root
-        c = {loaded_from[base]};
-        root_type[loaded_from[base]] = type_of[base];
-      } else {
-        c = {base};
-        root_type[base] = type_of[base];
-      }
-      c.insert(c.end(), in.words.begin() + 4, in.words.end());
-      chain[in.words[2]] = c;
-    }
-    // Every load through a chain whose last step takes a constant component of a vector
-    for (const Instruction& in : code) {
-      if (in.op != 61 || !chain.count(in.words[3])) continue;
-      const std::vector<uint32_t>& c = chain[in.words[3]];
-      if (c.size() < 2) continue;
-      // The root's pointee type, then every index but the last
-      const uint32_t root = root_type[c[0]];
-      uint32_t t = type.count(root) && type[root]->op == 32 ? type[root]->words[3] : 0;
-      std::string path = name.count(c[0]) ? name[c[0]] : name.count(t) ? name[t] : "%" + std::to_string(c[0]);
-      for (size_t k = 1; k + 1 < c.size() && t; ++k) {
-        if (type.count(t) && type[t]->op == 30 && constant.count(c[k]))
-          path += "." + member_name[{t, constant[c[k]]}];
-        else
-          path += "[]";
-        t = member(t, c[k]);
-      }
-      if (!t || !type.count(t) || type[t]->op != 23 /*Vector*/ || !constant.count(c.back())) continue;
-      const std::vector<uint32_t> vector(c.begin(), c.end() - 1);
-      components[vector].insert(constant[c.back()]);
-      paths[vector] = path;
-    }
-    for (const auto& [vector, loaded] : components) {
+    const VectorLoads loads = deviceAddressVectorLoads(instructions(simShader(key)));
+    for (const auto& [vector, loaded] : loads.components) {
       ++vectors;
-      EXPECT_LT(loaded.size(), 2u) << key << ": loads " << loaded.size() << " components of " << paths[vector]
+      EXPECT_LT(loaded.size(), 2u) << key << ": loads " << loaded.size() << " components of " << loads.paths.at(vector)
                                    << " apart";
     }
   }
