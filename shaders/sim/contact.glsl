@@ -142,6 +142,35 @@ void slidePair(uvec4 q, vec3 x0, vec3 x1, vec3 x2, vec3 x3, ContactPair c, bool 
   }
 }
 
+// contactNearOf's weighing of one candidate `other` of query k (a triangle for a particle, an
+// edge for an edge): the pair's distance, listed `into` a list being built, then its bounds and
+// pushes (or, from NEAR_PASS, its half-spaces); pairs sharing a particle are none, pairs with a
+// free particle only listed.
+void weighPair(uint k, uint other, bool particle, uvec2 edge, uint into, uint only) {
+  // The pair's four particles: the particle and the triangle's three, or the two edges' two
+  uvec4 q;
+  if (particle) {
+    uvec4 tri = triangles[other];
+    if (k == tri.x || k == tri.y || k == tri.z) return;
+    q = uvec4(k, tri.xyz);
+  } else {
+    uvec2 f = contactEdge(other).xy;
+    if (edge.x == f.x || edge.x == f.y || edge.y == f.x || edge.y == f.y) return;
+    q = uvec4(edge, f);
+  }
+  bool free = contactFree(q.x) || contactFree(q.y) || contactFree(q.z) || contactFree(q.w);
+  if (free && into == SIM_NONE) return;
+  vec3 x0 = vec3(nearPosition(q.x, only)), x1 = vec3(nearPosition(q.y, only)), x2 = vec3(nearPosition(q.z, only)),
+       x3 = vec3(nearPosition(q.w, only));
+  ContactPair c = particle ? pointTriangle(x0, x1, x2, x3) : segmentSegment(x0, x1, x2, x3);
+  if (only >= NEAR_PASS) {
+    if (!free) slidePair(q, x0, x1, x2, x3, c, !particle, only);
+    return;
+  }
+  if (into != SIM_NONE) listPair(into, c.d2, other);
+  if (!free) contactPair(q, c);
+}
+
 // contact_near: query k (`particle`: k < particles), particle k (against the triangles near it) or edge
 // e = k - particles (against the edges after it near it): through its list, or when the lists are
 // built (or its list overflowed) through the grid, its box widened past the reach (or the radius):
@@ -218,31 +247,7 @@ void contactNearOf(uint k, uint only, bool particle) {
       }
       if (++found == CONTACT_BATCH) break;
     }
-    for (uint j = 0u; j < found; ++j) {
-      uint other = batch[j];
-      // The pair's four particles: the particle and the triangle's three, or the two edges' two
-      uvec4 q;
-      if (particle) {
-        uvec4 tri = triangles[other];
-        if (k == tri.x || k == tri.y || k == tri.z) continue;
-        q = uvec4(k, tri.xyz);
-      } else {
-        uvec2 f = contactEdge(other).xy;
-        if (edge.x == f.x || edge.x == f.y || edge.y == f.x || edge.y == f.y) continue;
-        q = uvec4(edge, f);
-      }
-      bool free = contactFree(q.x) || contactFree(q.y) || contactFree(q.z) || contactFree(q.w);
-      if (free && into == SIM_NONE) continue;
-      vec3 x0 = vec3(nearPosition(q.x, only)), x1 = vec3(nearPosition(q.y, only)), x2 = vec3(nearPosition(q.z, only)),
-           x3 = vec3(nearPosition(q.w, only));
-      ContactPair c = particle ? pointTriangle(x0, x1, x2, x3) : segmentSegment(x0, x1, x2, x3);
-      if (only >= NEAR_PASS) {
-        if (!free) slidePair(q, x0, x1, x2, x3, c, !particle, only);
-        continue;
-      }
-      if (into != SIM_NONE) listPair(into, c.d2, other);
-      if (!free) contactPair(q, c);
-    }
+    for (uint j = 0u; j < found; ++j) weighPair(k, batch[j], particle, edge, into, only);
   }
 }
 

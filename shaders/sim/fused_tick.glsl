@@ -164,6 +164,210 @@ void resetFrame(uint n) {
 }
 #endif
 
+// 1. Contact's bounds (with contact on), the air (as air.comp), then Verlet integration (as
+// integrate.comp)
+void integrateStage(uint s, uint n, float dt2) {
+  uint lid = gl_LocalInvocationID.x;
+#ifdef SIM_FUSED_CONTACT
+  if (contactKeys().x > 0.0f && (u.flags & SIM_FLAG_CONTACT_PASSES) == 0u) contactSubstep(s, n);
+#endif
+  if ((u.flags & SIM_FLAG_AIR) != 0u) {
+    sync(); // the air reads the positions of other invocations' particles (loaded or moved)
+    for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(airOnParticle(i), 0.0f);
+    sync();
+  }
+  for (uint i = lid; i < n; i += kInvocations) {
+    VerletState st = integrateParticle(i, s_pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index, u.grab_target[s],
+                                       u.grab_prev[s], u.hand, u.hand_motion, u.flags, u.gravity,
+                                       windWithAir(u.wind[s], delta[i], u.flags), u.wind_twist[s],
+                                       substepDamping(u.damping, u.verlet, s), dt2);
+    s_pos[i] = st.position;
+    prev[i] = st.previous;
+  }
+  sync();
+}
+
+// 2. Collision (as candidates_check, hash_*, collide and candidates_finish). From the candidate lists
+// while they hold every pair that can touch (no particle has travelled SIM_CANDIDATE_TRAVEL x skin
+// since they were built); otherwise from the spatial hash (count, scan, scatter, order within
+// bucket) and a search of the 27 cells around each particle, which rebuilds the lists as it
+// goes unless they were outgrown too fast of late (SIM_CANDIDATE_MIN_AGE, SIM_CANDIDATE_WAIT).
+void collideStage(uint n) {
+  uint lid = gl_LocalInvocationID.x;
+  uvec4 state = counters.candidate_state;
+  if (lid == 0u) counters.candidate_flags = uvec4(0u);
+  sync();
+  if (candidatesCurrentNow(state)) {
+    float skin = candidateSkinNow();
+    bool far = false;
+    for (uint i = lid; i < n; i += kInvocations)
+      far = far || travelledTooFar(vec3(s_pos[i]), vec3(candidate_base[i]), skin);
+    if (far) atomicOr(counters.candidate_flags.x, 1u);
+    sync();
+  }
+  uvec4 flags = counters.candidate_flags; // whole: no invocation sets one until the next sync
+  uint mode = collideModeOf(state, flags.x != 0u);
+  if (mode != SIM_COLLIDE_CANDIDATES) {
+    for (uint i = lid; i < n; i += kInvocations) hashCount(i, vec3(s_pos[i]));
+    sync();
+    scanWorkgroup(SIM_SCAN_HASH, 0u, u.hash_mask + 1u, compactSlots());
+    for (uint i = lid; i < n; i += kInvocations) hashScatter(i);
+    sync();
+    for (uint i = lid; i < n; i += kInvocations) hashSort(i, vec3(s_pos[i]));
+    sync();
+  } else {
+    // The lists read the positions of other particles: all of them before any moves
+    for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(candidateRepulsion(i, vec3(s_pos[i])), 0.0f);
+    sync();
+  }
+  // Each free particle takes its repulsion (from the lists, or gathered here from the hash's
+  // bucket-ordered copy of the positions; as collide.comp, then repel.comp), kept in delta too.
+  for (uint i = lid; i < n; i += kInvocations) {
+    vec4 q = s_pos[i];
+    bool fits = true;
+    vec3 repel = mode == SIM_COLLIDE_CANDIDATES ? vec3(delta[i]) : gatherParticle(i, vec3(q), mode, fits);
+    if (!fits) atomicOr(counters.candidate_flags.y, 1u);
+    delta[i] = vec4(repel, 0.0f);
+    s_pos[i] = repelParticle(q, repel, u.flags);
+  }
+  sync();
+  if (lid == 0u) {
+    uvec4 after = counters.candidate_flags;
+    counters.candidate_state = candidatesNextStateOf(state, mode, after.y != 0u);
+  }
+}
+
+// 3. Gauss-Seidel over colours (as project.comp), a barrier after each colour that projects in this
+// iteration (projectsInIteration: the same for every invocation); with `shorten`, the shorten stage
+// (as shorten.comp): the colours with edges while nothing holds the sheet. True when the run stops
+// after one of the passes (numbered from `first`).
+bool colourStage(bool shorten, uint first) {
+  uint lid = gl_LocalInvocationID.x;
+  bool shortens = !shorten || limitShortens(u.limit.x, u.grab_index, u.flags);
+  for (uint it = 0u; it < u.iterations; ++it)
+    for (uint c = 0u; c < u.color_count; ++c) {
+      uvec2 range = color_range[c];
+      uint kind = range.y > 0u ? constraints[range.x].kind_id : 0u;
+      if (shortens && range.y > 0u && (shorten ? shortensColour(kind) : projectsInIteration(kind, it))) {
+        for (uint t = lid; t < range.y; t += kInvocations) {
+          if (shorten)
+            shortenConstraint(constraints[range.x + t]);
+          else
+            projectConstraint(constraints[range.x + t], it);
+        }
+        sync();
+      }
+      if (stopsAfter(first + it * u.color_count + c)) return true;
+    }
+  return false;
+}
+
+// 5. The stretch limit (as limit.comp): ring after ring from the roots; 6. the creases (as
+// crease.comp). True when the run stops after the limit.
+bool limitAndCreaseStage(uint limit_pass) {
+  uint lid = gl_LocalInvocationID.x;
+  if (u.limit.x > 0.0f) {
+    uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
+    vec4 limit = u.limit; // read whole (limitParticle says why)
+    uint rings = uint(limit.z);
+    for (uint k = 1u; k <= rings; ++k) {
+      limitRing(roots, k, lid, kInvocations);
+      sync();
+    }
+  }
+  if (stopsAfter(limit_pass)) return true;
+  if (creasingNow()) {
+    for (uint k = lid; k < hingeKeys().y; k += kInvocations) creaseHinge(k);
+    sync();
+  }
+  return false;
+}
+
+// 7. The floor (as floor.comp), and with contact the steps cut to their pairs' half-spaces and
+// their bounds (as contact_pass, contact_excess, contact_share and contact_step)
+void floorStage(uint s, uint n) {
+  uint lid = gl_LocalInvocationID.x;
+  for (uint i = lid; i < n; i += kInvocations) {
+    VerletState st = floorContact(s_pos[i], prev[i], u.floor_y, u.restitution, u.friction);
+#ifdef SIM_FUSED_CONTACT
+    if (contactKeys().x > 0.0f) contactSlideClear(i);
+#endif
+    s_pos[i] = st.position;
+    prev[i] = st.previous;
+  }
+  sync();
+#ifdef SIM_FUSED_CONTACT
+  if (contactKeys().x > 0.0f) contactSlideSubstep(s, n);
+#endif
+}
+
+// 9. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's live
+// count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
+// tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
+// substep it tore in removed it), and kinds that cannot tear skip the position loads.
+void tearStage() {
+  uint lid = gl_LocalInvocationID.x;
+  for (uint c = 0u; c < u.color_count; ++c) {
+    uvec2 range = color_range[c];
+    for (uint t = lid; t < range.y; t += kInvocations) {
+      Constraint k = constraints[range.x + t];
+      if ((u.tear_kinds & (1u << (k.kind_id & SIM_KIND_MASK))) != 0u) markTear(k, s_pos[k.a], s_pos[k.b]);
+    }
+  }
+  sync();
+  if (counters.torn_new == 0u) return;
+  // What stood on the triangles lost goes too (as tear_unsupported), then the compaction
+  for (uint c = 0u; c < u.color_count; ++c) {
+    uvec2 range = color_range[c];
+    for (uint t = lid; t < range.y; t += kInvocations) markUnsupported(constraints[range.x + t]);
+  }
+  sync();
+  uint slots = compactSlots();
+  for (uint k = lid; k < slots; k += kInvocations) tearFlags(k);
+  sync();
+  scanWorkgroup(SIM_SCAN_SCRATCH, 0u, slots, slots);
+  for (uint k = lid; k < slots; k += kInvocations) tearCompact(k);
+  sync();
+}
+
+// The stages of each substep of this dispatch, stopping where the run is cut short (stopsAfter:
+// each stage's first pass by SIM_STAGES).
+bool runSubsteps(uint n) {
+  bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
+  bool tearing = tearingOn(u.tear_factor) && u.constraint_count > 0u;
+  float dt2 = u.dt * u.dt;
+  uint end = min(p.first_substep + p.substeps, substepCount(u.substeps));
+  uint per_substep = passesPerSubstep(u.iterations, u.color_count, collision);
+#define SIM_FIRST_PASS(stage) stageFirstPass(SIM_STAGE_##stage, u.iterations, u.color_count, collision)
+  for (uint s = p.first_substep; s < end; ++s) {
+    uint first = s * per_substep;
+    integrateStage(s, n, dt2);
+    if (stopsAfter(first + SIM_FIRST_PASS(integrate))) return true;
+    // A new substep: no constraint torn in it yet (every invocation read the count of the last
+    // substep before the barrier above).
+    if (gl_LocalInvocationID.x == 0u) counters.torn_new = 0u;
+    if (collision) {
+      collideStage(n);
+      if (stopsAfter(first + SIM_FIRST_PASS(collide))) return true;
+    }
+    if (colourStage(false, first + SIM_FIRST_PASS(project))) return true;
+    if (colourStage(true, first + SIM_FIRST_PASS(shorten))) return true;
+    if (limitAndCreaseStage(first + SIM_FIRST_PASS(limit))) return true;
+    if (stopsAfter(first + SIM_FIRST_PASS(crease))) return true;
+    floorStage(s, n);
+    if (stopsAfter(first + SIM_FIRST_PASS(floor))) return true;
+#ifdef SIM_FUSED_CONTACT
+    // 8. The settle stage, with contact and its sweeps on
+    if (contactKeys().x > 0.0f && contactChecks().y > 0u) contactSettleSubstep(s);
+#endif
+    if (stopsAfter(first + SIM_FIRST_PASS(settle))) return true;
+    if (tearing) tearStage();
+    if (stopsAfter(first + SIM_FIRST_PASS(tear))) return true;
+  }
+#undef SIM_FIRST_PASS
+  return false;
+}
+
 void main() {
   uint lid = gl_LocalInvocationID.x;
 #ifdef SIM_BATCH
@@ -173,222 +377,8 @@ void main() {
     return;
   }
 #endif
-  uint n = p.count, m = u.constraint_count;
-  bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
-  bool tearing = tearingOn(u.tear_factor) && m > 0u;
-  float dt2 = u.dt * u.dt;
+  uint n = p.count;
   for (uint i = lid; i < n; i += kInvocations) s_pos[i] = pos[i];
-  uint end = min(p.first_substep + p.substeps, substepCount(u.substeps));
-  // The number within a substep of each stage's first pass (SIM_STAGES)
-  uint per_substep = passesPerSubstep(u.iterations, u.color_count, collision);
-  uint integrate_pass = stageFirstPass(SIM_STAGE_integrate, u.iterations, u.color_count, collision);
-  uint project_pass = stageFirstPass(SIM_STAGE_project, u.iterations, u.color_count, collision);
-  uint shorten_pass = stageFirstPass(SIM_STAGE_shorten, u.iterations, u.color_count, collision);
-  uint limit_pass = stageFirstPass(SIM_STAGE_limit, u.iterations, u.color_count, collision);
-  uint crease_pass = stageFirstPass(SIM_STAGE_crease, u.iterations, u.color_count, collision);
-  uint collide_pass = stageFirstPass(SIM_STAGE_collide, u.iterations, u.color_count, collision);
-  uint floor_pass = stageFirstPass(SIM_STAGE_floor, u.iterations, u.color_count, collision);
-  uint settle_pass = stageFirstPass(SIM_STAGE_settle, u.iterations, u.color_count, collision);
-  uint tear_pass = stageFirstPass(SIM_STAGE_tear, u.iterations, u.color_count, collision);
-  for (uint s = p.first_substep; s < end; ++s) {
-    uint first_pass = s * per_substep;
-    // 1. Contact's bounds (with contact on), the air (as air.comp), then Verlet integration (as
-    // integrate.comp)
-#ifdef SIM_FUSED_CONTACT
-    if (contactKeys().x > 0.0f && (u.flags & SIM_FLAG_CONTACT_PASSES) == 0u) contactSubstep(s, n);
-#endif
-    if ((u.flags & SIM_FLAG_AIR) != 0u) {
-      sync(); // the air reads the positions of other invocations' particles (loaded or moved)
-      for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(airOnParticle(i), 0.0f);
-      sync();
-    }
-    for (uint i = lid; i < n; i += kInvocations) {
-      VerletState st = integrateParticle(i, s_pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index,
-                                         u.grab_target[s], u.grab_prev[s], u.hand, u.hand_motion, u.flags, u.gravity,
-                                         windWithAir(u.wind[s], delta[i], u.flags), u.wind_twist[s],
-                                         substepDamping(u.damping, u.verlet, s), dt2);
-      s_pos[i] = st.position;
-      prev[i] = st.previous;
-    }
-    sync();
-    if (stopsAfter(first_pass + integrate_pass)) {
-      storePositions(n);
-      return;
-    }
-    // A new substep: no constraint torn in it yet (every invocation read the count of the last
-    // substep before the barrier above).
-    if (lid == 0u) counters.torn_new = 0u;
-    // 2. Collision (as candidates_check, hash_*, collide and candidates_finish). From the candidate lists
-    // while they hold every pair that can touch (no particle has travelled SIM_CANDIDATE_TRAVEL x skin
-    // since they were built); otherwise from the spatial hash (count, scan, scatter, order within
-    // bucket) and a search of the 27 cells around each particle, which rebuilds the lists as it
-    // goes unless they were outgrown too fast of late (SIM_CANDIDATE_MIN_AGE, SIM_CANDIDATE_WAIT).
-    uvec4 state = counters.candidate_state;
-    uint mode = SIM_COLLIDE_HASH;
-    if (collision) {
-      if (lid == 0u) counters.candidate_flags = uvec4(0u);
-      sync();
-      if (candidatesCurrentNow(state)) {
-        float skin = candidateSkinNow();
-        bool far = false;
-        for (uint i = lid; i < n; i += kInvocations)
-          far = far || travelledTooFar(vec3(s_pos[i]), vec3(candidate_base[i]), skin);
-        if (far) atomicOr(counters.candidate_flags.x, 1u);
-        sync();
-      }
-      uvec4 flags = counters.candidate_flags; // whole: no invocation sets one until the next sync
-      mode = collideModeOf(state, flags.x != 0u);
-      if (mode != SIM_COLLIDE_CANDIDATES) {
-        for (uint i = lid; i < n; i += kInvocations) hashCount(i, vec3(s_pos[i]));
-        sync();
-        scanWorkgroup(SIM_SCAN_HASH, 0u, u.hash_mask + 1u, compactSlots());
-        for (uint i = lid; i < n; i += kInvocations) hashScatter(i);
-        sync();
-        for (uint i = lid; i < n; i += kInvocations) hashSort(i, vec3(s_pos[i]));
-        sync();
-      } else {
-        // The lists read the positions of other particles: all of them before any moves
-        for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(candidateRepulsion(i, vec3(s_pos[i])), 0.0f);
-        sync();
-      }
-    }
-    // Each free particle takes its repulsion (from the lists, or gathered here from the hash's
-    // bucket-ordered copy of the positions; as collide.comp, then repel.comp), kept in delta too.
-    if (collision) {
-      for (uint i = lid; i < n; i += kInvocations) {
-        vec4 q = s_pos[i];
-        bool fits = true;
-        vec3 repel = mode == SIM_COLLIDE_CANDIDATES ? vec3(delta[i]) : gatherParticle(i, vec3(q), mode, fits);
-        if (!fits) atomicOr(counters.candidate_flags.y, 1u);
-        delta[i] = vec4(repel, 0.0f);
-        s_pos[i] = repelParticle(q, repel, u.flags);
-      }
-      sync();
-      if (lid == 0u) {
-        uvec4 flags = counters.candidate_flags;
-        counters.candidate_state = candidatesNextStateOf(state, mode, flags.y != 0u);
-      }
-      if (stopsAfter(first_pass + collide_pass)) {
-        storePositions(n);
-        return;
-      }
-    }
-    // 3. Gauss-Seidel over colours (as project.comp), a barrier after each colour that projects
-    // in this iteration (projectsInIteration: the same for every invocation)
-    for (uint it = 0u; it < u.iterations; ++it)
-      for (uint c = 0u; c < u.color_count; ++c) {
-        uvec2 range = color_range[c];
-        if (range.y > 0u && projectsInIteration(constraints[range.x].kind_id, it)) {
-          for (uint t = lid; t < range.y; t += kInvocations) projectConstraint(constraints[range.x + t], it);
-          sync();
-        }
-        if (stopsAfter(first_pass + project_pass + it * u.color_count + c)) {
-          storePositions(n);
-          return;
-        }
-      }
-    // 4. The shorten stage (as shorten.comp) while nothing holds the sheet: Gauss-Seidel over the
-    // colours with edges, a barrier after each
-    bool shortens = limitShortens(u.limit.x, u.grab_index, u.flags);
-    for (uint it = 0u; it < u.iterations; ++it)
-      for (uint c = 0u; c < u.color_count; ++c) {
-        uvec2 range = color_range[c];
-        if (shortens && range.y > 0u && shortensColour(constraints[range.x].kind_id)) {
-          for (uint t = lid; t < range.y; t += kInvocations) shortenConstraint(constraints[range.x + t]);
-          sync();
-        }
-        if (stopsAfter(first_pass + shorten_pass + it * u.color_count + c)) {
-          storePositions(n);
-          return;
-        }
-      }
-    // 5. The stretch limit (as limit.comp): ring after ring from the roots
-    if (u.limit.x > 0.0f) {
-      uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
-      vec4 limit = u.limit; // read whole (limitParticle says why)
-      uint rings = uint(limit.z);
-      for (uint k = 1u; k <= rings; ++k) {
-        limitRing(roots, k, lid, kInvocations);
-        sync();
-      }
-    }
-    if (stopsAfter(first_pass + limit_pass)) {
-      storePositions(n);
-      return;
-    }
-    // 6. The creases (as crease.comp)
-    if (creasingNow()) {
-      for (uint k = lid; k < hingeKeys().y; k += kInvocations) creaseHinge(k);
-      sync();
-    }
-    if (stopsAfter(first_pass + crease_pass)) {
-      storePositions(n);
-      return;
-    }
-    // 7. The floor (as floor.comp)
-    for (uint i = lid; i < n; i += kInvocations) {
-      VerletState st = floorContact(s_pos[i], prev[i], u.floor_y, u.restitution, u.friction);
-#ifdef SIM_FUSED_CONTACT
-      if (contactKeys().x > 0.0f) contactSlideClear(i);
-#endif
-      s_pos[i] = st.position;
-      prev[i] = st.previous;
-    }
-    sync();
-#ifdef SIM_FUSED_CONTACT
-    // With contact, the steps cut to their pairs' half-spaces and their bounds (as contact_pass,
-    // contact_excess, contact_share and contact_step)
-    if (contactKeys().x > 0.0f) contactSlideSubstep(s, n);
-#endif
-    if (stopsAfter(first_pass + floor_pass)) {
-      storePositions(n);
-      return;
-    }
-#ifdef SIM_FUSED_CONTACT
-    // 8. The settle stage, with contact and its sweeps on
-    if (contactKeys().x > 0.0f && contactChecks().y > 0u) contactSettleSubstep(s);
-#endif
-    if (stopsAfter(first_pass + settle_pass)) {
-      storePositions(n);
-      return;
-    }
-    // 9. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's
-    // live count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
-    // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
-    // substep it tore in removed it), and kinds that cannot tear skip the position loads.
-    if (!tearing) {
-      if (stopsAfter(first_pass + tear_pass)) {
-        storePositions(n);
-        return;
-      }
-      continue;
-    }
-    for (uint c = 0u; c < u.color_count; ++c) {
-      uvec2 range = color_range[c];
-      for (uint t = lid; t < range.y; t += kInvocations) {
-        Constraint k = constraints[range.x + t];
-        if ((u.tear_kinds & (1u << (k.kind_id & SIM_KIND_MASK))) != 0u) markTear(k, s_pos[k.a], s_pos[k.b]);
-      }
-    }
-    sync();
-    if (counters.torn_new != 0u) {
-      // What stood on the triangles lost goes too (as tear_unsupported), then the compaction
-      for (uint c = 0u; c < u.color_count; ++c) {
-        uvec2 range = color_range[c];
-        for (uint t = lid; t < range.y; t += kInvocations) markUnsupported(constraints[range.x + t]);
-      }
-      sync();
-      uint slots = compactSlots();
-      for (uint k = lid; k < slots; k += kInvocations) tearFlags(k);
-      sync();
-      scanWorkgroup(SIM_SCAN_SCRATCH, 0u, slots, slots);
-      for (uint k = lid; k < slots; k += kInvocations) tearCompact(k);
-      sync();
-    }
-    if (stopsAfter(first_pass + tear_pass)) {
-      storePositions(n);
-      return;
-    }
-  }
+  runSubsteps(n);
   storePositions(n);
 }
