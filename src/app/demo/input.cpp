@@ -170,7 +170,8 @@ void DemoApp::onChar(GLFWwindow* w, unsigned codepoint) {
 void DemoApp::onKey(GLFWwindow* w, int key, int scancode, int action, int mods) {
   DemoApp& app = *appOf(w);
   if (app.keys_.feeding) return;
-  if (app.imgui_ready_) app.keys_.waiting.push_back({key, scancode, action, mods, 0});
+  // (ImGui 1.86 repeats a held key itself and ignores GLFW's repeats: queued, they would only wait.)
+  if (app.imgui_ready_ && action != GLFW_REPEAT) app.keys_.waiting.push_back({key, scancode, action, mods, 0});
   if (action != GLFW_PRESS) return;
   if (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureKeyboard) return;
   if (!app.sim_) return;
