@@ -31,9 +31,8 @@
 
 namespace tender::test {
 
-/// Parameters of a preset with overrides (which must be valid).
-inline SimParams preset(const std::string& name, const std::vector<std::string>& sets) {
-  SimParams p = *presetParams(name);
+/// `p` with overrides (which must be valid).
+inline SimParams withSets(SimParams p, const std::vector<std::string>& sets) {
   for (const std::string& s : sets) {
     auto err = applyOverride(p, s);
     EXPECT_FALSE(err) << *err;
@@ -42,8 +41,19 @@ inline SimParams preset(const std::string& name, const std::vector<std::string>&
   EXPECT_FALSE(err) << *err;
   return p;
 }
+
+/// Parameters of a preset with overrides (which must be valid).
+inline SimParams preset(const std::string& name, const std::vector<std::string>& sets) {
+  return withSets(*presetParams(name), sets);
+}
 inline SimParams preset(const char* name, std::initializer_list<const char*> sets = {}) {
   return preset(std::string(name), std::vector<std::string>(sets.begin(), sets.end()));
+}
+
+/// The seeds' cloth as SimParams' defaults give it (the sheet hanging from its pins with the
+/// particle repulsion, no contact), with `sets` over it: a test scene that no preset file changes.
+inline SimParams cloth(std::initializer_list<const char*> sets = {}) {
+  return withSets(SimParams{}, std::vector<std::string>(sets.begin(), sets.end()));
 }
 
 /// Parses an input script (which must be valid).

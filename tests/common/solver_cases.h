@@ -39,8 +39,8 @@ TYPED_TEST_SUITE_P(SolverCase);
 
 TYPED_TEST_P(SolverCase, FreeFallMatchesDampedVerlet) {
   // Positions near y = 0 keep float rounding of the Verlet velocity (a position difference) small.
-  SimParams p = preset("tender", {"contact_factor=0", "pins=none", "wind=off", "collision=off", "tear_factor=0",
-                                  "floor_y=-10000", "cols=7", "rows=5", "top_y=0.36"});
+  SimParams p = cloth(
+      {"pins=none", "wind=off", "collision=off", "tear_factor=0", "floor_y=-10000", "cols=7", "rows=5", "top_y=0.36"});
   for (int ticks : {5, 60}) {
     auto solver = this->make();
     Simulation sim(p, *solver);
@@ -58,7 +58,7 @@ TYPED_TEST_P(SolverCase, FreeFallMatchesDampedVerlet) {
 
 TYPED_TEST_P(SolverCase, HangingSheetSettles) {
   auto solver = this->make();
-  Simulation sim(preset("tender", {"contact_factor=0", "wind=off", "cols=12", "rows=16"}), *solver);
+  Simulation sim(cloth({"wind=off", "cols=12", "rows=16"}), *solver);
   SimState s = run(sim, 360);
   SheetStats st = computeStats(s, sim.params().substepDt());
   EXPECT_LT(st.max_stretch, 1.05f);
@@ -71,7 +71,7 @@ TYPED_TEST_P(SolverCase, HangingSheetSettles) {
 
 TYPED_TEST_P(SolverCase, PinsNeverMove) {
   auto solver = this->make();
-  Simulation sim(preset("tender", {"contact_factor=0", "cols=16", "rows=24"}), *solver);
+  Simulation sim(cloth({"cols=16", "rows=24"}), *solver);
   sim.setScript(script("0 grab particle 300\n2 move 3 -2 4\n20 release\n"));
   const auto& topo = sim.topology();
   for (int t = 0; t < 40; ++t) {
@@ -86,7 +86,7 @@ TYPED_TEST_P(SolverCase, PinsNeverMove) {
 
 TYPED_TEST_P(SolverCase, PinsToggleFreesTheSheet) {
   auto solver = this->make();
-  Simulation sim(preset("tender", {"contact_factor=0", "wind=off", "cols=12", "rows=16"}), *solver);
+  Simulation sim(cloth({"wind=off", "cols=12", "rows=16"}), *solver);
   sim.setScript(script("10 pins off\n"));
   SimState s = run(sim, 40);
   EXPECT_LT(s.pos[0].y, sim.topology().rest_pos[0].y - 0.01f);
@@ -96,7 +96,7 @@ TYPED_TEST_P(SolverCase, PinsToggleFreesTheSheet) {
 template <class Fixture>
 uint32_t tornAtStretch(Fixture& f, float factor) {
   auto solver = f.make();
-  Simulation sim(preset("tender", {"contact_factor=0", "cols=1", "rows=2", "wind=off", "collision=off"}), *solver);
+  Simulation sim(cloth({"cols=1", "rows=2", "wind=off", "collision=off"}), *solver);
   glm::vec3 top(sim.topology().rest_pos[0]);
   sim.grabParticle(1);
   sim.moveGrab(top - glm::vec3(0.0f, factor * sim.params().spacing, 0.0f));
@@ -112,7 +112,7 @@ TYPED_TEST_P(SolverCase, TearSurvivesAt249AndTearsAt251) {
 
 TYPED_TEST_P(SolverCase, ZeroTearFactorNeverTears) {
   auto solver = this->make();
-  Simulation sim(preset("tender", {"contact_factor=0", "tear_factor=0", "cols=16", "rows=24"}), *solver);
+  Simulation sim(cloth({"tear_factor=0", "cols=16", "rows=24"}), *solver);
   sim.setScript(script("0 grab particle 383\n1 move 8 -4 8\n"));
   EXPECT_EQ(computeStats(run(sim, 30), 1.0f).torn, 0u);
 }
@@ -175,7 +175,7 @@ TYPED_TEST_P(SolverCase, TwoRunsAreBitwiseIdentical) {
 
 TYPED_TEST_P(SolverCase, ResetAnimatesBackOverThirtyFrames) {
   auto solver = this->make();
-  Simulation sim(preset("tender", {"contact_factor=0", "cols=8", "rows=12"}), *solver);
+  Simulation sim(cloth({"cols=8", "rows=12"}), *solver);
   sim.setScript(script("0 grab particle 95\n1 move 6 -5 6\n20 reset\n"));
   SimState torn = run(sim, 20);
   ASSERT_GT(computeStats(torn, 1.0f).torn, 0u);
@@ -192,7 +192,7 @@ TYPED_TEST_P(SolverCase, ResetAnimatesBackOverThirtyFrames) {
 
 TYPED_TEST_P(SolverCase, PauseFreezesTheState) {
   auto solver = this->make();
-  Simulation sim(preset("tender", {"contact_factor=0", "cols=8", "rows=12"}), *solver);
+  Simulation sim(cloth({"cols=8", "rows=12"}), *solver);
   sim.setScript(script("5 pause on\n10 pause off\n"));
   SimState a = run(sim, 6);
   SimState b = run(sim, 4);
@@ -236,7 +236,7 @@ TYPED_TEST_P(SolverCase, DragReleaseKeepsMomentum) {
 
 TYPED_TEST_P(SolverCase, PickFindsTheNearestParticleAndWhereItIs) {
   auto solver = this->make();
-  Simulation sim(preset("tender", {"contact_factor=0", "cols=16", "rows=24"}), *solver);
+  Simulation sim(cloth({"cols=16", "rows=24"}), *solver);
   // Equidistant particles (at rest, the same distance from the ray): the smaller index wins.
   const glm::vec3 mid = 0.5f * (glm::vec3(sim.topology().rest_pos[200]) + glm::vec3(sim.topology().rest_pos[201]));
   auto tie = solver->pick(mid + glm::vec3(0.0f, 0.0f, 10.0f), glm::vec3(0.0f, 0.0f, -1.0f), 0.6f);

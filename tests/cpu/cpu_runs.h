@@ -8,13 +8,17 @@
 
 namespace tender::test {
 
-/// Runs `ticks` ticks of a preset (with overrides and a script) and returns the final state.
-inline SimState runCpu(const std::string& preset_name, const std::vector<std::string>& sets,
-                       const std::string& script_text, int ticks, CpuOptions options) {
+/// Runs `ticks` ticks of a sheet (with a script) and returns the final state.
+inline SimState runCpu(const SimParams& p, const std::string& script_text, int ticks, CpuOptions options) {
   CpuSolver solver(options);
-  Simulation sim(preset(preset_name, sets), solver);
+  Simulation sim(p, solver);
   if (!script_text.empty()) sim.setScript(script(script_text.c_str()));
   return run(sim, ticks);
+}
+/// The same of a preset with overrides.
+inline SimState runCpu(const std::string& preset_name, const std::vector<std::string>& sets,
+                       const std::string& script_text, int ticks, CpuOptions options) {
+  return runCpu(preset(preset_name, sets), script_text, ticks, options);
 }
 
 /// Expects two states to be bitwise identical, array by array.

@@ -101,8 +101,8 @@ TEST(Collision, FoldedSheetKeepsLayersApart) {
   for (bool collide : {false, true}) {
     CpuSolver cpu;
     // No bend constraints: nothing but collision resists the fold.
-    Simulation sim(preset("tender", {"contact_factor=0", "cols=12", "rows=12", "pins=none", "wind=off", "gravity=0",
-                                     "tear_factor=0", "bend=off", collide ? "collision=on" : "collision=off"}),
+    Simulation sim(cloth({"cols=12", "rows=12", "pins=none", "wind=off", "gravity=0", "tear_factor=0", "bend=off",
+                          collide ? "collision=on" : "collision=off"}),
                    cpu);
     // Fold the lower half back over the upper half, 0.08 behind it (closer than 1.2 x spacing).
     auto& pos = cpu.positions();

@@ -99,7 +99,7 @@ TEST(Pieces, FoldingTearsNothing) {
 // hangs from its pins again, no particle above them (it used to stay folded up over the pin line,
 // held by the piece the pull had torn but the diagonals still tied on).
 TEST(Pieces, AHardPullLeavesNothingAboveThePins) {
-  const SimParams p = preset("tender", {"contact_factor=0"});
+  const SimParams p = cloth();
   CpuSolver solver;
   Simulation sim(p, solver);
   sim.setScript(script("0 wind off\n0 grab particle 1520\n2 move 0 -12 0\n4 move 8 -14 6\n6 move -8 -16 -6\n"

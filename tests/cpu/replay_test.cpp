@@ -29,7 +29,7 @@ struct LiveSession {
 } // namespace
 
 TEST(Replay, ARecordedSessionReplaysBitwiseAtAnyFrameRate) {
-  const SimParams p = preset("tender", {"contact_factor=0", "cols=16", "rows=24"});
+  const SimParams p = cloth({"cols=16", "rows=24"});
   LiveSession live(p);
   std::mt19937 rng(3);
   const float dts[] = {0.002f, 0.0164f, 0.033f, 0.05f, 0.009f};
@@ -103,7 +103,7 @@ TEST(Replay, ARecordedSessionReplaysBitwiseAtAnyFrameRate) {
 // rebuild (a new grid and tilt, grabbed afterwards) recorded as they happen replay bitwise, and
 // the replay ends with the session's parameters.
 TEST(Replay, RecordedParameterEditsReplayBitwise) {
-  const SimParams p = preset("tender", {"contact_factor=0", "cols=16", "rows=24"});
+  const SimParams p = cloth({"cols=16", "rows=24"});
   LiveSession live(p);
   auto edit = [&](std::vector<std::pair<std::string, std::string>> settings) {
     const uint64_t tick = live.sim.frameCount();
@@ -167,7 +167,7 @@ TEST(Replay, RecordedParameterEditsReplayBitwise) {
 // Set events are checked before a run: a bad value, a key of the solver, a rule broken by a
 // tick's settings together, a grab of a particle a rebuild removed, a layout change in a fleet.
 TEST(Script, SetEventsAreCheckedAgainstTheSheet) {
-  const SimParams p = preset("tender", {"contact_factor=0", "cols=16", "rows=24"});
+  const SimParams p = cloth({"cols=16", "rows=24"});
   std::string error;
   EXPECT_FALSE(parseScript("0 set damping 2\n", error));
   EXPECT_FALSE(parseScript("0 set threads 2\n", error));
@@ -186,7 +186,7 @@ TEST(Script, SetEventsAreCheckedAgainstTheSheet) {
 // A sheet a script rebuilds passes the check of `--set`, memory included: the largest grid there is
 // (2^24 particles) gets validate()'s answer on each backend, word for word after the tick.
 TEST(Script, ASheetAScriptRebuildsPassesTheMemoryCheck) {
-  const SimParams p = preset("tender", {"contact_factor=0", "cols=16", "rows=24"});
+  const SimParams p = cloth({"cols=16", "rows=24"});
   SimParams big = p;
   big.cols = big.rows = 4096;
   std::string error;
@@ -228,7 +228,7 @@ TEST(Script, AFleetsScriptsDoNotTurnContactOnInASheetMadeWithoutIt) {
 }
 
 TEST(Replay, ResetRestoresThePins) {
-  const SimParams p = preset("tender", {"contact_factor=0", "cols=8", "rows=12"});
+  const SimParams p = cloth({"cols=8", "rows=12"});
   CpuSolver solver;
   Simulation sim(p, solver);
   ASSERT_TRUE(sim.pins());

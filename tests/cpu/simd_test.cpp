@@ -305,13 +305,13 @@ constexpr CpuOptions kSimdTwo{.threads = 2, .min_chunk = 1, .simd = true};
 TEST(SimdSimulation, TearingYankIsIdenticalWithoutSimd) {
   // (it tears in its second tick; the last ticks run let go)
   const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n12 release\n";
-  const SimState reference = test::runCpu("tender", {"contact_factor=0"}, yank, 20, kScalarOne);
+  const SimState reference = test::runCpu(test::cloth(), yank, 20, kScalarOne);
   EXPECT_GT(test::tornCount(reference), 0u); // the run tears and compacts
   EXPECT_FALSE(CpuSolver(kScalarOne).usesSimd());
   EXPECT_EQ(CpuSolver(kSimdOne).usesSimd(), simd::kBuilt);
-  test::expectIdentical(reference, test::runCpu("tender", {"contact_factor=0"}, yank, 20, kSimdOne));
-  test::expectIdentical(reference, test::runCpu("tender", {"contact_factor=0"}, yank, 20, kSimdTwo));
-  test::expectIdentical(reference, test::runCpu("tender", {"contact_factor=0"}, yank, 20, kScalarTwo));
+  test::expectIdentical(reference, test::runCpu(test::cloth(), yank, 20, kSimdOne));
+  test::expectIdentical(reference, test::runCpu(test::cloth(), yank, 20, kSimdTwo));
+  test::expectIdentical(reference, test::runCpu(test::cloth(), yank, 20, kScalarTwo));
 }
 
 TEST(SimdSimulation, CrumpleTossIsIdenticalWithoutSimd) {

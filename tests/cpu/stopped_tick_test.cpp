@@ -14,9 +14,7 @@ namespace {
 
 const char* kYank = "0 grab particle 300\n1 move 3 -2 4\n";
 
-SimParams sheet() {
-  return preset("tender", {"contact_factor=0", "cols=16", "rows=24", "substeps=2", "iterations=2", "wind=on"});
-}
+SimParams sheet() { return cloth({"cols=16", "rows=24", "substeps=2", "iterations=2", "wind=on"}); }
 
 } // namespace
 

@@ -14,11 +14,12 @@ namespace {
 using test::expectIdentical;
 using test::tornCount;
 
-// The `tender` runs are the seeds' cloth, its contact off; contact's threads: the crumple runs
-SimState run(const std::string& preset, const std::vector<std::string>& sets, const std::string& script, int ticks,
-             CpuOptions options) {
-  return test::runCpu(preset, sets, script, ticks, options);
+// The cloth runs have no contact; contact's threads: the crumple runs
+SimState run(const SimParams& p, const std::string& script, int ticks, CpuOptions options) {
+  return test::runCpu(p, script, ticks, options);
 }
+using test::cloth;
+using test::preset;
 
 // min_chunk = 1 splits every loop, however small, so the small sheets exercise every parallel path.
 constexpr CpuOptions kOne{1, 1}, kTwo{2, 1}, kThree{3, 1};
@@ -28,16 +29,16 @@ constexpr CpuOptions kOneNoLists{1, 1, false};
 } // namespace
 
 TEST(CpuThreads, HangingSheetIsIdenticalOnOneAndTwoThreads) {
-  SimState one = run("tender", {"contact_factor=0"}, "", 20, kOne);
-  SimState two = run("tender", {"contact_factor=0"}, "", 20, kTwo);
+  SimState one = run(cloth(), "", 20, kOne);
+  SimState two = run(cloth(), "", 20, kTwo);
   expectIdentical(one, two);
 }
 
 TEST(CpuThreads, TearingYankIsIdenticalOnOneAndTwoThreads) {
   // (it tears in its second tick; the last ticks run let go)
   const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n12 release\n";
-  SimState one = run("tender", {"contact_factor=0"}, yank, 20, kOne);
-  SimState two = run("tender", {"contact_factor=0"}, yank, 20, kTwo);
+  SimState one = run(cloth(), yank, 20, kOne);
+  SimState two = run(cloth(), yank, 20, kTwo);
   EXPECT_GT(tornCount(one), 0u); // the run really tears and compacts
   EXPECT_LT(one.triangle_count, 2914u);
   expectIdentical(one, two);
@@ -45,18 +46,16 @@ TEST(CpuThreads, TearingYankIsIdenticalOnOneAndTwoThreads) {
 
 TEST(CpuThreads, CrumpleTossAndAwkwardSizeAreIdentical) {
   const std::string toss = "0 grab particle 100\n1 move 1 2 3\n10 release\n";
-  expectIdentical(run("crumple", {"cols=37", "rows=53"}, toss, 40, kOne),
-                  run("crumple", {"cols=37", "rows=53"}, toss, 40, kThree));
+  expectIdentical(run(preset("crumple", {"cols=37", "rows=53"}), toss, 40, kOne),
+                  run(preset("crumple", {"cols=37", "rows=53"}), toss, 40, kThree));
 }
 
 TEST(CpuThreads, TunedChunkingIsIdenticalOnALargerSheet) {
   // Default chunk sizes: the loops of a 64 x 128 sheet are split the way real runs split them (its
   // 8192 particles are two shares of kGrainParticles, its colours several of kGrainConstraints).
   const std::string yank = "0 grab particle 8191\n1 move 6 -4 8\n12 release\n";
-  SimState one =
-      run("tender", {"contact_factor=0", "cols=64", "rows=128"}, yank, 20, CpuOptions{.threads = 1, .min_chunk = 0});
-  SimState two =
-      run("tender", {"contact_factor=0", "cols=64", "rows=128"}, yank, 20, CpuOptions{.threads = 2, .min_chunk = 0});
+  SimState one = run(cloth({"cols=64", "rows=128"}), yank, 20, CpuOptions{.threads = 1, .min_chunk = 0});
+  SimState two = run(cloth({"cols=64", "rows=128"}), yank, 20, CpuOptions{.threads = 2, .min_chunk = 0});
   expectIdentical(one, two);
 }
 
@@ -64,16 +63,14 @@ TEST(CpuThreads, FullAdjacencyAndFourThreadsAreIdentical) {
   // Bend and triangle bend together: 16 neighbours per inner particle, the most the collision
   // pass's adjacency test holds in registers; four workers split every loop and phase.
   const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n12 release\n";
-  SimState one = run("tender", {"contact_factor=0", "tri_bend=on"}, yank, 20, kOne);
+  SimState one = run(cloth({"tri_bend=on"}), yank, 20, kOne);
   EXPECT_GT(tornCount(one), 0u);
-  expectIdentical(
-      one, run("tender", {"contact_factor=0", "tri_bend=on"}, yank, 20, CpuOptions{.threads = 4, .min_chunk = 1}));
+  expectIdentical(one, run(cloth({"tri_bend=on"}), yank, 20, CpuOptions{.threads = 4, .min_chunk = 1}));
 }
 
 TEST(CpuThreads, ResetAndNoCollisionAreIdentical) {
   const std::string script = "0 grab particle 1535\n1 move 4 -4 6\n20 reset\n";
-  expectIdentical(run("tender", {"contact_factor=0", "collision=off"}, script, 40, kOne),
-                  run("tender", {"contact_factor=0", "collision=off"}, script, 40, kTwo));
+  expectIdentical(run(cloth({"collision=off"}), script, 40, kOne), run(cloth({"collision=off"}), script, 40, kTwo));
 }
 
 TEST(CpuThreads, ZeroMeansOnePerHardwareThread) {
@@ -92,9 +89,7 @@ TEST(CpuThreads, MemoryIsReported) {
 
 TEST(CpuCandidateLists, ListsAreUsedAndChangeNothing) {
   // A sheet hanging in the wind: most substeps sum from the lists.
-  SimParams p = *presetParams("tender");
-  ASSERT_FALSE(applyOverride(p, "wind=on").has_value());
-  ASSERT_FALSE(applyOverride(p, "contact_factor=0").has_value()); // the seeds' cloth
+  const SimParams p = cloth({"wind=on"});
   CpuSolver solver(kTwo);
   Simulation sim(p, solver);
   uint32_t on_lists = 0;
@@ -106,23 +101,21 @@ TEST(CpuCandidateLists, ListsAreUsedAndChangeNothing) {
   solver.computeNormals();
   SimState with;
   solver.readback(with);
-  expectIdentical(with, run("tender", {"contact_factor=0", "wind=on"}, "", 60, kOneNoLists));
+  expectIdentical(with, run(cloth({"wind=on"}), "", 60, kOneNoLists));
 }
 
 TEST(CpuCandidateLists, DragTossAndCrowdsAreIdenticalWithoutLists) {
   // A drag that tears (lists outgrown, then waiting), a crumple toss, a radius of 1.6 spacings
   // (lists of several candidates each) and one of 2.5 spacings (lists overflow).
   const std::string drag = "0 grab particle 1535\n1 move 1 2 1\n10 move 2 0 2\n20 move 4 -4 6\n40 release\n";
-  SimState a = run("tender", {"contact_factor=0", "wind=on"}, drag, 80, kTwo);
+  SimState a = run(cloth({"wind=on"}), drag, 80, kTwo);
   EXPECT_GT(tornCount(a), 0u);
-  expectIdentical(a, run("tender", {"contact_factor=0", "wind=on"}, drag, 80, kOneNoLists));
+  expectIdentical(a, run(cloth({"wind=on"}), drag, 80, kOneNoLists));
   const std::string toss = "0 grab particle 100\n1 move 1 2 3\n10 release\n";
-  expectIdentical(run("crumple", {"cols=37", "rows=53"}, toss, 40, kThree),
-                  run("crumple", {"cols=37", "rows=53"}, toss, 40, kOneNoLists));
-  expectIdentical(run("tender", {"contact_factor=0", "collision_factor=1.6", "wind=on"}, drag, 40, kTwo),
-                  run("tender", {"contact_factor=0", "collision_factor=1.6", "wind=on"}, drag, 40, kOneNoLists));
-  expectIdentical(
-      run("tender", {"contact_factor=0", "cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9"}, "", 20, kTwo),
-      run("tender", {"contact_factor=0", "cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9"}, "", 20,
-          kOneNoLists));
+  expectIdentical(run(preset("crumple", {"cols=37", "rows=53"}), toss, 40, kThree),
+                  run(preset("crumple", {"cols=37", "rows=53"}), toss, 40, kOneNoLists));
+  expectIdentical(run(cloth({"collision_factor=1.6", "wind=on"}), drag, 40, kTwo),
+                  run(cloth({"collision_factor=1.6", "wind=on"}), drag, 40, kOneNoLists));
+  expectIdentical(run(cloth({"cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9"}), "", 20, kTwo),
+                  run(cloth({"cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9"}), "", 20, kOneNoLists));
 }

@@ -164,7 +164,7 @@ TEST_P(GpuBatchPasses, WithoutCandidateListsSheetsMatchTheirRunsAlone) {
 TEST_P(GpuBatchPasses, LargeSheetsRecordTheDispatchesOfOneSheetPerPassOrPerSheet) {
   // Five sheets of one size: batched, the passes one of them records alone; sheet by sheet, five
   // times those
-  const SimParams p = preset("tender", {"contact_factor=0", "cols=48", "rows=48"});
+  const SimParams p = cloth({"cols=48", "rows=48"});
   gpu::GpuBatch batch(ctx(), 5, GetParam());
   Fleet fleet(batch, std::vector<FleetSheet>(5, FleetSheet{p, {}}));
   gpu::GpuSolver alone(ctx());

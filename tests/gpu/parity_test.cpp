@@ -53,7 +53,7 @@ TEST_F(Parity, HashBucketsMatchTheCpu) {
 TEST_F(Parity, HugeHashTableUsesThreeScanLevelsAndTallGrids) {
   // 2^23 buckets: the scan needs three levels (8192 and 8 block sums) and adding the block sums
   // back takes 131072 workgroups, more than one grid row (the grid spills into Y).
-  SimParams p = preset("tender", {"contact_factor=0", "cols=24", "rows=30", "wind=on"});
+  SimParams p = cloth({"cols=24", "rows=30", "wind=on"});
   SheetTopology topo = buildSheet(p);
   topo.hash_size = 1u << 23;
   CpuSolver scratch_solver;
@@ -88,7 +88,7 @@ TEST_F(Parity, HugeHashTableUsesThreeScanLevelsAndTallGrids) {
 
 TEST_F(Parity, NoCollisionNoTearFor240Ticks) {
   // Time is the subject, not size: a 16 x 24 sheet dragged by its last corner and let go
-  SimParams p = preset("tender", {"cols=16", "rows=24", "contact_factor=0", "collision=off", "tear_factor=0"});
+  SimParams p = cloth({"cols=16", "rows=24", "collision=off", "tear_factor=0"});
   for (bool fused : {true, false}) {
     auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 383\n2 move 2 -1 2\n120 release\n", 240, fused);
     EXPECT_TRUE(sameState(cpu, gpu));
@@ -97,7 +97,7 @@ TEST_F(Parity, NoCollisionNoTearFor240Ticks) {
 
 TEST_F(Parity, FullPhysicsTender60Ticks) {
   // The seeds' cloth (the preset with contact: TheTenderPresetWithContactTearsTheSameOnTheGpu)
-  SimParams p = preset("tender", {"contact_factor=0"});
+  SimParams p = cloth();
   for (bool fused : {true, false}) {
     auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 1535\n1 move 1 -1 3\n", 60, fused);
     EXPECT_TRUE(sameState(cpu, gpu));
@@ -135,7 +135,7 @@ TEST_F(Parity, PaperInTheAir) {
 
 TEST_F(Parity, ScriptedYankTearsTheSameConstraints) {
   // Grab the bottom-right corner and pull it far away fast.
-  SimParams p = preset("tender", {"contact_factor=0", "wind=off"}); // the seeds' cloth
+  SimParams p = cloth({"wind=off"}); // the seeds' cloth
   auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 1535\n1 move 7 -4 6\n", 12);
   ASSERT_GT(tornIds(cpu).size(), 0u);
   std::printf("yank: %zu torn on the CPU, %zu on the GPU; %u / %u triangles\n", tornIds(cpu).size(),
@@ -189,7 +189,7 @@ TEST_F(Parity, AwkwardSizes) {
   const std::pair<const char*, const char*> sizes[] = {
       {"cols=1", "rows=2"}, {"cols=7", "rows=11"}, {"cols=37", "rows=53"}};
   for (auto [c, r] : sizes) {
-    SimParams p = preset("tender", {"contact_factor=0", c, r, "wind=on"});
+    SimParams p = cloth({c, r, "wind=on"});
     const uint32_t last = p.cols * p.rows - 1;
     std::string text = "0 grab particle " + std::to_string(last) + "\n1 move 3 -3 3\n";
     for (bool fused : {true, false}) {
@@ -218,7 +218,7 @@ TEST_F(Parity, SyncValidationCatchesAMissingBarrier) {
 
 TEST_F(Parity, FusedSmallSheetPathMatchesSeparatePasses) {
   // The fused substep (one workgroup, shared memory) against the per-colour passes and the CPU.
-  SimParams p = preset("tender", {"contact_factor=0", "wind=on"});
+  SimParams p = cloth({"wind=on"});
   const char* text = "0 grab particle 1535\n1 move 6 -5 6\n25 release\n";
   auto runGpu = [&](bool fused) {
     gpu::GpuSolver gpu(ctx());
@@ -253,12 +253,10 @@ TEST_F(Parity, FusedTickInTheShapesOfBothKindsOfDevice) {
     bool fused_on_cpu_device;
   };
   const Case cases[] = {
-      {preset("tender", {"contact_factor=0", "wind=on"}), "0 grab particle 1535\n1 move 6 -5 6\n25 release\n", true},
+      {cloth({"wind=on"}), "0 grab particle 1535\n1 move 6 -5 6\n25 release\n", true},
       // just under the CPU device's cell limit (0.72): the densest buckets it fuses
-      {preset("tender", {"contact_factor=0", "cell_size=0.7", "wind=on"}),
-       "0 grab particle 1535\n1 move 6 -5 6\n25 release\n", true},
-      {preset("tender", {"contact_factor=0", "cols=24", "rows=30", "cell_size=1.8", "wind=on"}),
-       "0 grab particle 719\n1 move 2 3 1\n", false},
+      {cloth({"cell_size=0.7", "wind=on"}), "0 grab particle 1535\n1 move 6 -5 6\n25 release\n", true},
+      {cloth({"cols=24", "rows=30", "cell_size=1.8", "wind=on"}), "0 grab particle 719\n1 move 2 3 1\n", false},
       // the air pass first in every substep (without contact: its work in the workgroup, a whole
       // tick in one dispatch, runs past lavapipe's loop count, bench/README.md "Fused small sheets")
       {preset("paper", {"tear_factor=1.6", "contact_factor=0"}),
@@ -296,7 +294,7 @@ TEST_F(Parity, FusedTickOfAnyWorkgroupSize) {
   // --fused-workgroup): from a few SIMD groups (a substep a dispatch: each invocation's loops run
   // long, and lavapipe caps a dispatch's loop iterations) to SIM_WG_FUSED_MAX (the whole tick in
   // one dispatch), the CPU's bits through a yank that tears.
-  const SimParams p = preset("tender", {"contact_factor=0", "wind=on"});
+  const SimParams p = cloth({"wind=on"});
   const char* text = "0 grab particle 1535\n1 move 6 -5 6\n12 release\n";
   CpuSolver cpu;
   Simulation cpu_sim(p, cpu);
@@ -321,7 +319,7 @@ TEST_F(Parity, BucketsLongerThanTheGatherWindow) {
   // Cells 10 spacings wide: a bucket holds far more particles than the collision gather's
   // 32-slot window, so buckets are read in several windows. The fused tick runs with any cell
   // here, one substep per dispatch of kGpuLikeWorkgroup invocations (well within lavapipe's loop count).
-  SimParams p = preset("tender", {"contact_factor=0", "cols=24", "rows=30", "cell_size=1.8", "wind=on"});
+  SimParams p = cloth({"cols=24", "rows=30", "cell_size=1.8", "wind=on"});
   for (bool fused : {true, false}) {
     auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 719\n1 move 2 3 1\n", 40, fused,
                               gpu::FusedShape{kGpuLikeWorkgroup, 1, -1.0f});
@@ -334,7 +332,7 @@ TEST_F(Parity, FarConnectedParticlesNeverRepel) {
   // Connect every particle of a strip to its mirror image across the middle row, far outside the
   // 5 x 5 grid stencil of the GPU's adjacency masks, then fold the strip in half so that the
   // mirrors meet: both solvers skip exactly those pairs (the GPU through the adjacency list).
-  SimParams p = preset("tender", {"contact_factor=0", "cols=6", "rows=40", "wind=off", "tear_factor=0"});
+  SimParams p = cloth({"cols=6", "rows=40", "wind=off", "tear_factor=0"});
   const char* text = "0 grab particle 237\n1 move 0.45 3 0.3\n";
   SheetTopology topo = buildSheet(p);
   std::vector<std::vector<uint32_t>> adj(topo.particleCount());
@@ -390,8 +388,7 @@ TEST_F(Parity, CandidateListsHoldEveryCloseUnconnectedPair) {
   // rows away (or two columns, one row) are unconnected and within 2.4 spacings.
   for (bool fused : {true, false})
     for (const char* factor : {"collision_factor=1.2", "collision_factor=1.6"})
-      checkCandidateLists(preset("tender", {"contact_factor=0", "wind=on", factor}), fused,
-                          std::strcmp(factor, "collision_factor=1.6") == 0);
+      checkCandidateLists(cloth({"wind=on", factor}), fused, std::strcmp(factor, "collision_factor=1.6") == 0);
 }
 
 void Parity::checkCandidateLists(const SimParams& p, bool fused, bool expect_entries) {
@@ -464,8 +461,7 @@ TEST_F(Parity, OverflowingCandidateListsFallBackToTheHash) {
   // A collision radius of 2.5 spacings reaches far past the connected neighbours: a particle has
   // more unconnected candidates than a list holds. Both GPU paths then wait SIM_CANDIDATE_WAIT
   // substeps before trying again, gathering from the hash meanwhile, and match the CPU.
-  SimParams p =
-      preset("tender", {"contact_factor=0", "cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9", "wind=on"});
+  SimParams p = cloth({"cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9", "wind=on"});
   for (bool fused : {true, false}) {
     gpu::GpuSolver gpu(ctx(), gpu::FusedShape{kGpuLikeWorkgroup, 1, -1.0f});
     gpu.setFusedPath(fused);
