@@ -209,14 +209,7 @@ int main(int argc, char** argv) {
   CLI::App app{"tender-bench: how the solvers scale with the size of the sheet."};
   std::string max_cpu_particles = std::to_string(run.o.max_cpu_particles), batches;
   addOptions(app, run.o, max_cpu_particles, batches);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::Success& e) { // --help, --version
-    return finishOutput(app.exit(e));
-  } catch (const CLI::ParseError& e) {
-    return fail(e.what());
-  }
-  if (auto err = emptyValue(app)) return fail(*err);
+  if (const std::optional<int> status = parseArgs(app, argc, argv)) return *status;
   // Validate everything before running anything: options, outputs, the device.
   if (auto err = checkRun(run, max_cpu_particles, batches)) return fail(*err);
 #ifdef TENDER_HAS_GPU

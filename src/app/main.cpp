@@ -206,14 +206,7 @@ int main(int argc, char** argv) {
   addDiff(app, c);
   addSweep(app, c);
   addListings(app, c);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::Success& e) { // --help, --version
-    return finishOutput(app.exit(e));
-  } catch (const CLI::ParseError& e) {
-    return fail(e.what());
-  }
-  if (auto err = emptyValue(app)) return fail(*err);
+  if (const std::optional<int> status = parseArgs(app, argc, argv)) return *status;
   // Everything a command prints must reach standard output: a lost line is an error (exit 2).
   try {
     return finishOutput(runCommand(c));

@@ -47,6 +47,18 @@ std::optional<std::string> emptyValue(const CLI::App& app) {
   return std::nullopt;
 }
 
+std::optional<int> parseArgs(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) { // --help, --version
+    return finishOutput(app.exit(e));
+  } catch (const CLI::ParseError& e) {
+    return fail(e.what());
+  }
+  if (auto err = emptyValue(app)) return fail(*err);
+  return std::nullopt;
+}
+
 CLI::Validator finiteRange(double lo, double hi) {
   return CLI::Validator(
       [lo, hi](std::string& text) -> std::string {

@@ -24,6 +24,9 @@ int finishOutput(int status);
 /// The first option of `app` or of its subcommands in use that was given an empty value, as
 /// "--video: the value is empty"; nullopt when none was.
 std::optional<std::string> emptyValue(const CLI::App& app);
+/// Parses the command line into `app`: the exit status when the run ends there (--help and
+/// --version printed, or a bad or empty option's one line), nothing when it goes on.
+std::optional<int> parseArgs(CLI::App& app, int argc, char** argv);
 /// A check for CLI11: a finite number in [lo, hi] (CLI::Range lets NaN through).
 CLI::Validator finiteRange(double lo, double hi);
 
