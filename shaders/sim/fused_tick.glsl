@@ -71,41 +71,37 @@ void scanWorkgroup(uint mode, uint offset, uint count, uint sums) {
 }
 
 #ifdef SIM_FUSED_CONTACT
-// The floor's steps with contact (as contact_pass, contact_excess, contact_share and contact_step):
-// each query's pairs from where the particles started, three times, then each step cut
-void contactSlideSubstep(uint s, uint n) {
+// After the floor, with contact: each query's pairs from where the particles started, three
+// times, then each step cut (as contact_pass, contact_excess, contact_share and contact_step); then,
+// with the settle's sweeps on and an edge over the limit, the pairs' half-spaces counted by
+// particle, scanned and listed, and the sweeps over the colours with structural edges until one
+// moves nothing (as contact_settle_check, contact_half_count, scan, contact_half_fill and
+// contact_settle). One loop over the five kinds of query, so that the shader holds one copy of
+// contactNear's body here, not two (NIR inlines every call, and a copy is a fifth of the kernel).
+// True when the run stops after the floor (`floor_pass`: its first pass).
+bool contactAfterFloor(uint s, uint n, uint floor_pass) {
   uint lid = gl_LocalInvocationID.x;
   uint queries = u.particle_count + contactEdgeCount();
-  // (one loop over the three, so that the shader holds one copy of contactNear's body, not three)
-  for (uint only = NEAR_PASS; only <= NEAR_SHARE; ++only) {
-    for (uint k = lid; k < queries; k += kInvocations) contactNear(k, only);
-    sync();
-  }
-  for (uint i = lid; i < n; i += kInvocations) {
-    VerletState st;
-    st.position = s_pos[i];
-    st.previous = prev[i];
-    st = contactSlideStep(i, st, s);
-    s_pos[i] = st.position;
-    prev[i] = st.previous;
-  }
-  sync();
-}
-
-// The settle stage (as contact_settle_check, contact_half_count, scan, contact_half_fill and
-// contact_settle): with an edge over the limit, the pairs' half-spaces counted by particle, scanned
-// and listed, then the sweeps over the colours with structural edges until one moves nothing
-void contactSettleSubstep(uint s) {
-  uint lid = gl_LocalInvocationID.x;
-  for (uint c = 0u; c < u.color_count; ++c) {
-    uvec2 range = color_range[c];
-    for (uint t = lid; t < range.y; t += kInvocations) contactSettleCheck(range.x + t, s);
-  }
-  sync();
-  if (!settleStarts()) return;
-  uint queries = u.particle_count + contactEdgeCount();
-  // (counted, then after the counts' scan filled: one loop, one copy of contactNear's body)
-  for (uint only = NEAR_HALF_COUNT; only <= NEAR_HALF_FILL; ++only) {
+  for (uint only = NEAR_PASS; only <= NEAR_HALF_FILL; ++only) {
+    if (only == NEAR_HALF_COUNT) {
+      for (uint i = lid; i < n; i += kInvocations) {
+        VerletState st;
+        st.position = s_pos[i];
+        st.previous = prev[i];
+        st = contactSlideStep(i, st, s);
+        s_pos[i] = st.position;
+        prev[i] = st.previous;
+      }
+      sync();
+      if (stopsAfter(floor_pass)) return true;
+      if (contactChecks().y == 0u) return false;
+      for (uint c = 0u; c < u.color_count; ++c) {
+        uvec2 range = color_range[c];
+        for (uint t = lid; t < range.y; t += kInvocations) contactSettleCheck(range.x + t, s);
+      }
+      sync();
+      if (!settleStarts()) return false;
+    }
     if (only == NEAR_HALF_FILL) scanWorkgroup(SIM_SCAN_SCRATCH, halfStarts(), u.particle_count + 1u, compactSlots());
     for (uint k = lid; k < queries; k += kInvocations) contactNear(k, only);
     sync();
@@ -119,6 +115,7 @@ void contactSettleSubstep(uint s) {
     }
     if (!settleSweeps(sweep + 1u)) break; // moved nothing: nor would the next
   }
+  return false;
 }
 
 // Contact (as the contact_* passes, contact.glsl): each particle's step bound and push for substep
@@ -283,9 +280,8 @@ bool limitAndCreaseStage(uint limit_pass) {
   return false;
 }
 
-// 7. The floor (as floor.comp), and with contact the steps cut to their pairs' half-spaces and
-// their bounds (as contact_pass, contact_excess, contact_share and contact_step)
-void floorStage(uint s, uint n) {
+// 7. The floor (as floor.comp); with contact, the steps are then cut (contactAfterFloor)
+void floorStage(uint n) {
   uint lid = gl_LocalInvocationID.x;
   for (uint i = lid; i < n; i += kInvocations) {
     VerletState st = floorContact(s_pos[i], prev[i], u.floor_y, u.restitution, u.friction);
@@ -296,9 +292,6 @@ void floorStage(uint s, uint n) {
     prev[i] = st.previous;
   }
   sync();
-#ifdef SIM_FUSED_CONTACT
-  if (contactKeys().x > 0.0f) contactSlideSubstep(s, n);
-#endif
 }
 
 // 9. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's live
@@ -354,11 +347,16 @@ bool runSubsteps(uint n) {
     if (colourStage(true, first + SIM_FIRST_PASS(shorten))) return true;
     if (limitAndCreaseStage(first + SIM_FIRST_PASS(limit))) return true;
     if (stopsAfter(first + SIM_FIRST_PASS(crease))) return true;
-    floorStage(s, n);
-    if (stopsAfter(first + SIM_FIRST_PASS(floor))) return true;
+    floorStage(n);
 #ifdef SIM_FUSED_CONTACT
-    // 8. The settle stage, with contact and its sweeps on
-    if (contactKeys().x > 0.0f && contactChecks().y > 0u) contactSettleSubstep(s);
+    // 7-8. With contact: the steps cut, and the settle stage with its sweeps on
+    if (contactKeys().x > 0.0f) {
+      if (contactAfterFloor(s, n, first + SIM_FIRST_PASS(floor))) return true;
+    } else if (stopsAfter(first + SIM_FIRST_PASS(floor))) {
+      return true;
+    }
+#else
+    if (stopsAfter(first + SIM_FIRST_PASS(floor))) return true;
 #endif
     if (stopsAfter(first + SIM_FIRST_PASS(settle))) return true;
     if (tearing) tearStage();
