@@ -290,14 +290,11 @@ std::vector<std::string> inexactOperations(std::span<const uint32_t> code) {
   };
   auto nameOf = [&](uint32_t id) {
     auto it = names.find(id);
-    // (a "%" appended to, not prepended: GCC 12 at -O3 warns of an overlapping copy in
-    // operator+(const char*, std::string&&), a false -Wrestrict, which -Werror refuses)
+    if (it != names.end()) return it->second.substr(0, it->second.find('('));
+    // (appended to "%", not "%" + ...: GCC 12 at -O3 takes operator+(const char*, std::string&&)
+    // for an overlapping copy, a false -Wrestrict that -Werror refuses)
     std::string n = "%";
-    if (it == names.end())
-      n += std::to_string(id);
-    else
-      n = it->second;
-    return n.substr(0, n.find('('));
+    return n.append(std::to_string(id));
   };
   std::vector<std::string> found;
   uint32_t function = 0;

@@ -255,9 +255,13 @@ VectorLoads deviceAddressVectorLoads(const std::vector<Instruction>& code) {
     // The root's pointee type, then every index but the last
     const uint32_t root = root_type[c[0]];
     uint32_t t = type.count(root) && type[root]->op == 32 ? type[root]->words[3] : 0;
-    // (appended to "%", not prepended: see nameOf in spirv_rules.cpp)
-    std::string path = "%";
-    path = name.count(c[0]) ? name[c[0]] : name.count(t) ? name[t] : path.append(std::to_string(c[0]));
+    std::string path = "%"; // (appended to, not "%" + ...: see nameOf in spirv_rules.cpp)
+    if (name.count(c[0]))
+      path = name[c[0]];
+    else if (name.count(t))
+      path = name[t];
+    else
+      path += std::to_string(c[0]);
     for (size_t k = 1; k + 1 < c.size() && t; ++k) {
       if (type.count(t) && type[t]->op == 30 && constant.count(c[k]))
         path += "." + member_name[{t, constant[c[k]]}];
