@@ -51,81 +51,101 @@ SIM_INLINE uint inexactOffset(uint h) {
   return h % 7u - 3u;
 }
 
+// What follows is written without an early return or a branch: its special cases (zero,
+// infinity, NaN, a denormal, an overflow) are selects. A shader inlines it at every divide and
+// square root, and there each return or branch became control flow that the driver's compiler had
+// to restructure: on lavapipe it took twice as long to build the largest kernels, for the same
+// bits. GLSL compilers make `c ? a : b` a branch unless a and b are plain values, so the choices
+// go through pickU, pickI and pickF, and the conditions are named before they are combined.
+
+/// c ? a : b, as a select.
+SIM_INLINE uint pickU(bool c, uint a, uint b) { return c ? a : b; }
+SIM_INLINE int pickI(bool c, int a, int b) { return c ? a : b; }
+SIM_INLINE float pickF(bool c, float a, float b) { return c ? a : b; }
+
 /// The device's square root of x >= 0, made inexact when SIM_INEXACT_MATH.
 SIM_INLINE float deviceSqrt(float x) {
   float r = sqrt(x);
-  if (SIM_INEXACT_MATH && r > 0.0f && r < 3.0e38f)
-    r = uintBitsToFloat(floatBitsToUint(r) + inexactOffset(floatBitsToUint(x)));
-  return r;
+  bool positive = r > 0.0f, finite = r < 3.0e38f;
+  float off = uintBitsToFloat(floatBitsToUint(r) + inexactOffset(floatBitsToUint(x)));
+  return pickF(SIM_INEXACT_MATH && positive && finite, off, r);
 }
 
 /// The device's quotient a / b, made inexact when SIM_INEXACT_MATH.
 SIM_INLINE float deviceDiv(float a, float b) {
   float q = a / b;
   float m = abs(q);
-  if (SIM_INEXACT_MATH && m > 1.0e-37f && m < 3.0e38f)
-    q = uintBitsToFloat(floatBitsToUint(q) + inexactOffset(floatBitsToUint(a) * 0x9E3779B9u ^ floatBitsToUint(b)));
-  return q;
+  bool large = m > 1.0e-37f, finite = m < 3.0e38f;
+  float off =
+      uintBitsToFloat(floatBitsToUint(q) + inexactOffset(floatBitsToUint(a) * 0x9E3779B9u ^ floatBitsToUint(b)));
+  return pickF(SIM_INEXACT_MATH && large && finite, off, q);
 }
 
 /// Significand (x: in [2^23, 2^24)) and unbiased exponent (y) of the finite non-zero float with
-/// magnitude bits `bits`; a denormal is normalised.
+/// magnitude bits `bits`; a denormal is normalised (with SIM_FLUSH_DENORMALS the callers have read
+/// it as zero, so there is none).
 SIM_INLINE ivec2 splitFloat(uint bits) {
   uint field = bits >> 23u;
-  if (field != 0u) return ivec2(int((bits & 0x7FFFFFu) | 0x800000u), int(field) - 127);
-  int shift = 23 - findMSB(bits);
-  return ivec2(int(bits << uint(shift)), -126 - shift);
+  bool zero_field = field == 0u;
+  bool denormal = !SIM_FLUSH_DENORMALS && zero_field;
+  int shift = pickI(denormal, 23 - findMSB(bits), 0);
+  uint m = pickU(denormal, bits << uint(shift), (bits & 0x7FFFFFu) | 0x800000u);
+  return ivec2(int(m), pickI(denormal, -126 - shift, int(field) - 127));
 }
 
 /// The float with sign `sign`, biased exponent `biased` (<= 0: denormal) and significand q in
 /// [2^23, 2^24) rounded to nearest even by `above`: the rest beyond q compared with half an ulp (-1
 /// below, 0 exactly half, 1 above; `inexact`: anything at all beyond q).
 SIM_INLINE float packRounded(uint sign, int biased, uint q, int above, bool inexact) {
-  if (biased >= 255) return uintBitsToFloat(sign | 0x7F800000u);
-  if (SIM_FLUSH_DENORMALS && biased <= 0) {
-    // Flushed unless it rounds up to the smallest normal (tininess after rounding, as x86 FTZ)
-    uint up = above > 0 || (above == 0 && (q & 1u) != 0u) ? 1u : 0u;
-    return uintBitsToFloat(sign | (biased == 0 && q + up == 0x1000000u ? 0x800000u : 0u));
-  }
-  if (biased >= 1) {
-    uint up = above > 0 || (above == 0 && (q & 1u) != 0u) ? 1u : 0u;
-    // A carry out of the significand moves into the exponent (up to infinity)
-    return uintBitsToFloat(sign | ((uint(biased - 1) << 23u) + q + up));
-  }
-  uint s = uint(1 - biased); // denormal: q >> s, rounded on the bits shifted out
-  if (s > 25u) return uintBitsToFloat(sign);
+  bool beyond_half = above > 0, exactly_half = above == 0, odd = (q & 1u) != 0u;
+  bool to_even = exactly_half && odd;
+  uint up = pickU(beyond_half || to_even, 1u, 0u);
+  // A carry out of the significand moves into the exponent (up to infinity)
+  uint normal = (uint(biased - 1) << 23u) + q + up;
+  // Flushed (as x86 FTZ) unless it rounds up to the smallest normal (tininess after rounding)
+  bool to_smallest = biased == 0, carries = q + up == 0x1000000u;
+  uint flushed = pickU(to_smallest && carries, 0x800000u, 0u);
+  // Kept: q >> s, rounded on the bits shifted out (past 25 places nothing is left, as q < 2^24)
+  uint s = uint(clamp(1 - biased, 1, 25));
   uint m = q >> s;
-  uint guard = (q >> (s - 1u)) & 1u;
-  bool sticky = (q & ((1u << (s - 1u)) - 1u)) != 0u || inexact;
-  uint up = guard != 0u && (sticky || (m & 1u) != 0u) ? 1u : 0u;
-  return uintBitsToFloat(sign | (m + up));
+  bool guard = ((q >> (s - 1u)) & 1u) != 0u, rest = (q & ((1u << (s - 1u)) - 1u)) != 0u, m_odd = (m & 1u) != 0u;
+  bool sticky_or_odd = rest || inexact || m_odd;
+  uint kept = m + pickU(guard && sticky_or_odd, 1u, 0u);
+  uint tiny = pickU(SIM_FLUSH_DENORMALS, flushed, kept);
+  bool overflow = biased >= 255, normalised = biased >= 1;
+  return uintBitsToFloat(sign | pickU(overflow, 0x7F800000u, pickU(normalised, normal, tiny)));
 }
 
 /// Correctly rounded a / b (round to nearest even, denormals kept) on any device.
 SIM_INLINE float exactDiv(float a, float b) {
-  if (!SIM_CORRECT_MATH) return deviceDiv(a, b);
   uint ua = floatBitsToUint(a), ub = floatBitsToUint(b);
-  if (SIM_FLUSH_DENORMALS) { // denormal inputs read as zero
-    if ((ua & 0x7F800000u) == 0u) ua &= 0x80000000u;
-    if ((ub & 0x7F800000u) == 0u) ub &= 0x80000000u;
-  }
+  // Denormal inputs read as zero where denormals are flushed
+  uint ea = ua & 0x7F800000u, eb = ub & 0x7F800000u;
+  bool flush_a = ea == 0u, flush_b = eb == 0u;
+  ua = pickU(SIM_FLUSH_DENORMALS && flush_a, ua & 0x80000000u, ua);
+  ub = pickU(SIM_FLUSH_DENORMALS && flush_b, ub & 0x80000000u, ub);
   uint sign = (ua ^ ub) & 0x80000000u;
   uint xa = ua & 0x7FFFFFFFu, xb = ub & 0x7FFFFFFFu;
-  const uint kInf = 0x7F800000u, kNaN = 0x7FC00000u;
-  if (xa > kInf || xb > kInf || (xa == kInf && xb == kInf) || (xa == 0u && xb == 0u)) return uintBitsToFloat(kNaN);
-  if (xa == kInf || xb == 0u) return uintBitsToFloat(sign | kInf);
-  if (xa == 0u || xb == kInf) return uintBitsToFloat(sign);
-  ivec2 fa = splitFloat(xa), fb = splitFloat(xb);
+  // Zero, infinity and NaN give their answer at the end; the arithmetic runs on 1 / 1 instead
+  const uint kInf = 0x7F800000u;
+  bool nan_a = xa > kInf, nan_b = xb > kInf, inf_a = xa == kInf, inf_b = xb == kInf;
+  bool zero_a = xa == 0u, zero_b = xb == 0u;
+  bool both_inf = inf_a && inf_b, both_zero = zero_a && zero_b;
+  bool nan = nan_a || nan_b || both_inf || both_zero;
+  bool inf = inf_a || zero_b;
+  bool special = nan || inf || zero_a || inf_b;
+  uint answer = pickU(nan, 0x7FC00000u, pickU(inf, sign | kInf, sign));
+  ivec2 fa = splitFloat(pickU(special, 0x3F800000u, xa)), fb = splitFloat(pickU(special, 0x3F800000u, xb));
   uint ma = uint(fa.x), mb = uint(fb.x);
   // q = floor(ma 2^shift / mb) in [2^23, 2^24); the result is q 2^(e - 23)
   bool ge = ma >= mb;
-  uint shift = ge ? 23u : 24u;
-  int e = fa.y - fb.y - (ge ? 0 : 1);
+  uint shift = pickU(ge, 23u, 24u);
+  int e = fa.y - fb.y - pickI(ge, 0, 1);
   // Start from the device's quotient of the significands (both in [1, 2), so it is within a few
   // ULP), then step to the floor: the remainder ma 2^shift - q mb is exact modulo 2^32 and small.
   float approx =
       deviceDiv(uintBitsToFloat(0x3F800000u | (ma & 0x7FFFFFu)), uintBitsToFloat(0x3F800000u | (mb & 0x7FFFFFu)));
-  uint q = clamp(uint(approx * (ge ? 8388608.0f : 16777216.0f)), 0x800000u, 0xFFFFFFu);
+  uint q = clamp(uint(approx * pickF(ge, 8388608.0f, 16777216.0f)), 0x800000u, 0xFFFFFFu);
   int r = int((ma << shift) - q * mb);
   // q is off by a few units: an estimate of floor(r / mb) (within one of it: |r / mb| <= 5, and
   // 1.5 - x / 2 is within 12 % of 1 / x on [1, 2), so no second division) and one last step
@@ -133,50 +153,54 @@ SIM_INLINE float exactDiv(float a, float b) {
   int d = int(floor(float(r) * inv_mb));
   q += uint(d);
   r -= d * int(mb);
-  if (r < 0) {
-    q -= 1u;
-    r += int(mb);
-  } else if (r >= int(mb)) {
-    q += 1u;
-    r -= int(mb);
-  }
+  bool low = r < 0, high = r >= int(mb);
+  int last = pickI(low, -1, pickI(high, 1, 0));
+  q += uint(last);
+  r -= last * int(mb);
   uint twice = 2u * uint(r);
-  int above = twice > mb ? 1 : twice == mb ? 0 : -1;
-  return packRounded(sign, e + 127, q, above, r != 0);
+  bool over = twice > mb, tie = twice == mb;
+  float result = packRounded(sign, e + 127, q, pickI(over, 1, pickI(tie, 0, -1)), r != 0);
+  return pickF(SIM_CORRECT_MATH, pickF(special, uintBitsToFloat(answer), result), deviceDiv(a, b));
 }
 
 /// Correctly rounded sqrt(x) (round to nearest even, denormals kept) on any device.
 SIM_INLINE float exactSqrt(float x) {
-  if (!SIM_CORRECT_MATH) return deviceSqrt(x);
   uint ux = floatBitsToUint(x);
-  if (SIM_FLUSH_DENORMALS && (ux & 0x7F800000u) == 0u) ux &= 0x80000000u; // a denormal reads as zero
-  if ((ux & 0x7FFFFFFFu) == 0u || ux == 0x7F800000u) return uintBitsToFloat(ux);
-  if (ux > 0x7F800000u) return uintBitsToFloat(0x7FC00000u); // NaN or negative
-  ivec2 f = splitFloat(ux);
+  uint ex = ux & 0x7F800000u;
+  bool flush = ex == 0u;
+  ux = pickU(SIM_FLUSH_DENORMALS && flush, ux & 0x80000000u, ux); // a denormal reads as zero
+  // Zero and infinity are their own roots; a NaN or a negative number has none. The arithmetic
+  // runs on 1 instead.
+  uint magnitude = ux & 0x7FFFFFFFu;
+  bool zero = magnitude == 0u, inf = ux == 0x7F800000u, none = ux > 0x7F800000u;
+  bool itself = zero || inf;
+  bool special = itself || none;
+  uint answer = pickU(itself, ux, 0x7FC00000u);
+  ivec2 f = splitFloat(pickU(special, 0x3F800000u, ux));
   uint m = uint(f.x);
   // x = m 2^(e - 23); with an even exponent left over, sqrt(x) = sqrt(N) 2^(half - 23) where
   // N = m 2^(23 or 24) lies in [2^46, 2^48) and s = floor(sqrt(N)) in [2^23, 2^24)
   bool odd = (f.y & 1) != 0;
-  int half_exp = (f.y - (odd ? 1 : 0)) / 2;
-  float scaled = uintBitsToFloat(0x3F800000u | (m & 0x7FFFFFu)) * (odd ? 2.0f : 1.0f); // N / 2^46
+  int half_exp = (f.y - pickI(odd, 1, 0)) / 2;
+  float scaled = uintBitsToFloat(0x3F800000u | (m & 0x7FFFFFu)) * pickF(odd, 2.0f, 1.0f); // N / 2^46
   uint s = clamp(uint(deviceSqrt(scaled) * 8388608.0f), 0x800000u, 0xFFFFFFu);
   // r = N - s^2, exact modulo 2^32 and small; s is the floor when 0 <= r <= 2s
-  uint n = m << (odd ? 24u : 23u);
+  uint n = m << pickU(odd, 24u, 23u);
   int r = int(n - s * s);
   // s is off by a few units: an estimate of the step r / 2s (within one of it: |r / 2s| <= 5, and
-  // 1.5 - x / 2 is within 12 % of 1 / x on [1, 2), so no division), then one last step
+  // 1.5 - x / 2 is within 12 % of 1 / x on [1, 2), so no division), then one last step: below the
+  // floor, s - 1 leaves r + 2s - 1; above it, s + 1 leaves r - 2s - 1
   float inv_2s = (1.5f - 0.5f * float(s) * 1.1920929e-7f) * 5.9604645e-8f;
   s += uint(int(floor(float(r) * inv_2s)));
   r = int(n - s * s);
-  if (r < 0) {
-    s -= 1u;
-    r += int(2u * s + 1u);
-  } else if (r > int(2u * s)) {
-    r -= int(2u * s + 1u);
-    s += 1u;
-  }
+  bool low = r<0, high = r> int(2u * s);
+  int r_low = r + int(2u * s - 1u), r_high = r - int(2u * s + 1u);
+  r = pickI(low, r_low, pickI(high, r_high, r));
+  s = pickU(low, s - 1u, pickU(high, s + 1u, s));
   // sqrt(N) is never exactly half-way; it is above s + 1/2 when N > s^2 + s
-  return packRounded(0u, half_exp + 127, s, r > int(s) ? 1 : -1, r != 0);
+  bool beyond = r > int(s);
+  float result = packRounded(0u, half_exp + 127, s, pickI(beyond, 1, -1), r != 0);
+  return pickF(SIM_CORRECT_MATH, pickF(special, uintBitsToFloat(answer), result), deviceSqrt(x));
 }
 
 #ifdef __cplusplus
