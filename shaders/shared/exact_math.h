@@ -81,6 +81,13 @@ SIM_INLINE float deviceDiv(float a, float b) {
   return pickF(SIM_INEXACT_MATH && large && finite, off, q);
 }
 
+/// The bits of x, a denormal read as zero where denormals are flushed.
+SIM_INLINE uint inputBits(float x) {
+  uint bits = floatBitsToUint(x);
+  bool denormal = (bits & 0x7F800000u) == 0u;
+  return pickU(SIM_FLUSH_DENORMALS && denormal, bits & 0x80000000u, bits);
+}
+
 /// Significand (x: in [2^23, 2^24)) and unbiased exponent (y) of the finite non-zero float with
 /// magnitude bits `bits`; a denormal is normalised (with SIM_FLUSH_DENORMALS the callers have read
 /// it as zero, so there is none).
@@ -118,12 +125,7 @@ SIM_INLINE float packRounded(uint sign, int biased, uint q, int above, bool inex
 
 /// Correctly rounded a / b (round to nearest even, denormals kept) on any device.
 SIM_INLINE float exactDiv(float a, float b) {
-  uint ua = floatBitsToUint(a), ub = floatBitsToUint(b);
-  // Denormal inputs read as zero where denormals are flushed
-  uint ea = ua & 0x7F800000u, eb = ub & 0x7F800000u;
-  bool flush_a = ea == 0u, flush_b = eb == 0u;
-  ua = pickU(SIM_FLUSH_DENORMALS && flush_a, ua & 0x80000000u, ua);
-  ub = pickU(SIM_FLUSH_DENORMALS && flush_b, ub & 0x80000000u, ub);
+  uint ua = inputBits(a), ub = inputBits(b);
   uint sign = (ua ^ ub) & 0x80000000u;
   uint xa = ua & 0x7FFFFFFFu, xb = ub & 0x7FFFFFFFu;
   // Zero, infinity and NaN give their answer at the end; the arithmetic runs on 1 / 1 instead
@@ -165,10 +167,7 @@ SIM_INLINE float exactDiv(float a, float b) {
 
 /// Correctly rounded sqrt(x) (round to nearest even, denormals kept) on any device.
 SIM_INLINE float exactSqrt(float x) {
-  uint ux = floatBitsToUint(x);
-  uint ex = ux & 0x7F800000u;
-  bool flush = ex == 0u;
-  ux = pickU(SIM_FLUSH_DENORMALS && flush, ux & 0x80000000u, ux); // a denormal reads as zero
+  uint ux = inputBits(x);
   // Zero and infinity are their own roots; a NaN or a negative number has none. The arithmetic
   // runs on 1 instead.
   uint magnitude = ux & 0x7FFFFFFFu;
