@@ -251,9 +251,9 @@ TEST_F(Parity, FusedTickInTheShapesOfBothKindsOfDevice) {
     bool fused_on_cpu_device;
   };
   const Case cases[] = {
-      {cloth({"wind=on"}), "0 grab particle 1535\n1 move 6 -5 6\n25 release\n", true},
+      {cloth({"wind=on"}), "0 grab particle 1535\n1 move 6 -5 6\n12 release\n", true},
       // just under the CPU device's cell limit (0.72): the densest buckets it fuses
-      {cloth({"cell_size=0.7", "wind=on"}), "0 grab particle 1535\n1 move 6 -5 6\n25 release\n", true},
+      {cloth({"cell_size=0.7", "wind=on"}), "0 grab particle 1535\n1 move 6 -5 6\n12 release\n", true},
       {cloth({"cols=24", "rows=30", "cell_size=1.8", "wind=on"}), "0 grab particle 719\n1 move 2 3 1\n", false},
       // the air pass first in every substep (without contact: its work in the workgroup, a whole
       // tick in one dispatch, runs past lavapipe's loop count, bench/README.md "Fused small sheets")
@@ -269,7 +269,7 @@ TEST_F(Parity, FusedTickInTheShapesOfBothKindsOfDevice) {
       const bool fused = gpu.usesFusedPath(gpu_sim.makeUniforms());
       ASSERT_EQ(fused, gpu_like || c.fused_on_cpu_device);
       gpu_sim.setScript(script(c.script));
-      SimState got = run(gpu_sim, 40);
+      SimState got = run(gpu_sim, 20);
       const uint32_t dispatches = gpu.dispatchesPerTick();
       if (fused) {
         EXPECT_EQ(dispatches, gpu_like ? 1u : p.substeps);
@@ -277,9 +277,9 @@ TEST_F(Parity, FusedTickInTheShapesOfBothKindsOfDevice) {
       CpuSolver cpu;
       Simulation cpu_sim(p, cpu);
       cpu_sim.setScript(script(c.script));
-      SimState ref = run(cpu_sim, 40);
+      SimState ref = run(cpu_sim, 20);
       const uint32_t torn = tornCount(ref);
-      std::printf("%s shape, %ux%u, cell %.2f, %u dispatches/tick, 40 ticks: torn %u\n",
+      std::printf("%s shape, %ux%u, cell %.2f, %u dispatches/tick, 20 ticks: torn %u\n",
                   gpu_like ? "GPU" : "CPU-device", p.cols, p.rows, p.cell_size, dispatches, torn);
       EXPECT_GT(torn, 0u);
       EXPECT_TRUE(sameState(ref, got));
