@@ -408,7 +408,7 @@ void Parity::checkCandidateLists(const SimParams& p, bool fused, bool expect_ent
   std::memcpy(&search_bits, &search, 4);
   int whole_ticks_on_lists = 0, checked = 0;
   size_t entries = 0;
-  const int ticks = 90;
+  const int ticks = 46; // four checks
   for (int t = 0; t < ticks; ++t) {
     run(sim, 1);
     run(ref, 1);
