@@ -293,7 +293,7 @@ TEST_F(Parity, ContactListsStandWhileTheGpuPathsTakeTurns) {
   const SimParams p = preset(
       "crumple", {"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9", "contact_factor=0.5", "collision=off"});
   const std::string text = "0 grab particle 102\n1 move 0 -8.8 -1.2\n4 squeeze 0.5\n12 squeeze 1\n";
-  constexpr int kSettle = 120, kTurns = 30;
+  constexpr int kSettle = 60, kTurns = 30;
   CpuSolver cpu;
   Simulation a(p, cpu);
   a.setScript(script(text.c_str()));
