@@ -148,7 +148,7 @@ TEST_F(Parity, SameGpuRunTwiceIsBitwiseIdentical) {
     gpu::GpuSolver gpu(ctx());
     Simulation sim(p, gpu);
     sim.setScript(script(text));
-    return run(sim, 30);
+    return run(sim, 20);
   };
   SimState a = once(), b = once();
   EXPECT_EQ(hashPositions(a.pos), hashPositions(b.pos));
