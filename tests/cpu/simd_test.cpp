@@ -316,10 +316,10 @@ TEST(SimdSimulation, TearingYankIsIdenticalWithoutSimd) {
 
 TEST(SimdSimulation, CrumpleTossIsIdenticalWithoutSimd) {
   const std::string toss = "0 grab particle 100\n1 move 1 2 3\n10 release\n";
-  const SimState reference = test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 30, kScalarOne);
-  test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 30, kSimdOne));
-  test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 30, kSimdTwo));
-  test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 30, kScalarTwo));
+  const SimState reference = test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 20, kScalarOne);
+  test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 20, kSimdOne));
+  test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 20, kSimdTwo));
+  test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 20, kScalarTwo));
 }
 
 TEST(SimdSimulation, TheShortenStageIsIdenticalWithoutSimd) {
@@ -328,9 +328,9 @@ TEST(SimdSimulation, TheShortenStageIsIdenticalWithoutSimd) {
   // left to tear) and let go
   const std::string toss = "0 grab particle 100\n1 move 1 2 3\n10 release\n";
   const std::vector<std::string> crumple = {"cols=37", "rows=53", "pins=none"};
-  const SimState reference = test::runCpu("crumple", crumple, toss, 30, kScalarOne);
-  test::expectIdentical(reference, test::runCpu("crumple", crumple, toss, 30, kSimdOne));
-  test::expectIdentical(reference, test::runCpu("crumple", crumple, toss, 30, kSimdTwo));
+  const SimState reference = test::runCpu("crumple", crumple, toss, 20, kScalarOne);
+  test::expectIdentical(reference, test::runCpu("crumple", crumple, toss, 20, kSimdOne));
+  test::expectIdentical(reference, test::runCpu("crumple", crumple, toss, 20, kSimdTwo));
   const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n12 release\n";
   const std::vector<std::string> tender = {"pins=none", "stretch_limit=1.01", "tear_factor=1.5"};
   const SimState torn = test::runCpu("tender", tender, yank, 30, kScalarOne);
