@@ -32,6 +32,8 @@
 #define SIM_SPEC_INEXACT_MATH 1
 #define SIM_SPEC_CORRECT_MATH 2
 #define SIM_SPEC_FLUSH_DENORMALS 3
+// ... and the particles the fused tick holds in shared memory (fusedCapacity in sim_pipeline.h)
+#define SIM_SPEC_FUSED_CAPACITY 4
 // Largest number of substeps per tick (per-substep inputs are arrays of this size)
 #define SIM_MAX_SUBSTEPS 32
 // Largest number of constraint colours
@@ -200,10 +202,11 @@
 // flat sheet holds about (cell / spacing)^2 of them: bigger cells could use up lavapipe's loop
 // count within one substep (the presets use 2.5; the per-colour passes stay within it at any size)
 #define SIM_FUSED_CPU_MAX_CELL_SPACINGS 4.0f
-// Largest sheet the fused tick takes: its positions fill 32 KiB of shared memory (vec4 each)
-#define SIM_FUSED_MAX_PARTICLES 2048
-// Largest hash table the fused tick takes (one workgroup scans it every substep)
-#define SIM_FUSED_MAX_BUCKETS 4096u
+// Largest sheet the fused tick takes on any device: it keeps the positions in shared memory (a
+// vec4 each), so a device takes as many particles as its shared memory holds, up to this
+// (SIM_SPEC_FUSED_CAPACITY: lavapipe's 32 KiB hold 2,048, NVIDIA's 48 KiB 3,072, 64 KiB 4,096).
+// The hash table it scans every substep in one workgroup has at most twice as many buckets.
+#define SIM_FUSED_MAX_PARTICLES 4096u
 
 // Candidate lists of the fused tick (SIM_BIND_CANDIDATES): for each particle, the particles not
 // connected to it within collision radius + skin when the lists were built (SIM_BIND_CANDIDATE_BASE

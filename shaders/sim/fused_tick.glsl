@@ -12,7 +12,9 @@
 #define SIM_COHERENT coherent
 #define SIM_PUSH_TYPE FusedPush
 #include "sim_common.glsl"
-shared vec4 s_pos[SIM_FUSED_MAX_PARTICLES];
+// As many positions as the device's shared memory holds (specialised: fusedCapacity)
+layout(constant_id = SIM_SPEC_FUSED_CAPACITY) const uint kFusedCapacity = 1u;
+shared vec4 s_pos[kFusedCapacity];
 #define SIM_POSITION(j) s_pos[j]
 #include "sim_elements.glsl"
 #ifdef SIM_FUSED_CONTACT

@@ -84,8 +84,8 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
   VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &layout_));
   float_rules_ = floatRulesFor(ctx_.floatControls());
   math_ = MathSwitches::fromEnvironment();
-  // The fused tick's shape on this kind of device (see FusedShape in gpu_solver.h); a device with
-  // too little shared memory for it runs every sheet's per-colour passes, as a sheet alone does.
+  // The fused tick's shape on this kind of device (see FusedShape in gpu_solver.h); a sheet larger
+  // than its capacity (fusedCapacity) runs the per-colour passes, as it does alone.
   const bool cpu_device = ctx_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   const FusedShape shape = resolveFusedShape(ctx_, fused, true);
   substeps_per_dispatch_ = shape.substeps_per_dispatch;
@@ -106,9 +106,8 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
     VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &sheet_layout_));
     if (per_sheet_) sheet_passes_ = makePassPipelines(ctx_, {sheet_layout_, "sheet"}, float_rules_, math_, false);
   }
-  if (fusedTickSupported(ctx_))
-    tick_batch_ = makeComputePipeline(ctx_, "tick_batch.comp", {layout_, "batch"}, float_rules_, math_,
-                                      sizeof(BatchPush), 1, shape.workgroup, true);
+  tick_batch_ = makeComputePipeline(ctx_, "tick_batch.comp", {layout_, "batch"}, float_rules_, math_, sizeof(BatchPush),
+                                    1, shape.workgroup, true);
 
   VkFenceCreateInfo fci{};
   fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;

@@ -1,6 +1,7 @@
 #include "gpu_solver.h"
 
 #include <algorithm>
+#include <bit>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -69,8 +70,7 @@ void GpuSolver::createPipelines(FusedShape fused) {
   fused_contact_ = shape.contact > 0;
   // The per-colour passes, the fused tick and the picks, made together (contact's wait for contact)
   std::vector<PipelineRequest> requests = passPipelineRequests(ctx_, pipes_, false);
-  if (fusedTickSupported(ctx_))
-    requests.push_back({&pipes_.tick_fused, "tick_fused.comp", sizeof(FusedPush), 1, fused_workgroup, true});
+  requests.push_back({&pipes_.tick_fused, "tick_fused.comp", sizeof(FusedPush), 1, fused_workgroup, true});
   for (uint32_t s = 0; s < 3; ++s) requests.push_back({&pipes_.pick[s], "pick.comp", sizeof(PickPush), 1, s, false});
   makeComputePipelines(ctx_, {layout_, "solver"}, float_rules_, math_, requests);
 
@@ -285,10 +285,6 @@ FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested, boo
   return shape;
 }
 
-bool fusedTickSupported(const VulkanContext& ctx) {
-  return ctx.properties().limits.maxComputeSharedMemorySize >= 16u * SIM_FUSED_MAX_PARTICLES;
-}
-
 float structuralSpacing(const SheetTopology& topo) {
   float spacing = std::numeric_limits<float>::max();
   for (const Constraint& k : topo.constraints)
@@ -296,8 +292,8 @@ float structuralSpacing(const SheetTopology& topo) {
   return spacing;
 }
 
-bool fusedTickFits(const SheetTopology& topo) {
-  return topo.particleCount() <= SIM_FUSED_MAX_PARTICLES && topo.hash_size <= SIM_FUSED_MAX_BUCKETS;
+bool fusedTickFits(const SheetTopology& topo, uint32_t capacity) {
+  return topo.particleCount() <= capacity && topo.hash_size <= 2u * std::bit_ceil(capacity);
 }
 
 bool fusedTickTakes(const SimUniforms& u, float spacing, float max_cell_spacings) {
@@ -305,7 +301,9 @@ bool fusedTickTakes(const SimUniforms& u, float spacing, float max_cell_spacings
   return u.inv_cell * max_cell_spacings * spacing >= 1.0f;
 }
 
-bool GpuSolver::usesFusedPath() const { return fused_allowed_ && pipes_.tick_fused.pipeline && fusedTickFits(topo_); }
+bool GpuSolver::usesFusedPath() const {
+  return fused_allowed_ && pipes_.tick_fused.pipeline && fusedTickFits(topo_, fusedCapacity(ctx_));
+}
 
 bool GpuSolver::usesFusedPath(const SimUniforms& u) const {
   return usesFusedPath() && fusedTickTakes(u, spacing_, fused_max_cell_spacings_);

@@ -39,15 +39,12 @@ struct FusedShape {
 /// sets, the device's kind's values for the rest.
 FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested = {}, bool fleet = false);
 
-/// True when the device has the shared memory the fused tick keeps its positions in.
-bool fusedTickSupported(const VulkanContext& ctx);
-
 /// The grid spacing of a topology: its shortest structural rest length.
 float structuralSpacing(const SheetTopology& topo);
 
-/// True when a sheet of this topology is small enough for the fused tick: at most
-/// SIM_FUSED_MAX_PARTICLES particles and SIM_FUSED_MAX_BUCKETS hash buckets.
-bool fusedTickFits(const SheetTopology& topo);
+/// True when a sheet of this topology is small enough for the fused tick of a device that holds
+/// `capacity` particles (fusedCapacity): at most that many, and at most twice as many hash buckets.
+bool fusedTickFits(const SheetTopology& topo, uint32_t capacity);
 /// True when a tick with these uniforms, of a sheet of grid spacing `spacing` that fits the fused
 /// tick, takes it on a device whose fused tick takes hash cells of at most `max_cell_spacings`
 /// spacings (< 0: any) when collision is on.
@@ -105,9 +102,8 @@ public:
   void readHash(std::vector<uint32_t>& cell_start, std::vector<uint32_t>& cell_particles);
   /// The buffer of a binding (SIM_BIND_*), for tests and tools.
   const Buffer& buffer(uint32_t binding) const { return buf_[binding]; }
-  /// Allows (default) or forbids the fused small-sheet tick; it is used when allowed, the device
-  /// supports it, the sheet has at most SIM_FUSED_MAX_PARTICLES particles and its hash table at
-  /// most SIM_FUSED_MAX_BUCKETS buckets.
+  /// Allows (default) or forbids the fused small-sheet tick; it is used when allowed and the sheet
+  /// fits it on this device (fusedTickFits).
   void setFusedPath(bool allowed) { fused_allowed_ = allowed; }
   /// True when the sheet is small enough for the fused small-sheet tick (and it is allowed).
   bool usesFusedPath() const;

@@ -42,12 +42,16 @@ VkPipeline createSimPipeline(VulkanContext& ctx, std::string_view key, VkPipelin
   mi.pCode = code.data();
   VK_CHECK(vkCreateShaderModule(ctx.device(), &mi, nullptr, &module));
   // exact_math.h flushes denormals as the rest of the arithmetic does (FloatRules), on every device
-  const uint32_t values[4] = {spec0.value_or(0u), math.inexact ? VK_TRUE : VK_FALSE,
-                              math.corrected ? VK_TRUE : VK_FALSE, VK_TRUE};
-  const VkSpecializationMapEntry entries[4] = {
-      {0, 0, 4}, {SIM_SPEC_INEXACT_MATH, 4, 4}, {SIM_SPEC_CORRECT_MATH, 8, 4}, {SIM_SPEC_FLUSH_DENORMALS, 12, 4}};
-  // Constant 0 only where the pass has one; the math switches everywhere (a shader without them ignores them)
-  VkSpecializationInfo spec{spec0 ? 4u : 3u, spec0 ? entries : entries + 1, sizeof(values), values};
+  const uint32_t values[5] = {spec0.value_or(0u), math.inexact ? VK_TRUE : VK_FALSE,
+                              math.corrected ? VK_TRUE : VK_FALSE, VK_TRUE, fusedCapacity(ctx)};
+  const VkSpecializationMapEntry entries[5] = {{0, 0, 4},
+                                               {SIM_SPEC_INEXACT_MATH, 4, 4},
+                                               {SIM_SPEC_CORRECT_MATH, 8, 4},
+                                               {SIM_SPEC_FLUSH_DENORMALS, 12, 4},
+                                               {SIM_SPEC_FUSED_CAPACITY, 16, 4}};
+  // Constant 0 only where the pass has one; the math switches and the fused tick's capacity
+  // everywhere (a shader without them ignores them)
+  VkSpecializationInfo spec{spec0 ? 5u : 4u, spec0 ? entries : entries + 1, sizeof(values), values};
   VkComputePipelineCreateInfo ci{};
   ci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
   ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
@@ -175,6 +179,14 @@ constexpr PipelineSpec kPasses[] = {
 bool isContactKernel(const PipelineSpec& spec) { return std::string_view(spec.key).starts_with("contact_"); }
 
 } // namespace
+
+uint32_t fusedCapacity(uint32_t shared_memory) {
+  return std::min(shared_memory / uint32_t(sizeof(float) * 4), uint32_t(SIM_FUSED_MAX_PARTICLES));
+}
+
+uint32_t fusedCapacity(const VulkanContext& ctx) {
+  return fusedCapacity(ctx.properties().limits.maxComputeSharedMemorySize);
+}
 
 uint32_t limitWorkgroup(const VulkanContext& ctx) {
   const VkPhysicalDeviceLimits& limits = ctx.properties().limits;

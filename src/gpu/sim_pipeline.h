@@ -47,7 +47,7 @@ struct SimPipelines {
 #define SIM_KERNEL_MEMBER(name, push, per_invocation, batched) ComputePipeline name;
   SIM_KERNELS(SIM_KERNEL_MEMBER)
 #undef SIM_KERNEL_MEMBER
-  ComputePipeline tick_fused;         ///< null when the device has under 32 KiB of shared memory
+  ComputePipeline tick_fused;         ///< the fused tick of sheets up to fusedCapacity
   ComputePipeline tick_fused_contact; ///< the fused tick with contact (addContactPipelines)
   std::array<ComputePipeline, 3> pick;
 };
@@ -83,6 +83,13 @@ struct PipelineRequest {
 /// the first error is thrown after every other has been made.
 void makeComputePipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
                           std::span<PipelineRequest> requests);
+
+/// Particles the fused tick holds in `shared_memory` bytes of shared memory (a vec4 each), at most
+/// SIM_FUSED_MAX_PARTICLES: the largest sheet it takes (specialization constant
+/// SIM_SPEC_FUSED_CAPACITY of every pipeline).
+uint32_t fusedCapacity(uint32_t shared_memory);
+/// ... on this device (its maxComputeSharedMemorySize).
+uint32_t fusedCapacity(const VulkanContext& ctx);
 
 /// Invocations of the stretch limit's workgroup (limit.comp) on this device: SIM_WG_LIMIT on a CPU
 /// device, SIM_WG_LIMIT_GPU (or the device's most) on a GPU.

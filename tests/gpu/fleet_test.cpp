@@ -1,6 +1,7 @@
 // A fleet on the GPU: one dispatch ticks every sheet the fused tick takes, one dispatch per pass
 // the others, and each sheet ends bitwise where the same sheet ends run alone on the GPU solver.
 #include <algorithm>
+#include <string>
 #include <thread>
 
 #include "common/fleet_cases.h"
@@ -108,7 +109,14 @@ TEST_F(GpuBatchTest, ContactSheetsMatchTheCpuReference) {
 
 // The per-colour passes of sheets the fused tick does not take, both ways: batched (a GPU's
 // default) and sheet by sheet (a CPU device's)
-class GpuBatchPasses : public GpuTest, public testing::WithParamInterface<gpu::BatchPasses> {};
+class GpuBatchPasses : public GpuTest, public testing::WithParamInterface<gpu::BatchPasses> {
+protected:
+  /// At least `rows` rows, and enough that a sheet of `cols` columns is too large for this device's
+  /// fused tick (lavapipe holds 2,048 particles, NVIDIA's 48 KiB 3,072: fusedCapacity)
+  uint32_t rowsPastTheFusedTick(uint32_t cols, uint32_t rows) {
+    return std::max(rows, gpu::fusedCapacity(ctx()) / cols + 1);
+  }
+};
 
 TEST_P(GpuBatchPasses, AFlushRunsFusedAndPerColourSheetsTogether) {
   // Sheet 5 has hash cells of 5 spacings: a CPU device's fused tick does not take it, so alone
@@ -129,24 +137,24 @@ TEST_P(GpuBatchPasses, AFlushRunsFusedAndPerColourSheetsTogether) {
 }
 
 TEST_P(GpuBatchPasses, SheetsTooLargeForTheFusedTickMatchTheCpuReference) {
-  // 48 x 48: over SIM_FUSED_MAX_PARTICLES. Batched, each pass is one dispatch for every sheet and
+  // 48 x 48 (or more rows): over the fused tick's capacity. Batched, each pass is one dispatch for every sheet and
   // a gate picks the sheets that run it (substeps, iterations, air, collision, hash, tears, reset).
   // Seven sheets: a yank (1, 5), a reset (2, 6), a ray grab (3), tearing off (3), stiff against
   // tearing (2), collision off (4), air (1, 6), 6 to 8 substeps, 3 or 4 iterations. 21 ticks: to
   // the ray grab's release (tick 20), after the resets (15).
-  const std::vector<FleetSheet> sheets = mixedFleet(7, 48, 48);
+  const std::vector<FleetSheet> sheets = mixedFleet(7, 48, rowsPastTheFusedTick(48, 48));
   gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
   EXPECT_EQ(batch.passesPerSheet(), GetParam() == gpu::BatchPasses::PerSheet);
   CpuSolver alone;
   const uint32_t tore = expectFleetMatchesAlone(batch, alone, sheets, 21);
-  EXPECT_FALSE(gpu::fusedTickFits(buildSheet(sheets[0].params)));
+  EXPECT_FALSE(gpu::fusedTickFits(buildSheet(sheets[0].params), gpu::fusedCapacity(ctx())));
   EXPECT_GT(tore, 0u);
   EXPECT_LT(tore, sheets.size());
 }
 
 TEST_P(GpuBatchPasses, LargeContactSheetsMatchTheirRunsAlone) {
   // Sheet 1 has contact on, sheet 0 not: batched, the contact passes' gates take sheet 1 alone
-  const std::vector<FleetSheet> sheets = withContact(mixedFleet(2, 40, 52));
+  const std::vector<FleetSheet> sheets = withContact(mixedFleet(2, 40, rowsPastTheFusedTick(40, 52)));
   gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
   CpuSolver alone;
   expectFleetMatchesAlone(batch, alone, sheets, 8);
@@ -155,7 +163,7 @@ TEST_P(GpuBatchPasses, LargeContactSheetsMatchTheirRunsAlone) {
 // Without the candidate lists (the switch the solver and the fleet both honour), every substep with
 // collision builds the hash, in a fleet as alone.
 TEST_P(GpuBatchPasses, WithoutCandidateListsSheetsMatchTheirRunsAlone) {
-  const std::vector<FleetSheet> sheets = mixedFleet(3, 48, 48);
+  const std::vector<FleetSheet> sheets = mixedFleet(3, 48, rowsPastTheFusedTick(48, 48));
   gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
   batch.setCandidateLists(false);
   gpu::GpuSolver alone(ctx());
@@ -166,7 +174,8 @@ TEST_P(GpuBatchPasses, WithoutCandidateListsSheetsMatchTheirRunsAlone) {
 TEST_P(GpuBatchPasses, LargeSheetsRecordTheDispatchesOfOneSheetPerPassOrPerSheet) {
   // Five sheets of one size: batched, the passes one of them records alone; sheet by sheet, five
   // times those
-  const SimParams p = cloth({"cols=48", "rows=48"});
+  const std::string rows = "rows=" + std::to_string(rowsPastTheFusedTick(48, 48));
+  const SimParams p = cloth({"cols=48", rows.c_str()});
   gpu::GpuBatch batch(ctx(), 5, GetParam());
   Fleet fleet(batch, std::vector<FleetSheet>(5, FleetSheet{p, {}}));
   gpu::GpuSolver alone(ctx());
