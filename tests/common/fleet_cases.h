@@ -33,7 +33,6 @@ inline std::vector<FleetSheet> mixedFleet(uint32_t count, uint32_t cols = 12, ui
     std::vector<std::string> sets = {
         "cols=" + std::to_string(cols),
         "rows=" + std::to_string(rows),
-        "contact_factor=0", // the seeds' cloth (fleets with contact: ContactSheetsMatchTheCpuReference)
         "spacing=0.16",
         std::string("pins=") + kPins[i % 3],
         std::string("wind_kind=") + (i % 2 ? "noise" : "sinusoid"),
@@ -57,16 +56,16 @@ inline std::vector<FleetSheet> mixedFleet(uint32_t count, uint32_t cols = 12, ui
                                                             : "1.05"),
     };
     FleetSheet s;
-    s.params = preset("tender", sets);
+    s.params = withSets(SimParams{}, sets); // the seeds' cloth (with contact: withContact in fleet_test.cpp)
     s.script = script(kScripts[i % 4]);
     sheets.push_back(std::move(s));
   }
   return sheets;
 }
 
-/// A fleet of `count` sheets of paper: the `crumple` preset's 12 x 16 sheet (hinges, creases, the
-/// stretch limit) lying on its floor, free or pinned at its corners, folded, crumpled by the hand
-/// and yanked; or, with `receipt`, the `paper` preset's receipt falling through the air and folded.
+/// A fleet of `count` sheets of paper without contact: paperSheet's paper on a 12 x 16 sheet (hinges,
+/// creases, the stretch limit) lying on its floor, free or pinned at its corners, folded, crumpled
+/// by the hand and yanked; or, with `receipt`, receiptSheet falling through the air and folded.
 inline std::vector<FleetSheet> paperFleet(uint32_t count, bool receipt = false) {
   static const char* kSheetScripts[] = {
       "",
@@ -89,7 +88,6 @@ inline std::vector<FleetSheet> paperFleet(uint32_t count, bool receipt = false) 
                                                       : "1.01"),
         "crease_hardening=" + std::to_string(0.25 * (i % 3)),
         "iterations=" + std::to_string(3 + i % 2),
-        "contact_factor=0", // (fleets with contact: ContactSheetsMatchTheCpuReference)
     };
     if (receipt) {
       sets.push_back(std::string("air=") + (i % 5 == 4 ? "off" : "on"));
@@ -100,7 +98,7 @@ inline std::vector<FleetSheet> paperFleet(uint32_t count, bool receipt = false) 
       sets.push_back(std::string("tear_factor=") + (i % 6 == 5 ? "0" : "2.5"));
     }
     FleetSheet s;
-    s.params = preset(receipt ? "paper" : "crumple", sets);
+    s.params = withSets(receipt ? receiptSheet() : paperSheet(), sets); // without contact
     s.script = script(receipt ? kReceiptScripts[i % 2] : kSheetScripts[i % 4]);
     sheets.push_back(std::move(s));
   }

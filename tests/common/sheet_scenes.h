@@ -16,12 +16,17 @@ namespace tender::test {
 /// Degrees a radian.
 inline constexpr double kDeg = 180.0 / 3.14159265358979323846;
 
-/// A sheet of `name` laid flat on its floor (rows running back along -z), with overrides.
-inline SimParams flatSheet(const char* name, std::vector<std::string> sets) {
+/// Sheet `base` laid flat on its floor (rows running back along -z), with overrides.
+inline SimParams flatSheet(const SimParams& base, std::vector<std::string> sets) {
   sets.insert(sets.begin(), {"tilt=90", "pins=none", "wind=off"});
-  SimParams p = preset(std::string(name), sets);
+  SimParams p = withSets(base, sets);
   p.top_y = p.floor_y + 0.5f * p.spacing; // a top_y != 0 places the flat sheet there
   return p;
+}
+
+/// A sheet of preset `name` laid flat on its floor, with overrides.
+inline SimParams flatSheet(const char* name, std::vector<std::string> sets) {
+  return flatSheet(*presetParams(name), std::move(sets));
 }
 
 /// A fold in half and back at a hand's pace: the middle of the sheet's last row is carried over

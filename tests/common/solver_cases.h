@@ -162,7 +162,7 @@ TYPED_TEST_P(SolverCase, NoNaNUnderWindAndCollision) {
 TYPED_TEST_P(SolverCase, TwoRunsAreBitwiseIdentical) {
   auto once = [this] {
     auto solver = this->make();
-    Simulation sim(preset("crumple", {"wind=on", "cols=20", "rows=30", "contact_factor=0"}), *solver);
+    Simulation sim(paperSheet({"wind=on", "cols=20", "rows=30"}), *solver);
     sim.setScript(script("0 grab particle 599\n1 move 5 -6 5\n20 release\n40 grab particle 300\n41 move 0 0 3\n"));
     return run(sim, 80);
   };
@@ -205,9 +205,9 @@ TYPED_TEST_P(SolverCase, PauseFreezesTheState) {
 
 TYPED_TEST_P(SolverCase, AccumulatorClampsFrameTime) {
   auto solver = this->make();
-  Simulation sim(preset("tender-low", {"contact_factor=0"}), *solver);
-  EXPECT_EQ(sim.advance(1.0f / 60.0f), 2); // two 120 Hz ticks in a 60 Hz frame
-  EXPECT_EQ(sim.advance(5.0f), 3);         // 5 s clamps to 33 ms: three ticks, remainder kept
+  Simulation sim(cloth({"cols=24", "rows=36", "spacing=0.24260871"}), *solver); // 120 Hz
+  EXPECT_EQ(sim.advance(1.0f / 60.0f), 2);                                      // two 120 Hz ticks in a 60 Hz frame
+  EXPECT_EQ(sim.advance(5.0f), 3); // 5 s clamps to 33 ms: three ticks, remainder kept
   EXPECT_EQ(sim.physicsTicks(), 5u);
 }
 

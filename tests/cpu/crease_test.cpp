@@ -179,9 +179,9 @@ FoldResult foldAndUnfold(const SimParams& p, double rest_s = 5.0, double carry_s
 
 TEST(Crease, AFoldLeavesACreaseInPaper) {
   TENDER_ONE_THREAD_TEST();
-  // (The crease tests and the limit's scenes below name contact off: their subject is the hinges
-  // and the rings; contact's own tests and the stretch test run the presets' contact.)
-  const SimParams crumple = flatSheet("crumple", {"cols=20", "rows=30", "contact_factor=0"});
+  // (The crease tests and the limit's scenes below are paper without contact: their subject is the
+  // hinges and the rings; contact's own tests and the stretch test run the presets' contact.)
+  const SimParams crumple = flatSheet(paperSheet(), {"cols=20", "rows=30"});
   const FoldResult r = foldAndUnfold(crumple);
   EXPECT_EQ(r.nans, 0u);
   EXPECT_GE(r.fold_line_deg, 20.0);
@@ -191,7 +191,7 @@ TEST(Crease, AFoldLeavesACreaseInPaper) {
   // The receipt: a fold held by its edge alone (nothing presses it) creases its hinges by some 30
   // degrees; on the floor its 15 cm halves, three times paper's elastic length (D / rho g)^(1/3) =
   // 5 cm, lie flat and open the crease to a few degrees.
-  const FoldResult receipt = foldAndUnfold(flatSheet("paper", {"contact_factor=0"}));
+  const FoldResult receipt = foldAndUnfold(flatSheet(receiptSheet(), {}));
   EXPECT_EQ(receipt.nans, 0u);
   EXPECT_GE(receipt.crease_deg, 20.0);
   EXPECT_GE(receipt.fold_line_deg, 4.0);
@@ -216,9 +216,8 @@ TEST(Crease, CreasesDoNotDependOnTheIterationCount) {
   // stiffness, which shapes the fold a little
   FoldResult r[2];
   for (int k = 0; k < 2; ++k)
-    r[k] = foldAndUnfold(
-        flatSheet("crumple", {"cols=20", "rows=30", k == 0 ? "iterations=4" : "iterations=16", "contact_factor=0"}),
-        0.5, 3.0);
+    r[k] = foldAndUnfold(flatSheet(paperSheet(), {"cols=20", "rows=30", k == 0 ? "iterations=4" : "iterations=16"}),
+                         0.5, 3.0);
   EXPECT_GE(r[0].crease_deg, 15.0);
   EXPECT_NEAR(r[0].crease_sum_deg, r[1].crease_sum_deg, 0.05 * r[1].crease_sum_deg);
   EXPECT_NEAR(r[0].crease_deg, r[1].crease_deg, 6.0);
@@ -228,7 +227,7 @@ TEST(Crease, WindCreasesNothing) {
   TENDER_ONE_THREAD_TEST();
   // The crumple sheet hanging from its corners in ten seconds of strong wind
   CpuSolver solver;
-  const SimParams p = preset("crumple", {"cols=20", "rows=30", "wind=on", "wind_strength=3", "contact_factor=0"});
+  const SimParams p = paperSheet({"cols=20", "rows=30", "wind=on", "wind_strength=3"});
   Simulation sim(p, solver);
   const SimState s = run(sim, int(10 * p.tick_hz));
   const SheetStats st = computeStats(s, p.substepDt());

@@ -72,7 +72,7 @@ TEST(Stretch, TheHandDragsFoldsAndCrumplesPaperWithinThreePercent) {
   }
   // Without it (and without the contact, whose cut holds edges back) the projection's iterations
   // leave a quarter of the drag's stretch
-  SimParams loose = flatSheet("crumple", {"stretch_limit=0", "contact_factor=0"});
+  SimParams loose = flatSheet(paperSheet(), {"stretch_limit=0"});
   const auto [drag, drag_ticks] = dragScript(loose);
   const float most = mostStretch(loose, drag, drag_ticks);
   std::printf("crumple without the limit: most stretch drag %.4f\n", double(most));
@@ -228,9 +228,9 @@ TEST(Stretch, ASheetHangingFromItsPinsHoldsTheLimitAtEachPin) {
   // three pins: the rings run from every pin, so the edges at each are held too (rings from the
   // sheet's middle left those at the pins to the projection alone: 1.54)
   for (const char* pins : {"pins=corners", "pins=top3"}) {
-    const SimParams base = preset("crumple", {"contact_factor=0"});
+    const SimParams base = paperSheet();
     const float scale = float(base.cols - 1) / 127.0f;
-    SimParams p = preset("crumple", {"cols=128", "rows=192", pins, "contact_factor=0"});
+    SimParams p = paperSheet({"cols=128", "rows=192", pins});
     p.spacing = base.spacing * scale;
     p.cell_size = base.cell_size * scale;
     const float most = mostStretch(p, "", 30);
@@ -242,7 +242,7 @@ TEST(Stretch, ASheetHangingFromItsPinsHoldsTheLimitAtEachPin) {
 TEST(Stretch, AHeldSheetYankedTearsAndALyingOneIsLeftAlone) {
   // The sheet hanging from its corners, its bottom middle yanked down at 20 sheet lengths a second:
   // the limit draws the sheet after the hand, the pins hold their corners, and the paper tears
-  const SimParams p = preset("crumple", {"cols=12", "rows=16", "wind=off", "contact_factor=0"});
+  const SimParams p = paperSheet({"cols=12", "rows=16"});
   const uint32_t bottom = (p.rows - 1) * p.cols + p.cols / 2;
   CpuSolver solver;
   Simulation sim(p, solver);
@@ -261,8 +261,8 @@ TEST(Stretch, AHeldSheetYankedTearsAndALyingOneIsLeftAlone) {
   // A sheet lying on its floor stretches no edge past the limit: the limit leaves every bit alone
   uint64_t hash[2] = {};
   for (int k = 0; k < 2; ++k) {
-    const SimParams q = flatSheet(
-        "crumple", {"cols=12", "rows=16", k == 0 ? "stretch_limit=0" : "stretch_limit=1.01", "contact_factor=0"});
+    const SimParams q =
+        flatSheet(paperSheet(), {"cols=12", "rows=16", k == 0 ? "stretch_limit=0" : "stretch_limit=1.01"});
     CpuSolver cpu;
     Simulation rest(q, cpu);
     hash[k] = computeStats(run(rest, 60), q.substepDt()).state_hash;

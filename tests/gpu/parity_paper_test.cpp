@@ -31,8 +31,7 @@ TEST_F(Parity, TheTenderPresetWithContactTearsTheSameOnTheGpu) {
 TEST_F(Parity, CreasesAreTheSameOnEveryPath) {
   // A sheet laid flat, its far edge lifted over and pressed down: the hinges crease, and their rest
   // angles, yields and multipliers hold the same bits on the CPU and both GPU paths.
-  SimParams p = preset(
-      "crumple", {"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9", "crease_yield=5", "contact_factor=0"});
+  SimParams p = paperSheet({"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9", "crease_yield=5"});
   std::string text = "0 grab particle 186\n";
   for (int t = 1; t <= 40; ++t) {
     const float f = float(t) / 40.0f;
@@ -68,7 +67,7 @@ TEST_F(Parity, TheStretchLimitIsTheSameOnEveryPath) {
   // within 1 % while those at the grab tear. Wider than long and longer than wide (the rings walk
   // the shorter side), and with the grab let go (the rings then run from the middle).
   for (const char* size : {"cols=16", "cols=9"}) {
-    const SimParams p = preset("crumple", {size, "rows=12", "tilt=90", "pins=none", "top_y=-9.9", "contact_factor=0"});
+    const SimParams p = paperSheet({size, "rows=12", "tilt=90", "pins=none", "top_y=-9.9"});
     const uint32_t corner = (p.rows - 1) * p.cols;
     const std::string text =
         "0 grab particle " + std::to_string(corner) + "\n1 move -3 -8 -2\n12 move -5 -7 4\n" + "20 release\n";
@@ -96,8 +95,7 @@ TEST_F(Parity, TheStretchLimitIsTheSameOnEveryPath) {
   // Sheets hanging from their pins, one iteration and a tight limit: the rings run from every pin
   // (limitRootSet), each particle around the one nearest it, and place particles every substep
   for (const char* pins : {"pins=corners", "pins=top3"}) {
-    const SimParams p =
-        preset("crumple", {"cols=16", "rows=24", pins, "iterations=1", "stretch_limit=1.001", "contact_factor=0"});
+    const SimParams p = paperSheet({"cols=16", "rows=24", pins, "iterations=1", "stretch_limit=1.001"});
     for (bool fused : {true, false}) {
       auto [cpu, gpu] = runBoth(ctx(), p, "", 20, fused);
       const SheetStats st = computeStats(cpu, p.substepDt());
@@ -111,8 +109,7 @@ TEST_F(Parity, TheStretchLimitIsTheSameOnEveryPath) {
   // larger workgroup walks them in one), dragged far off by a corner: a strip 8 wide, about the
   // fewest particles whose rings from the grab run on for dozens past a dispatch's, pulled whole
   // (no tearing, no pins) so that the last rings move too
-  const SimParams big = preset(
-      "crumple", {"cols=8", "rows=2400", "tilt=90", "pins=none", "wind=off", "tear_factor=0", "contact_factor=0"});
+  const SimParams big = paperSheet({"cols=8", "rows=2400", "tilt=90", "pins=none", "tear_factor=0"});
   const uint32_t grab = (big.rows - 1) * big.cols;
   const glm::uvec4 roots =
       shaderio::limitRootSet(glm::uvec4(SIM_NONE, SIM_NONE, SIM_NONE, 0u), grab, big.cols, big.rows);
@@ -181,7 +178,7 @@ TEST_F(Parity, ContactIsTheSameOnTheGpu) {
   // alone, then contact turned on (the GPU sizes its buffers then) and the sheet let go: the
   // particles of the crossing triangles go free, and the bounds, pushes and free particles hold the
   // CPU's bits on the way out, as does the count of particles in contact.
-  const SimParams p = preset("crumple", {"cols=16", "rows=24", "contact_factor=0", "contact_settle=0"});
+  const SimParams p = paperSheet({"cols=16", "rows=24"});
   const std::string text = forcedThroughScript(p);
   CpuSolver cpu;
   Simulation a(p, cpu);

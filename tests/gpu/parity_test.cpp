@@ -17,7 +17,7 @@ using namespace tender::test;
 TEST_F(Parity, HashBucketsMatchTheCpu) {
   // Run a while, then rebuild the hash from exactly the read-back positions on both sides: a
   // tick with dt = 0, damping = 0 and no iterations moves nothing before the hash is built.
-  SimParams p = preset("crumple", {"cols=24", "rows=30", "wind=on", "contact_factor=0"});
+  SimParams p = paperSheet({"cols=24", "rows=30", "wind=on"});
   gpu::GpuSolver gpu(ctx());
   Simulation sim(p, gpu);
   SimState s = run(sim, 30);
@@ -119,7 +119,7 @@ TEST_F(Parity, PaperInTheAir) {
   // velocity, SimUniforms::verlet): the same bits on both GPU paths and the CPU. Without contact,
   // which holds the throw's edges within the limit (AFallingSheetWithContactIsTheSameOnTheGpu changes
   // the substeps with it).
-  SimParams p = preset("paper", {"tear_factor=1.6", "contact_factor=0"});
+  SimParams p = receiptSheet({"tear_factor=1.6"});
   for (bool fused : {true, false}) {
     auto [cpu, gpu] = runBoth(
         ctx(), p, "0 grab particle 1036\n1 move 0.2 0.6 0.1\n8 release\n20 set substeps 12\n40 set substeps 6\n", 60,
@@ -257,8 +257,7 @@ TEST_F(Parity, FusedTickInTheShapesOfBothKindsOfDevice) {
       {cloth({"cols=24", "rows=30", "cell_size=1.8", "wind=on"}), "0 grab particle 719\n1 move 2 3 1\n", false},
       // the air pass first in every substep (without contact: its work in the workgroup, a whole
       // tick in one dispatch, runs past lavapipe's loop count, bench/README.md "Fused small sheets")
-      {preset("paper", {"tear_factor=1.6", "contact_factor=0"}),
-       "0 grab particle 1036\n1 move 0.2 0.6 0.1\n8 release\n", true}};
+      {receiptSheet({"tear_factor=1.6"}), "0 grab particle 1036\n1 move 0.2 0.6 0.1\n8 release\n", true}};
   const gpu::FusedShape gpu_shape{kGpuLikeWorkgroup, SIM_MAX_SUBSTEPS, -1.0f, 1};
   const gpu::FusedShape cpu_shape{SIM_WG_FUSED_CPU, SIM_FUSED_SUBSTEPS_CPU, SIM_FUSED_CPU_MAX_CELL_SPACINGS, -1};
   for (const Case& c : cases)
