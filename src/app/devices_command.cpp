@@ -3,6 +3,7 @@
 
 #include "commands.h"
 #include "gpu/context.h"
+#include "gpu/sim_pipeline.h"
 
 namespace tender {
 
@@ -29,10 +30,10 @@ int runDevices(const CommonOptions&) {
     // What the simulation's shaders ask of its float arithmetic (shaders/spirv/spirv_rules.h)
     const gpu::FloatRules rules = gpu::floatRulesFor(d.floats);
     std::printf("    float32 controls: round to nearest even %s, denormal preserve %s, flush %s -> denormals %s; "
-                "subgroup %u, shared memory %u KiB\n",
+                "subgroup %u, shared memory %u KiB (the fused tick: sheets of up to %u particles)\n",
                 d.floats.rounding_rte ? "yes" : "no", d.floats.denorm_preserve ? "yes" : "no",
                 d.floats.denorm_flush ? "yes" : "no", gpu::denormalsName(rules.denormals), d.subgroup_size,
-                d.shared_memory / 1024u);
+                d.shared_memory / 1024u, gpu::fusedCapacity(d.shared_memory));
   }
   std::printf("(* = used by default; choose another with --device N)\n");
   return 0;
