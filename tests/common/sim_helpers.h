@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <initializer_list>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -56,66 +57,36 @@ inline SimParams cloth(std::initializer_list<const char*> sets = {}) {
   return withSets(SimParams{}, std::vector<std::string>(sets.begin(), sets.end()));
 }
 
-/// A 40 x 60 sheet of paper hanging from its corners, without contact, with `sets` over it: hinges
-/// that crease and the stretch limit at the scale of the hand's scenes (the `crumple` preset's
-/// paper), built here so that no preset file changes the scenes built on it.
-inline SimParams paperSheet(std::initializer_list<const char*> sets = {}) {
-  std::vector<std::string> all = {"cols=40",
-                                  "rows=60",
-                                  "spacing=0.15",
-                                  "pins=corners",
-                                  "bend=off",
-                                  "dihedral=on",
-                                  "tick_hz=60",
-                                  "substeps=8",
-                                  "iterations=4",
-                                  "gravity=0.5",
-                                  "damping=0.995",
-                                  "wind=off",
-                                  "wind_kind=noise",
-                                  "wind_scale=0.15",
-                                  "bending_rigidity=0.02",
-                                  "crease_yield=11.5",
-                                  "crease_hardening=0.5",
-                                  "stretch_limit=1.01",
-                                  "cell_size=0.375",
-                                  "floor_y=-10",
-                                  "restitution=0.3",
-                                  "friction=0.3",
-                                  "release=drag"};
+/// SimParams' defaults with the space-separated `keys` and then `sets` over them (which must be
+/// valid): a test scene that names every key it depends on, so that no preset file changes it.
+inline SimParams keyed(const std::string& keys, std::initializer_list<const char*> sets) {
+  std::vector<std::string> all;
+  std::istringstream words(keys);
+  for (std::string key; words >> key;) all.push_back(key);
   all.insert(all.end(), sets.begin(), sets.end());
   return withSets(SimParams{}, all);
 }
 
+/// A 40 x 60 sheet of paper hanging from its corners, without contact, with `sets` over it: hinges
+/// that crease and the stretch limit at the scale of the hand's scenes (the `crumple` preset's
+/// paper).
+inline SimParams paperSheet(std::initializer_list<const char*> sets = {}) {
+  return keyed("cols=40 rows=60 spacing=0.15 pins=corners bend=off dihedral=on tick_hz=60 substeps=8 iterations=4 "
+               "gravity=0.5 damping=0.995 wind=off wind_kind=noise wind_scale=0.15 bending_rigidity=0.02 "
+               "crease_yield=11.5 crease_hardening=0.5 stretch_limit=1.01 cell_size=0.375 floor_y=-10 "
+               "restitution=0.3 friction=0.3 release=drag",
+               sets);
+}
+
 /// A receipt in SI units without contact, with `sets` over it: 80 mm x 300 mm of 55 g/m^2 paper in
 /// still air, its lowest point 1 m above the floor, leaning 5 degrees from flat (the `paper`
-/// preset's sheet), built here so that no preset file changes the scenes built on it.
+/// preset's sheet).
 inline SimParams receiptSheet(std::initializer_list<const char*> sets = {}) {
-  std::vector<std::string> all = {"cols=17",
-                                  "rows=61",
-                                  "spacing=0.005",
-                                  "pins=none",
-                                  "tilt=85",
-                                  "view_scale=0.1",
-                                  "bend=off",
-                                  "dihedral=on",
-                                  "damping=1",
-                                  "wind=off",
-                                  "air=on",
-                                  "paper_weight=55",
-                                  "bending_rigidity=7.9e-05",
-                                  "crease_yield=11.5",
-                                  "crease_hardening=0.5",
-                                  "stretch_limit=1.01",
-                                  "cell_size=0.012499999",
-                                  "floor_y=0",
-                                  "restitution=0.05",
-                                  "friction=0.6",
-                                  "release=drag",
-                                  "grab_radius=0.02",
-                                  "hand_reach=0.16"};
-  all.insert(all.end(), sets.begin(), sets.end());
-  return withSets(SimParams{}, all);
+  return keyed("cols=17 rows=61 spacing=0.005 pins=none tilt=85 view_scale=0.1 bend=off dihedral=on damping=1 "
+               "wind=off air=on paper_weight=55 bending_rigidity=7.9e-05 crease_yield=11.5 crease_hardening=0.5 "
+               "stretch_limit=1.01 cell_size=0.012499999 floor_y=0 restitution=0.05 friction=0.6 release=drag "
+               "grab_radius=0.02 hand_reach=0.16",
+               sets);
 }
 
 /// Parses an input script (which must be valid).
