@@ -101,9 +101,6 @@ struct SimUniforms {
 #define SIM_FLAG_CANDIDATES 4u
 // Air on every triangle (airOnTriangle in xpbd.h): a pass before integration sums it per particle
 #define SIM_FLAG_AIR 8u
-// Set by the GPU solver when the contact_* passes run before each substep of the fused tick, which
-// then leaves contact's bodies out (a CPU device: FusedShape::contact)
-#define SIM_FLAG_CONTACT_PASSES 16u
 
 /// The state of one hinge (SIM_BIND_HINGES, SheetState::hinges): x its rest angle (radians, in
 /// (-pi, pi]; 0 on a flat sheet, moved by creasing), y the yield its hardening has added, z and w

@@ -168,7 +168,7 @@ void resetFrame(uint n) {
 void integrateStage(uint s, uint n, float dt2) {
   uint lid = gl_LocalInvocationID.x;
 #ifdef SIM_FUSED_CONTACT
-  if (contactKeys().x > 0.0f && (u.flags & SIM_FLAG_CONTACT_PASSES) == 0u) contactSubstep(s, n);
+  if (contactKeys().x > 0.0f) contactSubstep(s, n);
 #endif
   if ((u.flags & SIM_FLAG_AIR) != 0u) {
     sync(); // the air reads the positions of other invocations' particles (loaded or moved)

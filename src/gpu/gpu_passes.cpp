@@ -56,21 +56,12 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
   anyToCompute(cmd); // earlier submissions (previous tick, copies, the renderer) are done
   bindSet(cmd, index);
   if (key.fused) {
-    // Small sheet: every pass of fused_substeps_ substeps (on a GPU: all) in one workgroup; on a
-    // CPU device with contact on, the contact passes on all its threads before each substep
-    // (SIM_FLAG_CONTACT_PASSES), the rest of the substep in the workgroup
+    // Small sheet: every pass of fused_substeps_ substeps (on a GPU: all) in one workgroup
     const SubstepPlan& plan = key.plan;
     const uint32_t per = passesPerSubstep(plan.iterations, topo_.colorCount(), plan.collision);
-    const bool contact_passes = plan.contact && !fused_contact_;
-    const uint32_t step = contact_passes ? 1 : fused_substeps_;
+    const uint32_t step = fused_substeps_;
     for (uint32_t s = 0; s < key.substeps; s += step) {
       if (s > 0) computeToCompute(cmd);
-      if (contact_passes) {
-        recording_ = &flight;
-        recordContactPasses(*this, pipes_, topo_, layout_sizes_, s);
-        recording_ = nullptr;
-        timestamp(cmd, flight, kContact);
-      }
       const uint32_t count = std::min(step, key.substeps - s);
       dispatch(cmd, plan.contact ? pipes_.tick_fused_contact : pipes_.tick_fused, Grid::Workgroup, 1,
                FusedPush{n, s, count, plan.stop});

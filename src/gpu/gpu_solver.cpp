@@ -135,7 +135,9 @@ void GpuSolver::tick(const SimUniforms& u) {
     // The contact's buffers and pipelines, the first time contact is on
     if (!layout_sizes_.contact) sizeContact();
     addContactPipelines(ctx_, {layout_, "solver"}, float_rules_, math_,
-                        pipes_.tick_fused.pipeline ? std::optional<uint32_t>(fused_workgroup_) : std::nullopt, pipes_);
+                        pipes_.tick_fused.pipeline && fused_contact_ ? std::optional<uint32_t>(fused_workgroup_)
+                                                                     : std::nullopt,
+                        pipes_);
   }
   last_contact_ = contact;
   const uint32_t index = next_in_flight_;
@@ -145,7 +147,6 @@ void GpuSolver::tick(const SimUniforms& u) {
   waitFor(flight);
   SimUniforms gpu_u = u;
   if (usesCandidateLists()) gpu_u.flags |= SIM_FLAG_CANDIDATES;
-  if (contact && !fused_contact_ && usesFusedPath(u)) gpu_u.flags |= SIM_FLAG_CONTACT_PASSES;
   if (contact) {
     gpu_u.contact_grid = glm::uvec4(layout_sizes_.contact_buckets / 2 - 1, layout_sizes_.contact_counts,
                                     layout_sizes_.contact_fill, layout_sizes_.contact_edges);
@@ -279,9 +280,9 @@ FusedShape resolveFusedShape(const VulkanContext& ctx, FusedShape requested, boo
   shape.max_cell_spacings = requested.max_cell_spacings != 0.0f ? requested.max_cell_spacings
                             : cpu_device                        ? SIM_FUSED_CPU_MAX_CELL_SPACINGS
                                                                 : -1.0f;
-  // A fleet's sheets run their workgroups side by side on a CPU device's threads: contact in each
-  // sheet's workgroup; a sheet alone leaves a CPU device's other threads to contact's passes
-  shape.contact = requested.contact ? requested.contact : cpu_device && !fleet ? -1 : 1;
+  // Contact's loops have no bound within lavapipe's loop count: a CPU device runs contact sheets on
+  // the per-colour passes, alone and in a fleet
+  shape.contact = requested.contact ? requested.contact : cpu_device ? -1 : 1;
   return shape;
 }
 
@@ -306,7 +307,8 @@ bool GpuSolver::usesFusedPath() const {
 }
 
 bool GpuSolver::usesFusedPath(const SimUniforms& u) const {
-  return usesFusedPath() && fusedTickTakes(u, spacing_, fused_max_cell_spacings_);
+  return usesFusedPath() && (!(u.contact.x > 0.0f) || fused_contact_) &&
+         fusedTickTakes(u, spacing_, fused_max_cell_spacings_);
 }
 
 } // namespace tender::gpu

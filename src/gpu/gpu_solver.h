@@ -25,13 +25,12 @@ struct FusedShape {
   uint32_t workgroup = 0;             ///< invocations of the workgroup, at most SIM_WG_FUSED_MAX
   uint32_t substeps_per_dispatch = 0; ///< substeps each dispatch runs
   float max_cell_spacings = 0.0f;     ///< largest hash cell (in grid spacings) with collision on; < 0: any
-  /// With contact on: 1, the fused tick's workgroup runs contact's bodies too; -1, the contact
-  /// passes run before each substep of the fused tick (one substep a dispatch), which leaves them
-  /// out (SIM_FLAG_CONTACT_PASSES); 0: the device's kind decides. A CPU device takes the passes
-  /// for a sheet alone: it runs the one workgroup on one thread, the passes on all (lavapipe, 2
-  /// threads, the crumple sheet at 32 x 48 falling: 32.4 ms a tick, against 37.5 on the per-colour
-  /// passes alone and 44-48 with contact in the workgroup); a fleet's sheets fill its threads with
-  /// their workgroups, so a fleet takes contact in the workgroup on every device.
+  /// With contact on: 1, the fused tick's workgroup runs contact's bodies too (a GPU's); -1, a
+  /// sheet with contact takes the per-colour passes (a CPU device's, alone or in a fleet); 0: the
+  /// device's kind decides. Lavapipe ends a dispatch's loops once a SIMD group has run 65535
+  /// iterations (bench/README.md, "Fused small sheets"), and contact's loops in a crumpled sheet
+  /// have no such bound: the hand's crumple of a 32 x 48 `crumple` sheet ran past it in the
+  /// settle's sweeps and parted from the CPU's bits in tick 4.
   int contact = 0;
 };
 
@@ -215,7 +214,7 @@ private:
   uint32_t fused_workgroup_ = 0;          ///< invocations of the fused tick's workgroup (fusedWorkgroup)
   uint32_t fused_substeps_ = 1;           ///< substeps per dispatch of the fused tick
   float fused_max_cell_spacings_ = -1.0f; ///< largest hash cell of the fused tick (< 0: any)
-  bool fused_contact_ = true;             ///< the fused tick's workgroup runs contact too (FusedShape)
+  bool fused_contact_ = true;             ///< sheets with contact take the fused tick (FusedShape::contact)
   float spacing_ = 0.0f;                  ///< grid spacing: the shortest structural rest length
   bool candidates_allowed_ = true;        ///< setCandidateLists
   uint32_t contact_list_capacity_ = SIM_CONTACT_LIST_CAPACITY; ///< setContactListCapacity

@@ -297,12 +297,6 @@ uint32_t marksPerSubstep() {
   return marks;
 }
 
-void recordContactPasses(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,
-                         uint32_t s) {
-  for (const Dispatch& d : kDispatches)
-    if (d.needs == Needs::CONTACT && d.stage == SIM_STAGE_integrate) recordDispatch(sink, pipes, topo, sizes, d, s, 0);
-}
-
 bool recordSubstep(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,
                    const SubstepPlan& plan, uint32_t s, uint32_t& pass) {
   const bool has_constraints = topo.constraintCount() > 0;

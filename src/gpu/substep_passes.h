@@ -121,12 +121,6 @@ SubstepPlan substepPlan(const shaderio::SimUniforms& u, uint32_t stop = SIM_NONE
 /// Timestamps a substep of the per-colour path records (one where each category ends).
 uint32_t marksPerSubstep();
 
-/// Records the contact passes that start substep `s` (the integrate stage's rows of SIM_DISPATCHES
-/// that need CONTACT), each followed by a barrier: what a CPU device dispatches before each substep
-/// of the fused tick (whose workgroup runs the floor's contact bodies).
-void recordContactPasses(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,
-                         uint32_t s);
-
 /// Records the passes of substep `s` of a sheet of this topology and layout; `pass` counts them.
 /// Returns true when the tick stops within it (SubstepPlan::stop).
 bool recordSubstep(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,

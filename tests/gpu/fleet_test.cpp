@@ -89,12 +89,14 @@ std::vector<FleetSheet> withContact(std::vector<FleetSheet> sheets) {
 }
 
 TEST_F(GpuBatchTest, ContactSheetsMatchTheCpuReference) {
-  // Sheets 1 and 3 with contact, whose bodies run in the fleet's fused tick on every device: one
+  // Sheets 1 and 3 with contact, whose bodies run in the fleet's fused tick as a GPU runs it: one
   // dispatch of tick_batch for the sheets without contact, one of tick_batch_contact for those
   // with (a CPU device: one each a substep and group of sheets). 12 ticks: both in contact
   // throughout, the yank's from tick 1 and the hand's from tick 4.
   const std::vector<FleetSheet> sheets = withContact(mixedFleet(4));
-  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()));
+  gpu::FusedShape in_workgroup;
+  in_workgroup.contact = 1;
+  gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), gpu::BatchPasses::Auto, in_workgroup);
   {
     Fleet fleet(batch, sheets);
     fleet.tick();

@@ -22,10 +22,14 @@ protected:
   void checkCandidateLists(const SimParams& p, bool fused, bool expect_entries);
 };
 
+/// The fused tick with contact's bodies in its workgroup, as a GPU runs it (a CPU device's own shape
+/// runs sheets with contact on the per-colour passes); the rest of the shape the device's.
+inline constexpr gpu::FusedShape kContactInTheWorkgroup{0, 0, 0.0f, 1};
+
 /// Runs the same parameters and script on both solvers; returns {cpu, gpu} states. `fused`
 /// allows the GPU's fused small-sheet tick (used when the sheet fits), in the given shape.
 inline std::pair<SimState, SimState> runBoth(gpu::VulkanContext& ctx, const SimParams& p, const char* text, int ticks,
-                                             bool fused = true, gpu::FusedShape shape = {}) {
+                                             bool fused = true, gpu::FusedShape shape = kContactInTheWorkgroup) {
   gpu::GpuSolver gpu(ctx, shape);
   CpuSolver cpu;
   gpu.setFusedPath(fused);
