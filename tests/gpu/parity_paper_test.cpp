@@ -246,25 +246,20 @@ TEST_F(Parity, ATornSheetWithContactIsTheSameOnTheGpu) {
   // once. Both ways: the fused tick with contact's bodies in its workgroup (a GPU's), the per-colour
   // passes (a CPU device's).
   const SimParams yank = preset("tender", {"cols=12", "rows=16", "wind=off", "contact_factor=0.5"});
-  struct Way {
-    const char* name;
-    bool fused;
-    int contact; // FusedShape::contact
-  };
-  for (const Way way : {Way{"fused tick", true, 1}, Way{"per-colour passes", false, 1}}) {
-    const gpu::FusedShape shape{0, 0, 0.0f, way.contact};
-    gpu::GpuSolver gpu(ctx(), shape);
-    gpu.setFusedPath(way.fused);
+  for (bool fused : {true, false}) {
+    const char* way = fused ? "fused tick" : "per-colour passes";
+    gpu::GpuSolver gpu(ctx(), kContactInTheWorkgroup);
+    gpu.setFusedPath(fused);
     Simulation g(yank, gpu);
     g.tick();
-    EXPECT_EQ(gpu.usesFusedPath(g.lastUniforms()), way.fused) << way.name;
+    EXPECT_EQ(gpu.usesFusedPath(g.lastUniforms()), fused) << way;
     // The fused tick's one dispatch a tick (a CPU device's: one a substep)
-    if (way.fused) {
-      EXPECT_LE(gpu.dispatchesPerTick(), yank.substeps) << way.name;
+    if (fused) {
+      EXPECT_LE(gpu.dispatchesPerTick(), yank.substeps) << way;
     }
-    auto [torn_cpu, torn_gpu] = runBoth(ctx(), yank, "0 grab particle 191\n1 move 6 -4 5\n", 10, way.fused, shape);
-    EXPECT_GT(tornIds(torn_cpu).size(), 0u) << way.name;
-    EXPECT_TRUE(sameState(torn_cpu, torn_gpu)) << way.name;
+    auto [torn_cpu, torn_gpu] = runBoth(ctx(), yank, "0 grab particle 191\n1 move 6 -4 5\n", 10, fused);
+    EXPECT_GT(tornIds(torn_cpu).size(), 0u) << way;
+    EXPECT_TRUE(sameState(torn_cpu, torn_gpu)) << way;
     expectSameTopology(torn_cpu, torn_gpu);
   }
   // Unless told, a CPU device runs a sheet with contact on the per-colour passes (lavapipe's loop
