@@ -51,7 +51,7 @@ GpuBatch::FlushQueue GpuBatch::takeQueued() {
     // A sheet with contact takes the fused tick with contact's bodies where the device's shape runs
     // them in the workgroup (FusedShape::contact), the per-colour passes elsewhere
     const bool contact = u.contact.x > 0.0f;
-    if (fits_fused && (!contact || fused_contact_) && fusedTickTakes(u, spacing_, fused_max_cell_spacings_)) {
+    if (fits_fused && fusedTickTakes(u, spacing_, fused_max_cell_spacings_, fused_contact_)) {
       f.fused_substeps = std::max(f.fused_substeps, std::max(substeps, 1u));
       (contact ? f.fused_contact : f.fused).push_back(i);
       continue;

@@ -297,7 +297,8 @@ bool fusedTickFits(const SheetTopology& topo, uint32_t capacity) {
   return topo.particleCount() <= capacity && topo.hash_size <= 2u * std::bit_ceil(capacity);
 }
 
-bool fusedTickTakes(const SimUniforms& u, float spacing, float max_cell_spacings) {
+bool fusedTickTakes(const SimUniforms& u, float spacing, float max_cell_spacings, bool contact_in_workgroup) {
+  if (u.contact.x > 0.0f && !contact_in_workgroup) return false;
   if ((u.flags & SIM_FLAG_COLLISION) == 0u || max_cell_spacings < 0.0f) return true;
   return u.inv_cell * max_cell_spacings * spacing >= 1.0f;
 }
@@ -307,8 +308,7 @@ bool GpuSolver::usesFusedPath() const {
 }
 
 bool GpuSolver::usesFusedPath(const SimUniforms& u) const {
-  return usesFusedPath() && (!(u.contact.x > 0.0f) || fused_contact_) &&
-         fusedTickTakes(u, spacing_, fused_max_cell_spacings_);
+  return usesFusedPath() && fusedTickTakes(u, spacing_, fused_max_cell_spacings_, fused_contact_);
 }
 
 } // namespace tender::gpu

@@ -46,8 +46,9 @@ float structuralSpacing(const SheetTopology& topo);
 bool fusedTickFits(const SheetTopology& topo, uint32_t capacity);
 /// True when a tick with these uniforms, of a sheet of grid spacing `spacing` that fits the fused
 /// tick, takes it on a device whose fused tick takes hash cells of at most `max_cell_spacings`
-/// spacings (< 0: any) when collision is on.
-bool fusedTickTakes(const shaderio::SimUniforms& u, float spacing, float max_cell_spacings);
+/// spacings (< 0: any) when collision is on, and with contact on only when its workgroup runs
+/// contact (`contact_in_workgroup`: FusedShape::contact). The solver and a fleet both ask it.
+bool fusedTickTakes(const shaderio::SimUniforms& u, float spacing, float max_cell_spacings, bool contact_in_workgroup);
 
 /// The Solver on Vulkan compute. A substep's passes (the pass table, sim_passes.h) are recorded
 /// by recordSubstep (substep_passes.h), the tear compaction and the hash passes as indirect dispatches
