@@ -42,6 +42,9 @@ public:
   bool passesPerSheet() const { return per_sheet_; }
   /// Keeps (default) or drops the collision candidate lists, as GpuSolver::setCandidateLists.
   void setCandidateLists(bool keep) { candidates_allowed_ = keep; }
+  /// Allows (default) or forbids the fused tick, as GpuSolver::setFusedPath: forbidden, every sheet
+  /// runs the per-colour passes, whatever its size.
+  void setFusedPath(bool allowed) { fused_allowed_ = allowed; }
   ~GpuBatch() override;
   GpuBatch(const GpuBatch&) = delete;
   GpuBatch& operator=(const GpuBatch&) = delete;
@@ -123,6 +126,7 @@ private:
   SimPipelines passes_;                ///< the per-colour passes of a batch (SIM_BATCH_PASS)
   bool per_sheet_ = false;             ///< BatchPasses::PerSheet
   bool candidates_allowed_ = true;     ///< setCandidateLists
+  bool fused_allowed_ = true;          ///< setFusedPath
   VkDescriptorSetLayout sheet_set_layout_ = VK_NULL_HANDLE; ///< PerSheet: a sheet's set, as the solver's
   VkPipelineLayout sheet_layout_ = VK_NULL_HANDLE;
   VkDescriptorPool sheet_pool_ = VK_NULL_HANDLE;

@@ -24,7 +24,7 @@ std::vector<uint32_t> GpuBatch::FlushQueue::queue() const {
 GpuBatch::FlushQueue GpuBatch::takeQueued() {
   // Each sheet takes the path it takes alone: the fused tick or the per-colour passes
   FlushQueue f;
-  const bool fits_fused = tick_batch_.pipeline && fusedTickFits(topo_, fusedCapacity(ctx_));
+  const bool fits_fused = fused_allowed_ && tick_batch_.pipeline && fusedTickFits(topo_, fusedCapacity(ctx_));
   f.uniforms_at = alignUp(4ull * size(), kSliceAlign);
   f.args_at = f.uniforms_at + stride_[SIM_BIND_UNIFORMS] * size();
   char* inputs = static_cast<char*>(inputs_.mapped);

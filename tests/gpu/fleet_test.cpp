@@ -138,38 +138,43 @@ TEST_P(GpuBatchPasses, AFlushRunsFusedAndPerColourSheetsTogether) {
     EXPECT_EQ(batch.dispatchesPerFlush(), 1u);
 }
 
-TEST_P(GpuBatchPasses, SheetsTooLargeForTheFusedTickMatchTheCpuReference) {
-  // 48 x 48 (or more rows): over the fused tick's capacity. Batched, each pass is one dispatch for every sheet and
-  // a gate picks the sheets that run it (substeps, iterations, air, collision, hash, tears, reset).
-  // Seven sheets: a yank (1, 5), a reset (2, 6), a ray grab (3), tearing off (3), stiff against
-  // tearing (2), collision off (4), air (1, 6), 6 to 8 substeps, 3 or 4 iterations. 21 ticks: to
-  // the ray grab's release (tick 20), after the resets (15).
-  const std::vector<FleetSheet> sheets = mixedFleet(7, 48, rowsPastTheFusedTick(48, 48));
+TEST_P(GpuBatchPasses, SheetsOnThePerColourPassesMatchTheCpuReference) {
+  // The per-colour passes of every sheet (the fused tick forbidden, as for a sheet over its
+  // capacity: LargeSheetsRecordTheDispatchesOfOneSheetPerPassOrPerSheet). Batched, each pass is one
+  // dispatch for every sheet and a gate picks the sheets that run it (substeps, iterations, air,
+  // collision, hash, tears, reset). Seven sheets: a yank (1, 5), a reset (2, 6), a ray grab (3),
+  // tearing off (3), stiff against tearing (2), collision off (4), air (1, 6), 6 to 8 substeps, 3
+  // or 4 iterations. 21 ticks: to the ray grab's release (tick 20), after the resets (15).
+  const std::vector<FleetSheet> sheets = mixedFleet(7, 16, 24);
   gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
+  batch.setFusedPath(false);
   EXPECT_EQ(batch.passesPerSheet(), GetParam() == gpu::BatchPasses::PerSheet);
   CpuSolver alone;
   const uint32_t tore = expectFleetMatchesAlone(batch, alone, sheets, 21);
-  EXPECT_FALSE(gpu::fusedTickFits(buildSheet(sheets[0].params), gpu::fusedCapacity(ctx())));
+  EXPECT_GT(batch.dispatchesPerFlush(), 50u); // the passes, not one fused dispatch a substep
   EXPECT_GT(tore, 0u);
   EXPECT_LT(tore, sheets.size());
 }
 
-TEST_P(GpuBatchPasses, LargeContactSheetsMatchTheirRunsAlone) {
+TEST_P(GpuBatchPasses, ContactSheetsOnThePerColourPassesMatchTheirRunsAlone) {
   // Sheet 1 has contact on, sheet 0 not: batched, the contact passes' gates take sheet 1 alone
-  const std::vector<FleetSheet> sheets = withContact(mixedFleet(2, 40, rowsPastTheFusedTick(40, 52)));
+  const std::vector<FleetSheet> sheets = withContact(mixedFleet(2, 16, 24));
   gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
+  batch.setFusedPath(false);
   CpuSolver alone;
   expectFleetMatchesAlone(batch, alone, sheets, 8);
 }
 
 // Without the candidate lists (the switch the solver and the fleet both honour), every substep with
-// collision builds the hash, in a fleet as alone.
+// collision builds the hash, in a fleet's per-colour passes as alone.
 TEST_P(GpuBatchPasses, WithoutCandidateListsSheetsMatchTheirRunsAlone) {
-  const std::vector<FleetSheet> sheets = mixedFleet(3, 48, rowsPastTheFusedTick(48, 48));
+  const std::vector<FleetSheet> sheets = mixedFleet(3, 16, 24);
   gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()), GetParam());
   batch.setCandidateLists(false);
+  batch.setFusedPath(false);
   gpu::GpuSolver alone(ctx());
   alone.setCandidateLists(false);
+  alone.setFusedPath(false);
   expectFleetMatchesAlone(batch, alone, sheets, 12);
 }
 
@@ -204,7 +209,8 @@ TEST_F(GpuBatchTest, ACpuDeviceRunsThePerColourPassesSheetBySheet) {
 TEST_F(GpuBatchTest, BatchedContactSheetsRecordTheDispatchesOfOneSheet) {
   // Four crumpled sheets with contact, each its own yank (their lists and grids are built in
   // different substeps): batched, the passes one sheet alone records, each sheet's contact
-  // passes armed by its own arguments (sheet by sheet: LargeContactSheetsMatchTheirRunsAlone and
+  // passes armed by its own arguments (sheet by sheet:
+  // ContactSheetsOnThePerColourPassesMatchTheirRunsAlone and
   // LargeSheetsRecordTheDispatchesOfOneSheetPerPassOrPerSheet). The same bits as alone.
   const SimParams p = preset("crumple", {"cols=12", "rows=16"});
   std::vector<FleetSheet> sheets;
