@@ -73,10 +73,10 @@ if [ -f "$report" ]; then
   grep -q "^| render-tests | .* | $render_count tests, $render_count passed (2 processes) |" "$report" ||
     fail "report.md: render-tests did not count $render_count tests from 2 processes"
   grep -q '^| dispatch cost | [0-9.]* us per empty dispatch' "$report" || fail "report.md has no dispatch cost"
-  grep -q '^| 128x192 | 24576 | gpu-percolor | [0-9]' "$report" || fail "report.md has no benchmark table"
+  grep -q '^| 64x64 | 4096 | gpu-percolor | [0-9]' "$report" || fail "report.md has no benchmark table"
   [ -s "$tmp/report/bench.json" ] && [ -s "$tmp/report/bench.csv" ] || fail "no bench.json or bench.csv"
-  grep -q '^32x48 *gpu *64 *[0-9.]' "$report" || fail "report.md has no fleet table with a batch of 64"
-  grep -q '^128x192 *gpu *4 *[0-9.]' "$report" || fail "report.md has no large-sheet fleet table with a batch of 4"
+  grep -q '^32x48 *gpu *4 *[0-9.]' "$report" || fail "report.md has no fleet table with a batch of 4"
+  grep -q '^64x64 *gpu *4 *[0-9.]' "$report" || fail "report.md has no large-sheet fleet table with a batch of 4"
   [ -s "$tmp/report/fleet.json" ] && [ -s "$tmp/report/fleet-large.json" ] || fail "no fleet.json or fleet-large.json"
   if command -v gnuplot >/dev/null && command -v python3 >/dev/null; then
     [ -s "$tmp/report/fleet.png" ] || fail "no fleet.png (gnuplot and python3 are here)"
