@@ -316,10 +316,10 @@ TEST(SimdSimulation, TearingYankIsIdenticalWithoutSimd) {
 
 TEST(SimdSimulation, CrumpleTossIsIdenticalWithoutSimd) {
   const std::string toss = "0 grab particle 100\n1 move 1 2 3\n10 release\n";
-  const SimState reference = test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 20, kScalarOne);
-  test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 20, kSimdOne));
-  test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 20, kSimdTwo));
-  test::expectIdentical(reference, test::runCpu("crumple", {"cols=37", "rows=53"}, toss, 20, kScalarTwo));
+  const SimState reference = test::runCpu("crumple", {"cols=13", "rows=19"}, toss, 20, kScalarOne);
+  test::expectIdentical(reference, test::runCpu("crumple", {"cols=13", "rows=19"}, toss, 20, kSimdOne));
+  test::expectIdentical(reference, test::runCpu("crumple", {"cols=13", "rows=19"}, toss, 20, kSimdTwo));
+  test::expectIdentical(reference, test::runCpu("crumple", {"cols=13", "rows=19"}, toss, 20, kScalarTwo));
 }
 
 TEST(SimdSimulation, TheShortenStageIsIdenticalWithoutSimd) {
@@ -327,7 +327,7 @@ TEST(SimdSimulation, TheShortenStageIsIdenticalWithoutSimd) {
   // and a tender sheet with the limit yanked hard enough to tear (edges at their tear length are
   // left to tear) and let go
   const std::string toss = "0 grab particle 100\n1 move 1 2 3\n10 release\n";
-  const std::vector<std::string> crumple = {"cols=37", "rows=53", "pins=none"};
+  const std::vector<std::string> crumple = {"cols=13", "rows=19", "pins=none"};
   const SimState reference = test::runCpu("crumple", crumple, toss, 20, kScalarOne);
   test::expectIdentical(reference, test::runCpu("crumple", crumple, toss, 20, kSimdOne));
   test::expectIdentical(reference, test::runCpu("crumple", crumple, toss, 20, kSimdTwo));
