@@ -323,8 +323,8 @@ TEST_F(Parity, TheSettleIsTheSameOnTheGpu) {
   // The hand's fist closing on a small sheet with contact on and the settle's sweeps (the
   // contact_settle key): the edges the contact holds past the stretch limit are shortened within the
   // steps' bounds with the CPU's bits on the per-colour passes and in the fused tick (whose
-  // workgroup runs the settle after the contact's bodies there, a GPU's way). The sweeps do their work here: the sheet
-  // ends elsewhere and less stretched than without them.
+  // workgroup runs the settle after the contact's bodies there, a GPU's way). The sweeps do their
+  // work here: the sheet ends elsewhere and less stretched than without them.
   const SimParams p = preset("crumple", {"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9",
                                          "contact_factor=0.5", "collision=off", "contact_settle=4"});
   const std::string text = "0 grab particle 102\n1 move 0 -8.8 -1.2\n4 squeeze 0.5\n12 squeeze 1\n";
