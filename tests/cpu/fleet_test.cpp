@@ -8,6 +8,13 @@ namespace {
 TEST(CpuFleet, EachSheetOfAMixedBatchMatchesItsRunAlone) {
   const std::vector<FleetSheet> sheets = mixedFleet(37);
   CpuBatch batch(uint32_t(sheets.size()), 2);
+  if (!kComparesThreadCounts) {
+    // ThreadSanitizer judges the batch's jobs on its two threads; the ci and ASan builds compare the
+    // bits with each sheet's run alone
+    Fleet fleet(batch, sheets);
+    for (int t = 0; t < 60; ++t) fleet.tick();
+    return;
+  }
   CpuSolver alone;
   const uint32_t tore = expectFleetMatchesAlone(batch, alone, sheets, 60);
   // Some sheets tore and some did not: the batch holds both.
