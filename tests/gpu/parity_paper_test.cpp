@@ -142,7 +142,7 @@ TEST_F(Parity, AStripHeldUnderAFoldIsPulledFreeOnEveryPath) {
   // Contact.AStripHeldUnderAFoldIsPulledFree's scene (a yanked 8 x 12 `tender` sheet whose strip by
   // its pin ends under a fold): the steps' excess passed on to the other side of their pairs
   // (contact_pass) frees it with the same bits on the CPU and both GPU paths, to tick 60, while it
-  // is being freed (stretched 9.08 there without the passing on, 1.73 with; the CPU test sees it
+  // is being freed (stretched 9.08 there without the passing on, 1.80 with; the CPU test sees it
   // freed by tick 120)
   const SimParams p = preset("tender", {"cols=8", "rows=12", "tear_factor=50"});
   for (bool fused : {true, false}) {
