@@ -122,9 +122,9 @@ TEST_F(Parity, PaperInTheAir) {
   SimParams p = receiptSheet({"tear_factor=1.6"});
   for (bool fused : {true, false}) {
     auto [cpu, gpu] = runBoth(
-        ctx(), p, "0 grab particle 1036\n1 move 0.2 0.6 0.1\n8 release\n20 set substeps 12\n40 set substeps 6\n", 60,
+        ctx(), p, "0 grab particle 1036\n1 move 0.2 0.6 0.1\n8 release\n12 set substeps 12\n18 set substeps 6\n", 24,
         fused);
-    std::printf("paper, 60 ticks, %s: %zu torn\n", fused ? "fused tick" : "per-colour passes", tornIds(cpu).size());
+    std::printf("paper, 24 ticks, %s: %zu torn\n", fused ? "fused tick" : "per-colour passes", tornIds(cpu).size());
     EXPECT_GT(tornIds(cpu).size(), 0u);
     EXPECT_TRUE(sameState(cpu, gpu));
     expectSameTopology(cpu, gpu);
