@@ -79,6 +79,7 @@ struct RenderOptions {
 
 struct DemoOptions {
   std::string record, replay;
+  uint64_t quit_at = 0; ///< the script clock's step at which the session ends (0: never)
   bool vsync = true;
   float ui_scale = 0.0f; ///< 0 = the window's content scale
   uint32_t width = 1280, height = 720;

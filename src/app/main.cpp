@@ -81,6 +81,8 @@ void addDemo(CLI::App& app, CommandLine& c) {
   DemoOptions& demo = c.demo;
   app.add_option("--record", demo.record, "write this session's input as an input script");
   app.add_option("--replay", demo.replay, "play an input script back");
+  app.add_option("--quit-at", demo.quit_at, "end the session at this step (of --replay's or --record's clock)")
+      ->check(CLI::Range(uint64_t(1), uint64_t(100000000)));
   app.add_option("--vsync", demo.vsync, "on or off")->transform(CLI::Transformer({{"on", "1"}, {"off", "0"}}));
   app.add_option("--ui-scale", demo.ui_scale, "HUD scale (default: the window's content scale)")
       ->check(finiteRange(0.25, 8.0));

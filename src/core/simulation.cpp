@@ -350,7 +350,8 @@ bool Simulation::tick() {
   return true;
 }
 
-int Simulation::advance(float frame_dt) {
+int Simulation::advance(float frame_dt, uint64_t last) {
+  if (frame_ >= last) return 0;
   applyDueEvents();
   if (reset_frame_ > 0) {
     ++frame_;
@@ -367,7 +368,7 @@ int Simulation::advance(float frame_dt) {
   const double step = 1.0 / double(params_.tick_hz);
   // Each physics tick is a step of the scripts' clock: events due before it apply first, so a
   // recording replays the same whatever the frame rate (tick() runs one step at a time).
-  while (accumulator_ >= step) {
+  while (accumulator_ >= step && frame_ < last) {
     if (n > 0) {
       applyDueEvents();
       if (paused_ || reset_frame_ > 0) break;

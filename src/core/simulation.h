@@ -2,6 +2,7 @@
 /// The controller shared by every program: input state (grab, wind, pins, pause, reset), the
 /// fixed-step accumulator, input scripts, and the per-tick uniforms handed to a Solver.
 #include <array>
+#include <cstdint>
 #include <memory>
 
 #include "params.h"
@@ -89,8 +90,8 @@ public:
   bool tick();
   /// Real-time frame: clamps dt, runs as many fixed ticks as the accumulator holds (one reset
   /// frame while resetting), applying each script event before the step it is due at. Returns
-  /// the number of physics ticks run.
-  int advance(float frame_dt);
+  /// the number of physics ticks run. No step goes past step `last` (the demo's --quit-at).
+  int advance(float frame_dt, uint64_t last = UINT64_MAX);
 
   /// Steps so far, the clock of scripts: one per physics tick, reset frame or paused frame (tick()
   /// runs one step; advance() as many as the frame's time holds).

@@ -114,17 +114,17 @@ toss="$tmp/toss.txt"
   for i in $(seq 80); do echo "$((120 + i)) move $(awk "BEGIN { print -0.3 * $i, 1 + 0.1 * $i }") 0"; done
   echo "201 release"
 } >"$toss"
-# Runs the toss for 15 s (F pressed first when $1 is "off"); prints the camera's exit line.
+# Runs the toss to its step 240, where --quit-at ends the session (F pressed first when $1 is
+# "off"); prints the camera's exit line.
 toss_camera() {
-  start_demo --backend cpu --preset crumple --set tear_factor=0 --set contact_factor=0 --width 800 --height 600 \
-    --replay "$toss"
+  start_demo --backend cpu --preset crumple --set tear_factor=0 --set contact_factor=0 --width 400 --height 300 \
+    --replay "$toss" --quit-at 240
   [ "$1" = off ] && xdotool key --window "$wid" f
-  sleep 15
-  alive "toss"
+  local i steps
+  for i in $(seq 600); do kill -0 "$demo" 2>/dev/null || break; sleep 0.1; done
   stop_demo
-  local steps
   steps=$(sed -n 's/^tender-demo: \([0-9]*\) steps.*/\1/p' "$tmp/demo.log")
-  [ "${steps:-0}" -ge 240 ] || fail "only ${steps:-0} steps in 15 s: the toss did not finish"
+  [ "${steps:-0}" -eq 240 ] || fail "the session ended at step ${steps:-0}, not at --quit-at's 240"
   grep '^tender-demo: camera follow' "$tmp/demo.log"
 }
 # x and y of "the sheet's centre at X Y in the view" (nothing when behind the camera)

@@ -210,6 +210,9 @@ TYPED_TEST_P(SolverCase, AccumulatorClampsFrameTime) {
   EXPECT_EQ(sim.advance(1.0f / 60.0f), 2); // two 120 Hz ticks in a 60 Hz frame
   EXPECT_EQ(sim.advance(5.0f), 3);         // 5 s clamps to 33 ms: three ticks, remainder kept
   EXPECT_EQ(sim.physicsTicks(), 5u);
+  EXPECT_EQ(sim.advance(5.0f, 6), 1); // no step past step 6 (the demo's --quit-at)
+  EXPECT_EQ(sim.advance(5.0f, 6), 0);
+  EXPECT_EQ(sim.frameCount(), 6u);
 }
 
 TYPED_TEST_P(SolverCase, DragReleaseKeepsMomentum) {

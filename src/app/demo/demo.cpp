@@ -363,7 +363,7 @@ int DemoApp::run() {
     if (renderer_->ready()) {
       if (!sim_start) sim_start = now;
       applyPendingMove();
-      sim_->advance(dt);
+      sim_->advance(dt, options_.quit_at > 0 ? options_.quit_at : UINT64_MAX);
       updateFollow(dt);
       backend_.solver->computeNormals();
     }
@@ -376,6 +376,7 @@ int DemoApp::run() {
     drawFrame(view);
     handleActions(actions);
     ++frames;
+    if (options_.quit_at > 0 && sim_->frameCount() >= options_.quit_at) break; // --quit-at
   }
   return finish(frames, std::chrono::duration<double>(Clock::now() - start).count());
 }
