@@ -70,11 +70,11 @@ inline std::vector<FleetSheet> paperFleet(uint32_t count, bool receipt = false) 
   static const char* kSheetScripts[] = {
       "",
       // A fold: the far edge lifted over the sheet and pressed down
-      "0 grab particle 186\n5 move 0.1 -9 -2\n12 move 0.1 -9.8 -0.2\n30 release\n",
+      "0 grab particle 186\n3 move 0.1 -9 -2\n6 move 0.1 -9.8 -0.2\n15 release\n",
       // The hand closing around the middle
-      "0 grab particle 102\n1 move 0 -8.8 -1.2\n4 squeeze 0.5\n12 squeeze 1\n24 move 1 -8 -1\n30 release\n",
+      "0 grab particle 102\n1 move 0 -8.8 -1.2\n3 squeeze 0.5\n6 squeeze 1\n12 move 1 -8 -1\n15 release\n",
       // A yank
-      "0 grab particle 186\n1 move 3 -6 4\n20 release\n",
+      "0 grab particle 186\n1 move 3 -6 4\n10 release\n",
   };
   static const char* kReceiptScripts[] = {"", "2 grab particle 1020\n3 move 0.05 0.9 0.1\n10 release\n"};
   std::vector<FleetSheet> sheets;

@@ -32,12 +32,12 @@ TEST_F(GpuBatchTest, EachSheetOfAMixedBatchMatchesTheCpuReference) {
 TEST_F(GpuBatchTest, SheetsOfPaperMatchTheCpuReference) {
   // Hinges, creases, the stretch limit and the hand in a fleet, and the receipt in the air: every
   // value the shaders read of a fleet's uniforms, by device address, is the sheet's own. The paper
-  // to its scripts' last release (tick 30) and after; the receipts past theirs (tick 10).
+  // to its scripts' last release (tick 15) and after; the receipts past theirs (tick 10).
   for (bool receipt : {false, true}) {
     const std::vector<FleetSheet> sheets = paperFleet(receipt ? 4 : 12, receipt);
     gpu::GpuBatch batch(ctx(), uint32_t(sheets.size()));
     CpuSolver alone;
-    expectFleetMatchesAlone(batch, alone, sheets, receipt ? 12 : 36);
+    expectFleetMatchesAlone(batch, alone, sheets, receipt ? 12 : 18);
   }
 }
 
