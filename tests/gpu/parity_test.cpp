@@ -103,12 +103,12 @@ TEST_F(Parity, FullPhysicsTender60Ticks) {
   }
 }
 
-TEST_F(Parity, FullPhysicsCrumple60Ticks) {
+TEST_F(Parity, FullPhysicsCrumple30Ticks) {
   // The crumple preset with wind, contact and the hand's pace, on the per-colour passes its own
   // sheet runs on a device with 32 KiB of shared memory (over fusedCapacity); at 16 x 24, a sixth of
   // its particles (the fused tick's crumple: TheHandCrumplesTheSameOnEveryPath)
   SimParams p = preset("crumple", {"cols=16", "rows=24", "wind=on"});
-  auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 383\n1 move 4 -6 4\n30 release\n", 60, false);
+  auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 383\n1 move 4 -6 4\n15 release\n", 30, false);
   EXPECT_TRUE(sameState(cpu, gpu));
   expectSameTopology(cpu, gpu);
 }
