@@ -319,7 +319,7 @@ TEST_F(Parity, BucketsLongerThanTheGatherWindow) {
   // here, one substep per dispatch of kGpuLikeWorkgroup invocations (well within lavapipe's loop count).
   SimParams p = cloth({"cols=24", "rows=30", "cell_size=1.8", "wind=on"});
   for (bool fused : {true, false}) {
-    auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 719\n1 move 2 3 1\n", 40, fused,
+    auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 719\n1 move 2 3 1\n", 20, fused,
                               gpu::FusedShape{kGpuLikeWorkgroup, 1, -1.0f});
     EXPECT_TRUE(sameState(cpu, gpu));
     expectSameTopology(cpu, gpu);
