@@ -93,11 +93,11 @@ TEST_F(Parity, NoCollisionNoTearFor240Ticks) {
   }
 }
 
-TEST_F(Parity, FullPhysicsTender60Ticks) {
+TEST_F(Parity, FullPhysicsTender30Ticks) {
   // The seeds' cloth (the preset with contact: TheTenderPresetWithContactTearsTheSameOnTheGpu)
   SimParams p = cloth();
   for (bool fused : {true, false}) {
-    auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 1535\n1 move 1 -1 3\n", 60, fused);
+    auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 1535\n1 move 1 -1 3\n", 30, fused);
     EXPECT_TRUE(sameState(cpu, gpu));
     expectSameTopology(cpu, gpu);
   }
