@@ -117,12 +117,12 @@ int runDemo(const CommonOptions& common, const DemoOptions& o) {
       std::printf("tender: this build has no tender-demo; rendering a picture instead\n");
     }
   }
-  // No display: one picture of the preset after two seconds of simulation (of the replayed
-  // session, with --replay); --record writes the input of that session.
+  // No display: one picture of the preset after two seconds of simulation, or at --quit-at's step
+  // (of the replayed session, with --replay); --record writes the input of that session.
   RenderOptions r;
   r.width = o.width;
   r.height = o.height;
-  r.ticks = uint64_t(2.0f * common.params.tick_hz);
+  r.ticks = o.quit_at > 0 ? o.quit_at : uint64_t(2.0f * common.params.tick_hz);
   r.out = "tender.png";
   std::string error;
   std::optional<InputScript> replay = scriptFor(o.replay, common.params, common.backend, error);

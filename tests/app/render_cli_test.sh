@@ -54,6 +54,11 @@ printf '0 wind off\n0 grab particle 1520\n1 move 0 -9 0\n' >"$tmp/replay.txt"
 (cd "$tmp" && env -u DISPLAY -u WAYLAND_DISPLAY "$T" --backend cpu --set contact_factor=0 --width 64 --height 64 --replay replay.txt --record rec.txt >/dev/null 2>&1) &&
   grep -q "move 0 -9 0" "$tmp/rec.txt" && echo "ok: no display: the replay is rendered and recorded" ||
   fail "no display: --replay/--record not honoured"
+# --quit-at 1: the picture of step 1, and the recording holds the events before it
+(cd "$tmp" && env -u DISPLAY -u WAYLAND_DISPLAY "$T" --backend cpu --set contact_factor=0 --width 64 --height 64 --replay replay.txt --record rec1.txt --quit-at 1 >/dev/null 2>&1) &&
+  grep -q "grab particle 1520" "$tmp/rec1.txt" && ! grep -q "move 0 -9 0" "$tmp/rec1.txt" &&
+  echo "ok: no display: --quit-at 1 renders and records the session to step 1" ||
+  fail "no display: --quit-at not honoured: $(cat "$tmp/rec1.txt")"
 
 # A Vulkan error at run time (the driver cannot allocate under a memory limit) is one line, exit 2.
 # 1024 x 1024 without contact: its buffers pass the binding check, its topology fits in the limit

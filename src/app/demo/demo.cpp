@@ -328,6 +328,7 @@ int DemoApp::run() {
   uint64_t frames = 0;
   float fps = 0.0f, fps_time = 0.0f;
   uint32_t fps_frames = 0;
+  const uint64_t last_step = options_.quit_at > 0 ? options_.quit_at : UINT64_MAX; // --quit-at
 
   // Ctrl-C, SIGTERM or SIGHUP end the session as a window close does (the recording and the summary
   // are written), then say so.
@@ -363,7 +364,7 @@ int DemoApp::run() {
     if (renderer_->ready()) {
       if (!sim_start) sim_start = now;
       applyPendingMove();
-      sim_->advance(dt, options_.quit_at > 0 ? options_.quit_at : UINT64_MAX);
+      sim_->advance(dt, last_step);
       updateFollow(dt);
       backend_.solver->computeNormals();
     }
@@ -376,7 +377,7 @@ int DemoApp::run() {
     drawFrame(view);
     handleActions(actions);
     ++frames;
-    if (options_.quit_at > 0 && sim_->frameCount() >= options_.quit_at) break; // --quit-at
+    if (sim_->frameCount() >= last_step) break; // --quit-at
   }
   return finish(frames, std::chrono::duration<double>(Clock::now() - start).count());
 }
