@@ -16,7 +16,6 @@ The gestures (a tick of each is timed around `Simulation.step(1)`; the stats are
 Keys after the options set every sheet (`backend=gpu`, `threads=1`, `contact_factor=0`, ...). The
 table is Markdown; a row is within real time when its slowest tick fits the period.
 """
-import math
 import statistics
 import sys
 import time
@@ -41,42 +40,6 @@ class Timed(stretch.Scene):
     def rest_for(self, seconds):
         for _ in range(int(seconds * self.hz)):
             self.step()
-
-
-def drag(sc):
-    g = (sc.rows - 1) * sc.cols
-    a = sc.at(g)
-    sc.sim.grab(g)
-    sc.carry(line(a, [a[0] + 0.3 * sc.length, a[1] + 0.3 * sc.length, a[2] + 1.5 * sc.length], int(1.5 * sc.hz)))
-
-
-def fold(sc):
-    g = (sc.rows - 1) * sc.cols + sc.cols // 2
-    a = sc.at(g)
-    over = [a[0], a[1] + 1.5 * sc.s, a[2] + sc.length - 0.5 * sc.s]
-    back = [a[0], a[1] + 1.5 * sc.s, a[2]]
-    sc.sim.grab(g)
-    sc.carry(line(a, over, int(1.5 * sc.hz), 0.4 * sc.length))
-    sc.rest_for(1.0)
-    sc.carry(line(over, back, int(1.5 * sc.hz), 0.4 * sc.length))
-    sc.sim.release()
-    sc.rest_for(0.5)
-
-
-def crumple(sc):
-    p = sc.p
-    area = (sc.cols - 1) * (sc.rows - 1) * sc.s * sc.s
-    ball = min((area * p["collision_factor"] * sc.s / 0.25 * 3 / (4 * math.pi)) ** (1 / 3), p["hand_reach"])
-    g = (sc.rows // 2) * sc.cols + sc.cols // 2
-    m = sc.at(g)
-    top = [m[0], m[1] + 0.3 * sc.length, m[2]]
-    sc.sim.grab(g)
-    sc.carry(line(m, top, sc.hz))
-    for t in range(1, sc.hz + 1):
-        sc.sim.squeeze(t / sc.hz)
-        sc.step()
-    sc.rest_for(1.0)
-    sc.carry(line(top, [m[0], max(m[1], p["floor_y"] + ball + sc.s), m[2]], sc.hz))
 
 
 def fast(sc):
@@ -112,7 +75,8 @@ def yank(sc):
     sc.rest_for(0.5)
 
 
-GESTURES = (("drag", drag), ("fold", fold), ("crumple", crumple), ("fast", fast), ("toss", toss), ("yank", yank))
+GESTURES = (("drag", stretch.drag), ("fold", stretch.fold), ("crumple", stretch.crumple), ("fast", fast), ("toss", toss),
+            ("yank", yank))
 
 
 def main():

@@ -55,18 +55,15 @@ def line(a, b, n, lift=0.0):
             for t in range(1, n + 1)]
 
 
-def drag(preset, overrides):
-    sc = Scene(preset, overrides)
+def drag(sc):
     g = (sc.rows - 1) * sc.cols
     a = sc.at(g)
     b = [a[0] + 0.3 * sc.length, a[1] + 0.3 * sc.length, a[2] + 1.5 * sc.length]
     sc.sim.grab(g)
     sc.carry(line(a, b, int(1.5 * sc.hz)))
-    return sc.most
 
 
-def fold(preset, overrides):
-    sc = Scene(preset, overrides)
+def fold(sc):
     g = (sc.rows - 1) * sc.cols + sc.cols // 2
     a = sc.at(g)
     over = [a[0], a[1] + 1.5 * sc.s, a[2] + sc.length - 0.5 * sc.s]
@@ -80,11 +77,9 @@ def fold(preset, overrides):
     sc.sim.release()
     for _ in range(sc.hz // 2):
         sc.step()
-    return sc.most
 
 
-def crumple(preset, overrides):
-    sc = Scene(preset, overrides)
+def crumple(sc):
     p = sc.p
     # The fist's radius (SimParams::handBallRadius): the sheet's area in layers a collision radius
     # thick at a packing of a quarter, within the hand's reach
@@ -102,15 +97,16 @@ def crumple(preset, overrides):
     for _ in range(sc.hz):
         sc.step()
     sc.carry(line(top, rest, sc.hz))
-    return sc.most
 
 
 def main():
     if len(sys.argv) < 2:
         sys.exit(__doc__)
     overrides = dict(arg.split("=", 1) for arg in sys.argv[2:])
-    for name, scene in (("drag", drag), ("fold", fold), ("crumple", crumple)):
-        print(f"{sys.argv[1]} {name}: most stretch {scene(sys.argv[1], overrides):.4f}", flush=True)
+    for name, gesture in (("drag", drag), ("fold", fold), ("crumple", crumple)):
+        sc = Scene(sys.argv[1], overrides)
+        gesture(sc)
+        print(f"{sys.argv[1]} {name}: most stretch {sc.most:.4f}", flush=True)
 
 
 if __name__ == "__main__":
