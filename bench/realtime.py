@@ -4,7 +4,7 @@ each preset, with the median and the slowest tick against the tick's period (1 /
 
     PYTHONPATH=build/release/python python3 bench/realtime.py [--presets crumple,tender] [key=value ...]
 
-The gestures (a tick of each is timed around `Simulation.step(1)`; the stats are read outside it):
+The gestures (each tick timed around `Simulation.step(1)` alone):
 - drag, fold and crumple: bench/stretch.py's (a corner dragged back over the sheet; the far edge
   folded over and back and let go; the middle lifted, the hand closed, held, lowered);
 - fast: bench/rest.py's fast crumple (the middle snatched up as the hand closes, swung round, let go
@@ -26,7 +26,7 @@ from stretch import line
 
 
 class Timed(stretch.Scene):
-    """stretch.Scene whose ticks are timed, the stats left out of the time."""
+    """stretch.Scene whose ticks are timed (and its stats not read)."""
 
     def __init__(self, preset, overrides):
         super().__init__(preset, overrides)
