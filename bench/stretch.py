@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """How far the sheet stretches under the hand: the largest structural length / rest at any tick
 (`tender sim`'s `max_stretch`) while a grab drags, folds and crumples a sheet lying on its floor at a
-hand's pace, on the CPU.
+hand's pace, crumples it faster, tosses it and yanks it, on the CPU.
 
     PYTHONPATH=build/ci/python python3 bench/stretch.py crumple [key=value ...]
 
@@ -9,7 +9,12 @@ hand's pace, on the CPU.
 - fold: the middle of the far row carried over an arc to just above the near row (1.5 s), held
   there (1 s), carried back (1.5 s) to 1.5 spacings above where it started, and let go (0.5 s);
 - crumple: the middle grabbed and lifted (1 s), the hand closed (1 s), held (1 s), and the ball
-  lowered until it rests on the floor (1 s).
+  lowered until it rests on the floor (1 s);
+- fast: bench/rest.py's fast crumple (the middle snatched up as the hand closes, swung round, let go
+  at tick 40), then a second on the floor;
+- toss: a corner swung up and forwards in 12 ticks and let go, then a second of flight and landing;
+- yank: the middle of the far row pulled away at four sheet lengths a second for half a second, let
+  go, then half a second more.
 """
 import math
 import sys
@@ -40,6 +45,10 @@ class Scene:
     def step(self):
         self.sim.step(1)
         self.most = max(self.most, self.sim.stats()["max_stretch"])
+
+    def rest_for(self, seconds):
+        for _ in range(int(seconds * self.hz)):
+            self.step()
 
     def carry(self, points):
         for q in points:
@@ -99,11 +108,49 @@ def crumple(sc):
     sc.carry(line(top, rest, sc.hz))
 
 
+def fast(sc):
+    import rest  # bench/rest.py, beside this script (it imports this one)
+
+    g = (sc.rows // 2) * sc.cols + sc.cols // 2
+    sc.middle, sc.m = g, sc.at(g)
+    sc.sim.grab(g)
+    for t in range(1, 40):
+        sc.sim.move(*rest.fast_hand(sc, t, 1.0))
+        if t <= 5:
+            sc.sim.squeeze(min(0.2 * t, 1.0))
+        sc.step()
+    sc.sim.release()
+    sc.rest_for(1.0)
+
+
+def toss(sc):
+    a = sc.at(0)
+    sc.sim.grab(0)
+    for k in range(1, 13):
+        sc.sim.move(a[0] + 0.02 * k * sc.length, a[1] + 0.05 * k * sc.length, a[2] + 0.08 * k * sc.length)
+        sc.step()
+    sc.sim.release()
+    sc.rest_for(1.0)
+
+
+def yank(sc):
+    g = (sc.rows - 1) * sc.cols + sc.cols // 2
+    a = sc.at(g)
+    n = sc.hz // 2
+    sc.sim.grab(g)
+    sc.carry(line(a, [a[0], a[1] + 0.5 * sc.length, a[2] - 2.0 * sc.length], n))
+    sc.sim.release()
+    sc.rest_for(0.5)
+
+
+GESTURES = (("drag", drag), ("fold", fold), ("crumple", crumple), ("fast", fast), ("toss", toss), ("yank", yank))
+
+
 def main():
     if len(sys.argv) < 2:
         sys.exit(__doc__)
     overrides = dict(arg.split("=", 1) for arg in sys.argv[2:])
-    for name, gesture in (("drag", drag), ("fold", fold), ("crumple", crumple)):
+    for name, gesture in GESTURES:
         sc = Scene(sys.argv[1], overrides)
         gesture(sc)
         print(f"{sys.argv[1]} {name}: most stretch {sc.most:.4f}", flush=True)
