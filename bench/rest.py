@@ -17,12 +17,11 @@ most stretch, the fastest particle while the hand moves and after it lets go, an
 end (`max_speed`, units/s). How many edges a fast crumple tears changes with the last digit of the
 hand's path; a count at one pace says little.
 """
-import math
 import os
 import sys
 
 import tender
-from stretch import number  # bench/stretch.py, beside this script
+from stretch import fast_hand, number  # bench/stretch.py, beside this script
 
 
 class Scene:
@@ -57,13 +56,6 @@ class Scene:
               f"while held, {self.after:.2f} after, {s['max_speed']:.3f} at the end", flush=True)
 
 
-def fast_hand(sc, t, pace):
-    at = t * pace
-    if at <= 5:
-        return [sc.m[0], sc.m[1] + sc.length * 0.07 * at, sc.m[2]]
-    a = 0.35 * (at - 6)
-    return [sc.m[0] + 0.14 * sc.length * math.cos(a), sc.m[1] + sc.length * (0.35 - 0.09 * math.sin(a)),
-            sc.m[2] + 0.14 * sc.length * math.sin(a)]
 
 
 def fast(overrides, pace):

@@ -80,12 +80,10 @@ def fold(sc):
     n = int(1.5 * sc.hz)
     sc.sim.grab(g)
     sc.carry(line(a, over, n, 0.4 * sc.length))
-    for _ in range(sc.hz):
-        sc.step()
+    sc.rest_for(1.0)
     sc.carry(line(over, back, n, 0.4 * sc.length))
     sc.sim.release()
-    for _ in range(sc.hz // 2):
-        sc.step()
+    sc.rest_for(0.5)
 
 
 def crumple(sc):
@@ -103,19 +101,26 @@ def crumple(sc):
     for t in range(1, sc.hz + 1):
         sc.sim.squeeze(t / sc.hz)
         sc.step()
-    for _ in range(sc.hz):
-        sc.step()
+    sc.rest_for(1.0)
     sc.carry(line(top, rest, sc.hz))
 
 
-def fast(sc):
-    import rest  # bench/rest.py, beside this script (it imports this one)
+def fast_hand(sc, t, pace):
+    """Where the fast crumple's hand is at tick t, at `pace` times its speed (sc.m: the middle)."""
+    at = t * pace
+    if at <= 5:
+        return [sc.m[0], sc.m[1] + sc.length * 0.07 * at, sc.m[2]]
+    a = 0.35 * (at - 6)
+    return [sc.m[0] + 0.14 * sc.length * math.cos(a), sc.m[1] + sc.length * (0.35 - 0.09 * math.sin(a)),
+            sc.m[2] + 0.14 * sc.length * math.sin(a)]
 
+
+def fast(sc):
     g = (sc.rows // 2) * sc.cols + sc.cols // 2
     sc.middle, sc.m = g, sc.at(g)
     sc.sim.grab(g)
     for t in range(1, 40):
-        sc.sim.move(*rest.fast_hand(sc, t, 1.0))
+        sc.sim.move(*fast_hand(sc, t, 1.0))
         if t <= 5:
             sc.sim.squeeze(min(0.2 * t, 1.0))
         sc.step()
