@@ -107,6 +107,7 @@ void CpuContact::listEdges(const std::vector<uvec4>& triangles, uint32_t count) 
   }
   std::sort(edges_.begin(), edges_.end(), [](uvec2 a, uvec2 b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
   edges_.erase(std::unique(edges_.begin(), edges_.end()), edges_.end());
+  ownTriangles(triangles, count);
   edges_key_ = count;
   lists_ = false;
 }

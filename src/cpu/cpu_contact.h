@@ -2,9 +2,10 @@
 /// Penetration-free self-contact of the CPU solver: the step bound of every particle at the start
 /// of a substep (contact.h: slideBound, from the nearest of the triangles and edges near it) and,
 /// after the floor, the cut of each step to its pairs' half-spaces (slide), from lists of the
-/// pairs near each other that a uniform grid of the triangles', then the edges', boxes finds, kept
-/// while the particles travel little (once the sheet's turn is taken out, and where clusters of
-/// them next to each other travel alike) and repaired where a few travelled far. Each distance lowers
+/// pairs near each other that a uniform grid of the triangles' boxes finds (each triangle against
+/// those near it, the pairs of the edges and particles they own), kept while the particles travel
+/// little (once the sheet's turn is taken out, and where clusters of them next to each other
+/// travel alike) and repaired where a few travelled far. Each distance lowers
 /// the bounds of the particles of its pair by an atomic minimum, and each half-space their shares
 /// (their excesses are integer sums), so the bits are the same whatever the thread count or order
 /// and whatever the lists hold beyond the pairs closer than the radius.
@@ -107,7 +108,7 @@ private:
   /// bucket), and the fewest boxes a run
   static constexpr uint32_t kGridParts = 4, kGridPartBoxes = 4096;
   /// Shares a worker takes of a list build's searches: a crumpled part of the sheet costs more than
-  /// a flat one, and an edge looks only at the edges after it, so the first edges cost the most
+  /// a flat one, and a triangle looks only at the triangles after it, so the first cost the most
   static constexpr uint32_t kSearchShares = 8;
 
   /// Calls visit(pair, ContactPair, edge, j, SlideHalf) for each half-space the pairs closer than
@@ -165,9 +166,12 @@ private:
   /// each two clusters next to each other lie within two contactTravel, and the whole spread
   /// within cluster_far_.
   bool clustersHold(glm::vec3 lo, glm::vec3 hi, float radius);
-  /// The boxes of the first `count` triangles at `pos`, then of the edges, into lo_ and hi_.
+  /// The boxes of the first `count` triangles at `pos` into lo_ and hi_ (and their balls into ball_),
+  /// then of the edges.
   void boxTriangles(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count);
   void boxEdges(const std::vector<glm::vec4>& pos);
+  /// What each triangle owns for buildLists's search (own_, own_particles_, owned_).
+  void ownTriangles(const std::vector<glm::uvec4>& triangles, uint32_t count);
   /// The cells of the lists' grids for pairs within `reach` at `pos` (1 / their width), or 0 when
   /// the positions have gone wrong.
   float listCell(const std::vector<glm::vec4>& pos, float reach) const;
@@ -180,30 +184,34 @@ private:
   WorkerPool& pool_;
   Lists lists_kept_;
   uint32_t grid_part_boxes_;
-  std::vector<glm::uvec4> vf_;       ///< particle, then the triangle's three: pairs within radius + skin
-  std::vector<glm::ivec4> sums_;     ///< each particle's pushes in fixed point, and their count
-  std::vector<glm::uvec4> ee_;       ///< two edges' particles: pairs within radius + skin
-  std::vector<glm::vec4> base_;      ///< where the particles were when the lists were built
-  bool lists_ = false;               ///< the lists are usable
-  std::vector<uint8_t> free_;        ///< particles of triangles crossing another: not bounded
-  std::vector<uint8_t> was_free_;    ///< free_ of the last call
-  std::vector<uint32_t> checked_;    ///< scratch: the triangles checked for crossing
-  std::vector<uint8_t> crossing_;    ///< scratch: the triangles crossing another
-  bool tangles_ = false;             ///< the sheet crossed itself at the last call
-  float list_radius_ = 0.0f;         ///< the contact radius they were built for
-  std::vector<glm::uvec2> edges_;    ///< the sheet's edges, each once (a < b)
-  uint64_t edges_key_ = ~0ull;       ///< the triangle count the edges were worked out for
-  std::vector<glm::vec3> lo_, hi_;   ///< scratch: the boxes of the triangles, then of the edges
-  std::vector<glm::vec3> points_;    ///< scratch: the particles (a repair's grid of them)
-  std::vector<uint8_t> moved_;       ///< scratch: the particles a repair looks at
-  std::vector<float> travels_;       ///< scratch: one component of every particle's travel
-  std::vector<uint32_t> dirty_;      ///< scratch: the particles, triangles, edges a repair looks at
-  std::vector<uint32_t> nearest2_;   ///< the bits of each particle's smallest squared distance
-  std::vector<uint32_t> share_bits_; ///< scratch: the bits of each particle's share (slide)
-  std::vector<uint32_t> half_start_; ///< each particle's half-spaces at [half_start_[i], half_start_[i + 1])
-  std::vector<glm::vec4> half_;      ///< the half-spaces (SlideHalf::h)
-  std::vector<float> half_slack_;    ///< and their slack
-  std::vector<uint32_t> half_fill_;  ///< scratch: where each particle's next half-space goes
+  std::vector<glm::uvec4> vf_;          ///< particle, then the triangle's three: pairs within radius + skin
+  std::vector<glm::ivec4> sums_;        ///< each particle's pushes in fixed point, and their count
+  std::vector<glm::uvec4> ee_;          ///< two edges' particles: pairs within radius + skin
+  std::vector<glm::vec4> base_;         ///< where the particles were when the lists were built
+  bool lists_ = false;                  ///< the lists are usable
+  std::vector<uint8_t> free_;           ///< particles of triangles crossing another: not bounded
+  std::vector<uint8_t> was_free_;       ///< free_ of the last call
+  std::vector<uint32_t> checked_;       ///< scratch: the triangles checked for crossing
+  std::vector<uint8_t> crossing_;       ///< scratch: the triangles crossing another
+  bool tangles_ = false;                ///< the sheet crossed itself at the last call
+  float list_radius_ = 0.0f;            ///< the contact radius they were built for
+  std::vector<glm::uvec2> edges_;       ///< the sheet's edges, each once (a < b)
+  uint64_t edges_key_ = ~0ull;          ///< the triangle count the edges were worked out for
+  std::vector<glm::vec3> lo_, hi_;      ///< scratch: the boxes of the triangles, then of the edges
+  std::vector<glm::vec4> ball_;         ///< scratch: the triangles' balls (centroid, farthest corner)
+  std::vector<glm::uvec4> own_;         ///< each triangle's own edges and counts (ownTriangles)
+  std::vector<uint32_t> own_particles_; ///< each triangle's own particles, three slots a triangle
+  std::vector<uint8_t> owned_;          ///< the particles some triangle holds
+  std::vector<glm::vec3> points_;       ///< scratch: the particles (a repair's grid of them)
+  std::vector<uint8_t> moved_;          ///< scratch: the particles a repair looks at
+  std::vector<float> travels_;          ///< scratch: one component of every particle's travel
+  std::vector<uint32_t> dirty_;         ///< scratch: the particles, triangles, edges a repair looks at
+  std::vector<uint32_t> nearest2_;      ///< the bits of each particle's smallest squared distance
+  std::vector<uint32_t> share_bits_;    ///< scratch: the bits of each particle's share (slide)
+  std::vector<uint32_t> half_start_;    ///< each particle's half-spaces at [half_start_[i], half_start_[i + 1])
+  std::vector<glm::vec4> half_;         ///< the half-spaces (SlideHalf::h)
+  std::vector<float> half_slack_;       ///< and their slack
+  std::vector<uint32_t> half_fill_;     ///< scratch: where each particle's next half-space goes
   Grid grid_, points_grid_;
   uint64_t contacts_ = 0;
   uint32_t builds_ = 0;

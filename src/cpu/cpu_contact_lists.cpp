@@ -1,9 +1,9 @@
 // The CPU contact's pair lists (cpu_contact.h): the grid of boxes they are searched in, their
-// build, and how they are kept while the particles travel: with the sheet's turn taken out
-// (turnedTravel), while clusters next to each other travel alike (clustersHold), and repaired
-// around the few particles that travelled too far (repairLists).
+// build, and their repair around the few particles that travelled too far (repairLists); how far
+// the particles travelled is cpu_contact_travel.cpp's.
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtx/component_wise.hpp>
@@ -78,40 +78,71 @@ void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3
 
 void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
                             float radius) {
-  const float reach = contactReach(radius);
-  const uint32_t n = uint32_t(pos.size()), edge_count = uint32_t(edges_.size());
+  const float reach = contactReach(radius), reach2 = reach * reach;
+  const uint32_t n = uint32_t(pos.size());
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
   vf_.clear();
   ee_.clear();
   lists_ = false;
   const float inv_cell = listCell(pos, reach);
   if (!(inv_cell > 0.0f)) return;
-  const float reach2 = reach * reach;
-  // Particles against the triangles that do not hold them: the boxes of the triangles in the grid,
-  // each particle's box of half-width `reach` against them
+  // One search finds both kinds of pair: the triangles' boxes in the grid, each triangle against
+  // those after it whose boxes come within the reach. Each edge and each particle belongs to the
+  // first triangle that holds it (ownTriangles), and two triangles weigh the pairs of what they
+  // own: an edge-edge pair within the reach lies in two triangles within it, and a particle
+  // within the reach of a triangle lies in one; a pair of triangles is met once, so every pair is.
+  // Particles no triangle holds (torn free) look for their triangles on their own.
   boxTriangles(pos, triangles, count);
   grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
-  gatherPairs(pool_, n, kGrainCollide, kSearchShares, vf_, [&](uint32_t v, std::vector<uvec4>& found) {
-    const vec3 p = at(v), plo = p - vec3(reach), phi = p + vec3(reach);
-    visitBox(grid_, plo, phi, inv_cell, 0, [&](uint32_t t) {
-      const uvec4 tri = triangles[t];
-      if (v == tri.x || v == tri.y || v == tri.z) return;
-      if (pointTriangleDistance2(p, at(tri.x), at(tri.y), at(tri.z)) < reach2)
-        found.push_back(uvec4(v, tri.x, tri.y, tri.z));
+  auto close_to = [&](uint32_t v, uvec4 tri) {
+    return v != tri.x && v != tri.y && v != tri.z &&
+           pointTriangleDistance2(at(v), at(tri.x), at(tri.y), at(tri.z)) < reach2;
+  };
+  // A particle farther than the reach from a triangle's ball is farther from the triangle
+  auto near_ball = [&](uint32_t v, glm::vec4 ball) { return !ballsApart(glm::vec4(at(v), 0.0f), ball, reach); };
+  // Edges j and k as the lists hold them, the lower first (segmentDistance2 weighs them in that
+  // order), when they share no particle and come within the reach
+  auto close_edges = [&](uint32_t j, uint32_t k, std::vector<uvec4>& found) {
+    const uvec2 e = edges_[std::min(j, k)], f = edges_[std::max(j, k)];
+    if (f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
+    const vec3 a = at(e.x), b = at(e.y), c = at(f.x), d = at(f.y);
+    if (segmentsApart((a + b) * 0.5f, b - a, (c + d) * 0.5f, d - c, reach)) return;
+    if (segmentDistance2(a, b, c, d) < reach2) found.push_back(uvec4(e, f));
+  };
+  std::mutex merge;
+  pool_.parallelFor(
+      count, kGrainCollide,
+      [&](uint32_t begin, uint32_t end) {
+        std::vector<uvec4> vf, ee;
+        for (uint32_t t = begin; t < end; ++t) {
+          const uvec4 tri = triangles[t], mine = own_[t];
+          visitBox(grid_, lo_[t] - vec3(reach), hi_[t] + vec3(reach), inv_cell, t + 1, [&](uint32_t o) {
+            if (ballsApart(ball_[t], ball_[o], reach)) return;
+            const uvec4 other = triangles[o], theirs = own_[o];
+            for (uint32_t i = 0; i < (mine.w & 3u); ++i)
+              for (uint32_t j = 0; j < (theirs.w & 3u); ++j) close_edges(mine[int(i)], theirs[int(j)], ee);
+            for (uint32_t i = 0; i < (mine.w >> 2); ++i) {
+              const uint32_t v = own_particles_[t * 3 + i];
+              if (near_ball(v, ball_[o]) && close_to(v, other)) vf.push_back(uvec4(v, other.x, other.y, other.z));
+            }
+            for (uint32_t j = 0; j < (theirs.w >> 2); ++j) {
+              const uint32_t v = own_particles_[o * 3 + j];
+              if (near_ball(v, ball_[t]) && close_to(v, tri)) vf.push_back(uvec4(v, tri.x, tri.y, tri.z));
+            }
+          });
+        }
+        const std::lock_guard<std::mutex> lock(merge);
+        vf_.insert(vf_.end(), vf.begin(), vf.end());
+        ee_.insert(ee_.end(), ee.begin(), ee.end());
+      },
+      kSearchShares);
+  for (uint32_t v = 0; v < n; ++v) {
+    if (v < owned_.size() && owned_[v]) continue;
+    const vec3 p = at(v);
+    visitBox(grid_, p - vec3(reach), p + vec3(reach), inv_cell, 0, [&](uint32_t t) {
+      if (close_to(v, triangles[t])) vf_.push_back(uvec4(v, triangles[t].x, triangles[t].y, triangles[t].z));
     });
-  });
-  // Edges against the edges that share no particle with them, each pair once
-  boxEdges(pos);
-  grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
-  gatherPairs(pool_, edge_count, kGrainCollide, kSearchShares, ee_, [&](uint32_t k, std::vector<uvec4>& found) {
-    const uvec2 e = edges_[k];
-    const vec3 elo = lo_[k] - vec3(reach), ehi = hi_[k] + vec3(reach);
-    visitBox(grid_, elo, ehi, inv_cell, k + 1, [&](uint32_t j) {
-      const uvec2 f = edges_[j];
-      if (f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
-      if (segmentDistance2(at(e.x), at(e.y), at(f.x), at(f.y)) < reach2) found.push_back(uvec4(e, f));
-    });
-  });
+  }
   // The same lists whatever the threads' order (visitBox meets each pair once)
   std::sort(vf_.begin(), vf_.end(), less4);
   std::sort(ee_.begin(), ee_.end(), less4);
@@ -123,13 +154,49 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
   ++builds_;
 }
 
+// What each triangle owns for the search of buildLists: the edges (own_[t].xyz, own_[t].w & 3 of
+// them) and the particles (own_particles_[3 t ...], own_[t].w >> 2 of them) that no triangle before
+// it holds; owned_ marks the particles some triangle holds.
+void CpuContact::ownTriangles(const std::vector<uvec4>& triangles, uint32_t count) {
+  own_.assign(count, uvec4(0u));
+  own_particles_.assign(size_t(count) * 3, 0u);
+  std::vector<uint8_t> edge_owned(edges_.size(), 0);
+  owned_.clear();
+  auto edge_index = [&](uint32_t a, uint32_t b) {
+    const uvec2 e(std::min(a, b), std::max(a, b));
+    return uint32_t(std::lower_bound(edges_.begin(), edges_.end(), e,
+                                     [](uvec2 x, uvec2 y) { return x.x != y.x ? x.x < y.x : x.y < y.y; }) -
+                    edges_.begin());
+  };
+  for (uint32_t t = 0; t < count; ++t) {
+    const uvec4 tri = triangles[t];
+    uint32_t edges = 0, particles = 0;
+    for (const uvec2 e : {uvec2(tri.x, tri.y), uvec2(tri.y, tri.z), uvec2(tri.z, tri.x)}) {
+      const uint32_t k = edge_index(e.x, e.y);
+      if (edge_owned[k]) continue;
+      edge_owned[k] = 1;
+      own_[t][int(edges++)] = k;
+    }
+    for (const uint32_t v : {tri.x, tri.y, tri.z}) {
+      if (v >= owned_.size()) owned_.resize(v + 1, 0);
+      if (owned_[v]) continue;
+      owned_[v] = 1;
+      own_particles_[t * 3 + particles++] = v;
+    }
+    own_[t].w = edges | (particles << 2);
+  }
+}
+
 void CpuContact::boxTriangles(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count) {
   lo_.resize(count);
   hi_.resize(count);
+  ball_.resize(count);
   for (uint32_t t = 0; t < count; ++t) {
     const vec3 a = vec3(pos[triangles[t].x]), b = vec3(pos[triangles[t].y]), c = vec3(pos[triangles[t].z]);
     lo_[t] = glm::min(a, glm::min(b, c));
     hi_[t] = glm::max(a, glm::max(b, c));
+    const vec3 m = (a + b + c) * (1.0f / 3.0f);
+    ball_[t] = glm::vec4(m, std::sqrt(std::max({length2(a - m), length2(b - m), length2(c - m)})));
   }
 }
 
@@ -276,159 +343,6 @@ void CpuContact::searchMoved(const std::vector<glm::vec4>& pos, const std::vecto
         found.push_back(j < k ? uvec4(f, e) : uvec4(e, f));
     });
   });
-}
-
-void CpuContact::clusterBases(float radius) {
-  using glm::ivec3;
-  const uint32_t n = uint32_t(base_.size());
-  cluster_count_ = 0;
-  cluster_pairs_.clear();
-  // The longest edge between bases (a repair moves a base off where the particle was)
-  float longest2 = 0.0f;
-  for (const uvec2 e : edges_) longest2 = std::max(longest2, length2(vec3(base_[e.y]) - vec3(base_[e.x])));
-  const float longest = std::sqrt(longest2), width = kClusterWidth * (contactReach(radius) + longest);
-  cluster_far_ = width - 2.0f * longest - radius;
-  const float inv = 1.0f / width;
-  if (n == 0 || !(cluster_far_ > 0.0f) || !std::isfinite(inv) || !(longest < 1e30f)) return;
-  // The particles in the order of their cells, a cluster's together
-  std::vector<std::pair<ivec3, uint32_t>> cells(n);
-  auto less3 = [](ivec3 a, ivec3 b) { return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z; };
-  for (uint32_t i = 0; i < n; ++i) cells[i] = {cellOf(vec3(base_[i]), inv), i};
-  std::sort(cells.begin(), cells.end(), [&](const auto& a, const auto& b) {
-    return less3(a.first, b.first) || (a.first == b.first && a.second < b.second);
-  });
-  std::vector<ivec3> keys;
-  cluster_members_.resize(n);
-  cluster_start_.clear();
-  for (uint32_t k = 0; k < n; ++k) {
-    if (keys.empty() || keys.back() != cells[k].first) {
-      keys.push_back(cells[k].first);
-      cluster_start_.push_back(k);
-    }
-    cluster_members_[k] = cells[k].second;
-  }
-  cluster_start_.push_back(n);
-  cluster_count_ = uint32_t(keys.size());
-  // Each cluster with itself and with those in the 26 cells around it, each pair once
-  for (uint32_t a = 0; a < cluster_count_; ++a)
-    for (int z = -1; z <= 1; ++z)
-      for (int y = -1; y <= 1; ++y)
-        for (int x = -1; x <= 1; ++x) {
-          const ivec3 other = keys[a] + ivec3(x, y, z);
-          if (less3(other, keys[a])) continue;
-          const auto it = std::lower_bound(keys.begin(), keys.end(), other, less3);
-          if (it != keys.end() && *it == other) cluster_pairs_.push_back(uvec2(a, uint32_t(it - keys.begin())));
-        }
-}
-
-bool CpuContact::clustersHold(vec3 lo, vec3 hi, float radius) {
-  // Why the lists still hold every pair closer than the radius (the proof of repairLists, in the
-  // turned frame of turnedTravel). A pair the lists lack was apart by at least the reach at its
-  // particles' bases (or a repair's reach less two travels), and its distance has fallen by at
-  // most the largest |q_k - q_l| of its particles k, l. Where every such k and l lie in clusters A
-  // and B next to each other (or one), |q_k - q_l| <= T_A + T_B + |m_A - m_B| (m the middle of a
-  // cluster's travels' box, T its half-diagonal), which must stay within two travels, as the
-  // whole sheet's spread must without clusters. Where some k and l lie in clusters apart, their
-  // bases are a cluster's width apart along an axis, the pair's at least that less two longest
-  // edges, and it has fallen by at most the whole spread: cluster_far_ less the radius allows.
-  if (cluster_key_ != builds_ + repairs_done_) {
-    clusterBases(radius);
-    cluster_key_ = builds_ + repairs_done_;
-  }
-  if (cluster_count_ == 0 || !(glm::length(hi - lo) < cluster_far_)) return false;
-  cluster_box_.resize(cluster_count_);
-  pool_.parallelFor(cluster_count_, kGrainRepair, [&](uint32_t begin, uint32_t end) {
-    for (uint32_t a = begin; a < end; ++a) {
-      vec3 blo(INFINITY), bhi(-INFINITY);
-      for (uint32_t k = cluster_start_[a]; k < cluster_start_[a + 1]; ++k) {
-        blo = glm::min(blo, travel_[cluster_members_[k]]);
-        bhi = glm::max(bhi, travel_[cluster_members_[k]]);
-      }
-      cluster_box_[a] = glm::vec4(0.5f * (blo + bhi), 0.5f * glm::length(bhi - blo));
-    }
-  });
-  const float budget = 2.0f * contactTravel(radius);
-  for (const uvec2 p : cluster_pairs_) {
-    const glm::vec4 a = cluster_box_[p.x], b = cluster_box_[p.y];
-    if (!(a.w + b.w + glm::length(vec3(a) - vec3(b)) < budget)) return false;
-  }
-  return true;
-}
-
-std::pair<vec3, vec3> CpuContact::turnedTravel(const std::vector<glm::vec4>& pos) {
-  // Why a turn keeps the lists' proof (repairLists): for any rotation R and points c, c', the
-  // distance between particles i and j is |R^T (x_i - x_j)| = |(b_i - b_j) + (q_i - q_j)| with
-  // q_i = R^T (x_i - c) - (b_i - c') their travel in the turned frame, so a pair's distance
-  // differs from its bases' by at most |q_i - q_j|, as it does by |d_i - d_j| with no turn. R may
-  // be any rotation at any call: the best fit only makes the travels small.
-  using glm::dmat3;
-  using glm::dvec3;
-  const uint32_t n = uint32_t(pos.size());
-  travel_.resize(n);
-  if (n == 0) return {vec3(0.0f), vec3(0.0f)};
-  // The centroids and the cross-covariance of the positions and the bases, about the first
-  // particle's (small sums), in chunks added in their order
-  auto d3 = [](glm::vec4 v) { return dvec3(v.x, v.y, v.z); };
-  const dvec3 x0 = d3(pos[0]), b0 = d3(base_[0]);
-  struct Moments {
-    dvec3 x{0.0}, b{0.0};
-    dmat3 xb{0.0};
-  };
-  const uint32_t chunks = pool_.chunksFor(n, kGrainParticles);
-  std::vector<Moments> parts(chunks);
-  pool_.run(chunks, [&](uint32_t c) {
-    Moments m;
-    for (uint32_t i = WorkerPool::chunkBound(n, chunks, c); i < WorkerPool::chunkBound(n, chunks, c + 1); ++i) {
-      const dvec3 x = d3(pos[i]) - x0, b = d3(base_[i]) - b0;
-      m.x += x;
-      m.b += b;
-      m.xb += glm::outerProduct(x, b);
-    }
-    parts[c] = m;
-  });
-  Moments all;
-  for (const Moments& m : parts) {
-    all.x += m.x;
-    all.b += m.b;
-    all.xb += m.xb;
-  }
-  const dvec3 cx = all.x / double(n), cb = all.b / double(n);
-  const dmat3 a = all.xb - double(n) * glm::outerProduct(cx, cb);
-  // The rotation of A's polar decomposition, the turn that carries the bases' shape nearest onto
-  // the positions' (Müller et al., "A Robust Method to Extract the Rotational Part of
-  // Deformations", 2016: a flat sheet's rank-2 A is no trouble), from the last call's
-  for (int k = 0; k < 32; ++k) {
-    const dmat3 r = glm::mat3_cast(turn_);
-    const dvec3 omega = glm::cross(r[0], a[0]) + glm::cross(r[1], a[1]) + glm::cross(r[2], a[2]);
-    const double w =
-        glm::length(omega) / (std::abs(glm::dot(r[0], a[0]) + glm::dot(r[1], a[1]) + glm::dot(r[2], a[2])) + 1e-30);
-    if (!(w > 1e-12) || !std::isfinite(w)) break;
-    turn_ = glm::normalize(glm::angleAxis(w, glm::normalize(omega)) * turn_);
-  }
-  if (!std::isfinite(turn_.w + turn_.x + turn_.y + turn_.z)) turn_ = glm::dquat(1.0, 0.0, 0.0, 0.0);
-  const dmat3 rt = glm::transpose(glm::mat3_cast(turn_));
-  struct Box {
-    glm::uvec3 lo{~0u}, hi{0u};
-  };
-  std::vector<Box> boxes(chunks);
-  pool_.run(chunks, [&](uint32_t c) {
-    Box box;
-    for (uint32_t i = WorkerPool::chunkBound(n, chunks, c); i < WorkerPool::chunkBound(n, chunks, c + 1); ++i) {
-      const vec3 q = vec3(rt * (d3(pos[i]) - x0 - cx) - (d3(base_[i]) - b0 - cb));
-      travel_[i] = q;
-      for (int k = 0; k < 3; ++k) {
-        box.lo[k] = std::min(box.lo[k], orderedBits(q[k]));
-        box.hi[k] = std::max(box.hi[k], orderedBits(q[k]));
-      }
-    }
-    boxes[c] = box;
-  });
-  Box box;
-  for (const Box& b : boxes) {
-    box.lo = glm::min(box.lo, b.lo);
-    box.hi = glm::max(box.hi, b.hi);
-  }
-  return {orderedCorner(box.lo), orderedCorner(box.hi)};
 }
 
 } // namespace tender
