@@ -48,7 +48,7 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
   keepLists(pos, triangles, count, radius, travel_lo, travel_hi);
   sums_.assign(n, glm::ivec4(0));
   findCrossings(pos, triangles, count, s == 0 && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u, thickness, scale);
-  lowerNearest(pos, radius, thickness, scale);
+  lowerNearest(pos, radius, thickness, scale, u.contact.y);
   const uint32_t none = std::bit_cast<uint32_t>(radius * radius);
   uint64_t contacts = 0;
   for (uint32_t i = 0; i < n; ++i) {
@@ -141,56 +141,57 @@ void CpuContact::keepLists(const std::vector<glm::vec4>& pos, const std::vector<
   if (!fresh && !(repairable && repairLists(pos, triangles, count, radius))) buildLists(pos, triangles, count, radius);
 }
 
-void CpuContact::lowerNearest(const std::vector<glm::vec4>& pos, float radius, float thickness, float scale) {
+void CpuContact::lowerNearest(const std::vector<glm::vec4>& pos, float radius, float thickness, float scale,
+                              float fraction) {
   const float r2 = radius * radius;
   const uint32_t none = std::bit_cast<uint32_t>(r2);
   nearest2_.assign(pos.size(), lists_ ? none : 0u); // positions gone wrong (no lists): nothing moves
+  weighed_.resize(vf_.size() + ee_.size());
+  near_.assign(vf_.size() + ee_.size(), 0);
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
-  auto vf = [](vec3 p, vec3 a, vec3 b, vec3 c) { return pointTriangle(p, a, b, c); };
-  auto ee = [](vec3 a, vec3 b, vec3 c, vec3 d) { return segmentSegment(a, b, c, d); };
-  // Each pair closer than r lowers the bounds of its four particles; one closer than the thickness
-  // pushes them apart (contactPush), summed in fixed point. Pairs with a free particle are left
-  // out: the sheet untangles there as the repulsion alone lets it. Neither the minimum nor the
-  // integer sums depend on the order of the pairs, so nothing depends on the thread count.
-  auto nearest = [&](const std::vector<uvec4>& list, auto&& pair) {
-    pool_.parallelFor(uint32_t(list.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
-      for (uint32_t k = begin; k < end; ++k) {
-        const uvec4 q = list[k];
-        if (free_[q.x] | free_[q.y] | free_[q.z] | free_[q.w]) continue;
-        const ContactPair c = pair(at(q.x), at(q.y), at(q.z), at(q.w));
-        if (!(c.d2 < r2)) continue;
-        for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], c.d2);
-        if (!(c.d2 < thickness * thickness)) continue;
-        const glm::vec4 x[4] = {pos[q.x], pos[q.y], pos[q.z], pos[q.w]};
-        for (uint32_t j = 0; j < 4; ++j)
-          addFixed(sums_, q[j], contactPush(x[0], x[1], x[2], x[3], c, thickness, j), scale);
-      }
-    });
-  };
-  nearest(vf_, vf);
-  nearest(ee_, ee);
-}
-
-// Each pair's half-spaces, weighed at `start` as computeBounds weighed it; `visit` sees each of its
-// particles' (a pair once, from any thread: what it sums and lowers must not depend on the order)
-// with the pair, its nearest points and the particle's place in it
-template <class Visit>
-void CpuContact::visitHalfSpaces(const std::vector<glm::vec4>& start, const SimUniforms& u, Visit&& visit) {
-  const float radius = u.contact.x, fraction = u.contact.y;
-  auto at = [&](uint32_t i) { return vec3(start[i]); };
+  // Each pair closer than r lowers the bounds of its four particles and sets them their
+  // half-spaces (slideConstraint, kept for the substep's slide and settle); one closer than the
+  // thickness pushes them apart (contactPush), summed in fixed point. Pairs with a free particle
+  // are left out: the sheet untangles there as the repulsion alone lets it. Neither the minimum
+  // nor the integer sums depend on the order of the pairs, so nothing depends on the thread count.
   for (const bool edge : {false, true}) {
     const std::vector<uvec4>& list = edge ? ee_ : vf_;
+    const size_t first = edge ? vf_.size() : 0;
     pool_.parallelFor(uint32_t(list.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
       for (uint32_t k = begin; k < end; ++k) {
         const uvec4 q = list[k];
         if (free_[q.x] | free_[q.y] | free_[q.z] | free_[q.w]) continue;
         const vec3 x0 = at(q.x), x1 = at(q.y), x2 = at(q.z), x3 = at(q.w);
         const ContactPair c = edge ? segmentSegment(x0, x1, x2, x3) : pointTriangle(x0, x1, x2, x3);
-        if (!(c.d2 < radius * radius)) continue;
-        for (uint32_t j = 0; j < 4; ++j) {
-          const SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, radius, fraction, j);
-          if (h.h.w >= 0.0f) visit(q, c, edge, j, h);
-        }
+        if (!(c.d2 < r2)) continue;
+        for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], c.d2);
+        Weighed& w = weighed_[first + k];
+        w.c = c;
+        for (uint32_t j = 0; j < 4; ++j) w.h[j] = slideConstraint(x0, x1, x2, x3, c, edge, radius, fraction, j);
+        near_[first + k] = 1;
+        if (!(c.d2 < thickness * thickness)) continue;
+        const glm::vec4 x[4] = {pos[q.x], pos[q.y], pos[q.z], pos[q.w]};
+        for (uint32_t j = 0; j < 4; ++j)
+          addFixed(sums_, q[j], contactPush(x[0], x[1], x[2], x[3], c, thickness, j), scale);
+      }
+    });
+  }
+}
+
+// Each pair's half-spaces, as computeBounds weighed them (lowerNearest); `visit` sees each of its
+// particles' (a pair once, from any thread: what it sums and lowers must not depend on the order)
+// with the pair, its nearest points and the particle's place in it
+template <class Visit>
+void CpuContact::visitHalfSpaces(Visit&& visit) {
+  for (const bool edge : {false, true}) {
+    const std::vector<uvec4>& list = edge ? ee_ : vf_;
+    const size_t first = edge ? vf_.size() : 0;
+    pool_.parallelFor(uint32_t(list.size()), kGrainConstraints, [&](uint32_t begin, uint32_t end) {
+      for (uint32_t k = begin; k < end; ++k) {
+        if (!near_[first + k]) continue;
+        const Weighed& w = weighed_[first + k];
+        for (uint32_t j = 0; j < 4; ++j)
+          if (w.h[j].h.w >= 0.0f) visit(list[k], w.c, edge, j, w.h[j]);
       }
     });
   }
@@ -204,7 +205,7 @@ void CpuContact::slide(const std::vector<glm::vec4>& start, const std::vector<gl
   excess.assign(n, glm::vec4(0.0f));
   share.assign(n, 1.0f);
   if (!lists_) return; // positions gone wrong: the bounds hold every particle
-  auto pairs = [&](auto&& visit) { visitHalfSpaces(start, u, visit); };
+  auto pairs = [&](auto&& visit) { visitHalfSpaces(visit); };
   // What each step's excess passes on to the other primitive of its pairs
   sums_.assign(n, glm::ivec4(0));
   pairs([&](const uvec4& q, const ContactPair& c, bool edge, uint32_t j, const SlideHalf& h) {
@@ -233,19 +234,18 @@ void CpuContact::slide(const std::vector<glm::vec4>& start, const std::vector<gl
   for (uint32_t i = 0; i < n; ++i) share[i] = std::bit_cast<float>(bits[i]);
 }
 
-void CpuContact::listHalfSpaces(const std::vector<glm::vec4>& start, const SimUniforms& u) {
+void CpuContact::listHalfSpaces(uint32_t n) {
   // Counted, scanned, filled (a particle's in any order: room() takes their minimum)
-  const uint32_t n = uint32_t(start.size());
   half_start_.assign(n + 1, 0u);
   if (!lists_) return;
-  visitHalfSpaces(start, u, [&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf&) {
+  visitHalfSpaces([&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf&) {
     std::atomic_ref<uint32_t>(half_start_[q[j] + 1]).fetch_add(1u, std::memory_order_relaxed);
   });
   for (uint32_t i = 0; i < n; ++i) half_start_[i + 1] += half_start_[i];
   half_.resize(half_start_[n]);
   half_slack_.resize(half_start_[n]);
   half_fill_.assign(half_start_.begin(), half_start_.end() - 1);
-  visitHalfSpaces(start, u, [&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf& h) {
+  visitHalfSpaces([&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf& h) {
     const uint32_t k = std::atomic_ref<uint32_t>(half_fill_[q[j]]).fetch_add(1u, std::memory_order_relaxed);
     half_[k] = h.h;
     half_slack_[k] = h.slack;
@@ -335,7 +335,8 @@ uint64_t CpuContact::memoryBytes() const {
          capacityBytes(travels_) + capacityBytes(travel_) + capacityBytes(cluster_members_) +
          capacityBytes(cluster_start_) + capacityBytes(cluster_pairs_) + capacityBytes(cluster_box_) +
          capacityBytes(points_grid_.start) + capacityBytes(points_grid_.entry) + capacityBytes(points_grid_.fill) +
-         capacityBytes(points_grid_.last);
+         capacityBytes(points_grid_.last) + capacityBytes(ball_) + capacityBytes(own_) + capacityBytes(own_particles_) +
+         capacityBytes(owned_) + capacityBytes(weighed_) + capacityBytes(near_);
 }
 
 } // namespace tender

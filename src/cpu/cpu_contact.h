@@ -51,9 +51,9 @@ public:
   /// excess taken out that keeps every one, the least slideShare, into `share` (slideStep).
   void slide(const std::vector<glm::vec4>& start, const std::vector<glm::vec4>& pos, const shaderio::SimUniforms& u,
              std::vector<glm::vec4>& passed, std::vector<glm::vec4>& excess, std::vector<float>& share);
-  /// Lists each particle's half-spaces of the last computeBounds's pairs (those slide cuts the
-  /// steps to; the pairs from `start`, where that call had the particles) for the settle stage.
-  void listHalfSpaces(const std::vector<glm::vec4>& start, const shaderio::SimUniforms& u);
+  /// Lists each of the `particles` particles' half-spaces of the last computeBounds's pairs (those
+  /// slide cuts the steps to, where that call had the particles) for the settle stage.
+  void listHalfSpaces(uint32_t particles);
   /// The lists of listHalfSpaces: particle i's half-spaces (SlideHalf::h, and their slack) from
   /// halfStart()[i] to halfStart()[i + 1], in no fixed order (settle_bodies.h takes minimums).
   const std::vector<uint32_t>& halfStart() const { return half_start_; }
@@ -112,9 +112,10 @@ private:
   static constexpr uint32_t kSearchShares = 8;
 
   /// Calls visit(pair, ContactPair, edge, j, SlideHalf) for each half-space the pairs closer than
-  /// the radius set their particles (particle j of the pair) at `start`, from the pool's threads.
+  /// the radius set their particles (particle j of the pair) where computeBounds had them (as
+  /// lowerNearest weighed them), from the pool's threads.
   template <class Visit>
-  void visitHalfSpaces(const std::vector<glm::vec4>& start, const shaderio::SimUniforms& u, Visit&& visit);
+  void visitHalfSpaces(Visit&& visit);
   /// Box tests below which the crossing check tests its triangles against every triangle
   static constexpr uint64_t kBruteForceTests = 1u << 20;
   /// Adds a push to particle i's sum in fixed point (contactFixed, `scale` units a unit of length)
@@ -134,9 +135,10 @@ private:
   /// Keeps the pair lists for this substep's positions: as they are, repaired or built anew.
   void keepLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                  float radius, glm::vec3 travel_lo, glm::vec3 travel_hi);
-  /// Each particle's nearest pair's squared distance under the radius (nearest2_), and the pushes
+  /// Each particle's nearest pair's squared distance under the radius (nearest2_), the half-spaces
+  /// of the pairs closer than it (weighed_, near_; slideConstraint with `fraction`), and the pushes
   /// of the pairs closer than `thickness` into sums_.
-  void lowerNearest(const std::vector<glm::vec4>& pos, float radius, float thickness, float scale);
+  void lowerNearest(const std::vector<glm::vec4>& pos, float radius, float thickness, float scale, float fraction);
   /// Lists the particle-triangle and edge-edge pairs closer than contactReach at `pos`.
   void buildLists(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
                   float radius);
@@ -207,11 +209,19 @@ private:
   std::vector<float> travels_;          ///< scratch: one component of every particle's travel
   std::vector<uint32_t> dirty_;         ///< scratch: the particles, triangles, edges a repair looks at
   std::vector<uint32_t> nearest2_;      ///< the bits of each particle's smallest squared distance
-  std::vector<uint32_t> share_bits_;    ///< scratch: the bits of each particle's share (slide)
-  std::vector<uint32_t> half_start_;    ///< each particle's half-spaces at [half_start_[i], half_start_[i + 1])
-  std::vector<glm::vec4> half_;         ///< the half-spaces (SlideHalf::h)
-  std::vector<float> half_slack_;       ///< and their slack
-  std::vector<uint32_t> half_fill_;     ///< scratch: where each particle's next half-space goes
+  /// A pair closer than the radius where computeBounds had its particles: its nearest points and
+  /// the half-space it sets each of them
+  struct Weighed {
+    shaderio::ContactPair c;
+    shaderio::SlideHalf h[4];
+  };
+  std::vector<Weighed> weighed_;     ///< each pair of vf_, then of ee_, where near_ marks it
+  std::vector<uint8_t> near_;        ///< the pairs closer than the radius with no free particle
+  std::vector<uint32_t> share_bits_; ///< scratch: the bits of each particle's share (slide)
+  std::vector<uint32_t> half_start_; ///< each particle's half-spaces at [half_start_[i], half_start_[i + 1])
+  std::vector<glm::vec4> half_;      ///< the half-spaces (SlideHalf::h)
+  std::vector<float> half_slack_;    ///< and their slack
+  std::vector<uint32_t> half_fill_;  ///< scratch: where each particle's next half-space goes
   Grid grid_, points_grid_;
   uint64_t contacts_ = 0;
   uint32_t builds_ = 0;

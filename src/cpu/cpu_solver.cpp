@@ -325,7 +325,7 @@ void CpuSolver::settlePass(const SimUniforms& u, uint32_t s) {
     return any.load();
   };
   if (!sweep([&](Constraint c) { return e.settleOver(c, s); })) return;
-  contact_.listHalfSpaces(start_, u);
+  contact_.listHalfSpaces(uint32_t(pos_.size()));
   e.half_start = contact_.halfStart().data();
   e.half_spaces = contact_.halfSpaces().data();
   e.half_slack = contact_.halfSlack().data();
