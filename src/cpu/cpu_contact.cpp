@@ -331,12 +331,10 @@ uint64_t CpuContact::memoryBytes() const {
          capacityBytes(sums_) + capacityBytes(crossing_) + capacityBytes(vf_) + capacityBytes(ee_) +
          capacityBytes(base_) + capacityBytes(lo_) + capacityBytes(hi_) + capacityBytes(nearest2_) +
          capacityBytes(grid_.start) + capacityBytes(grid_.entry) + capacityBytes(grid_.fill) +
-         capacityBytes(grid_.last) + capacityBytes(points_) + capacityBytes(moved_) + capacityBytes(dirty_) +
-         capacityBytes(travels_) + capacityBytes(travel_) + capacityBytes(cluster_members_) +
-         capacityBytes(cluster_start_) + capacityBytes(cluster_pairs_) + capacityBytes(cluster_box_) +
-         capacityBytes(points_grid_.start) + capacityBytes(points_grid_.entry) + capacityBytes(points_grid_.fill) +
-         capacityBytes(points_grid_.last) + capacityBytes(ball_) + capacityBytes(own_) + capacityBytes(own_particles_) +
-         capacityBytes(owned_) + capacityBytes(weighed_) + capacityBytes(near_);
+         capacityBytes(grid_.last) + capacityBytes(moved_) + capacityBytes(dirty_) + capacityBytes(travels_) +
+         capacityBytes(travel_) + capacityBytes(cluster_members_) + capacityBytes(cluster_start_) +
+         capacityBytes(cluster_pairs_) + capacityBytes(cluster_box_) + capacityBytes(ball_) + capacityBytes(own_) +
+         capacityBytes(own_particles_) + capacityBytes(owned_) + capacityBytes(weighed_) + capacityBytes(near_);
 }
 
 } // namespace tender

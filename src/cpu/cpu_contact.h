@@ -168,10 +168,16 @@ private:
   /// each two clusters next to each other lie within two contactTravel, and the whole spread
   /// within cluster_far_.
   bool clustersHold(glm::vec3 lo, glm::vec3 hi, float radius);
-  /// The boxes of the first `count` triangles at `pos` into lo_ and hi_ (and their balls into ball_),
-  /// then of the edges.
+  /// The boxes of the first `count` triangles at `pos` into lo_ and hi_, their balls into ball_.
   void boxTriangles(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count);
-  void boxEdges(const std::vector<glm::vec4>& pos);
+  /// The pairs within `reach` between what triangles t and o own that `keep` takes (buildLists).
+  template <class Keep>
+  void pairsOfTriangles(uint32_t t, uint32_t o, const std::vector<glm::vec4>& pos,
+                        const std::vector<glm::uvec4>& triangles, float reach, Keep&& keep, std::vector<glm::uvec4>& vf,
+                        std::vector<glm::uvec4>& ee) const;
+  /// Particle v, which no triangle holds, against the triangles within `reach` (grid_ of them).
+  void searchLoner(uint32_t v, const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, float reach,
+                   float inv_cell, std::vector<glm::uvec4>& vf) const;
   /// What each triangle owns for buildLists's search (own_, own_particles_, owned_).
   void ownTriangles(const std::vector<glm::uvec4>& triangles, uint32_t count);
   /// The cells of the lists' grids for pairs within `reach` at `pos` (1 / their width), or 0 when
@@ -199,15 +205,14 @@ private:
   float list_radius_ = 0.0f;            ///< the contact radius they were built for
   std::vector<glm::uvec2> edges_;       ///< the sheet's edges, each once (a < b)
   uint64_t edges_key_ = ~0ull;          ///< the triangle count the edges were worked out for
-  std::vector<glm::vec3> lo_, hi_;      ///< scratch: the boxes of the triangles, then of the edges
+  std::vector<glm::vec3> lo_, hi_;      ///< scratch: the boxes of the triangles
   std::vector<glm::vec4> ball_;         ///< scratch: the triangles' balls (centroid, farthest corner)
   std::vector<glm::uvec4> own_;         ///< each triangle's own edges and counts (ownTriangles)
   std::vector<uint32_t> own_particles_; ///< each triangle's own particles, three slots a triangle
   std::vector<uint8_t> owned_;          ///< the particles some triangle holds
-  std::vector<glm::vec3> points_;       ///< scratch: the particles (a repair's grid of them)
   std::vector<uint8_t> moved_;          ///< scratch: the particles a repair looks at
   std::vector<float> travels_;          ///< scratch: one component of every particle's travel
-  std::vector<uint32_t> dirty_;         ///< scratch: the particles, triangles, edges a repair looks at
+  std::vector<uint32_t> dirty_;         ///< scratch: the particles, then the triangles, a repair looks at
   std::vector<uint32_t> nearest2_;      ///< the bits of each particle's smallest squared distance
   /// A pair closer than the radius where computeBounds had its particles: its nearest points and
   /// the half-space it sets each of them
@@ -222,7 +227,7 @@ private:
   std::vector<glm::vec4> half_;      ///< the half-spaces (SlideHalf::h)
   std::vector<float> half_slack_;    ///< and their slack
   std::vector<uint32_t> half_fill_;  ///< scratch: where each particle's next half-space goes
-  Grid grid_, points_grid_;
+  Grid grid_;
   uint64_t contacts_ = 0;
   uint32_t builds_ = 0;
   uint32_t repairs_done_ = 0;

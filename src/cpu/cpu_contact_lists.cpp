@@ -76,11 +76,57 @@ void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3
   });
 }
 
+// What triangles t and o own (ownTriangles) within `reach` of each other, the pairs `keep` takes:
+// their edges' pairs into ee (the lower edge first, as segmentDistance2 weighs them), each one's
+// particles against the other triangle into vf. Balls around the triangles and two separating axes
+// of two segments part most neighbours of the sheet before their exact distance.
+template <class Keep>
+void CpuContact::pairsOfTriangles(uint32_t t, uint32_t o, const std::vector<glm::vec4>& pos,
+                                  const std::vector<uvec4>& triangles, float reach, Keep&& keep, std::vector<uvec4>& vf,
+                                  std::vector<uvec4>& ee) const {
+  if (ballsApart(ball_[t], ball_[o], reach)) return;
+  const float reach2 = reach * reach;
+  auto at = [&](uint32_t i) { return vec3(pos[i]); };
+  const uvec4 mine = own_[t], theirs = own_[o];
+  for (uint32_t i = 0; i < (mine.w & 3u); ++i)
+    for (uint32_t j = 0; j < (theirs.w & 3u); ++j) {
+      const uint32_t k = mine[int(i)], l = theirs[int(j)];
+      const uvec2 e = edges_[std::min(k, l)], f = edges_[std::max(k, l)];
+      if (f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y || !keep(uvec4(e, f))) continue;
+      const vec3 a = at(e.x), b = at(e.y), c = at(f.x), d = at(f.y);
+      if (segmentsApart((a + b) * 0.5f, b - a, (c + d) * 0.5f, d - c, reach)) continue;
+      if (segmentDistance2(a, b, c, d) < reach2) ee.push_back(uvec4(e, f));
+    }
+  // A particle farther than the reach from a triangle's ball is farther from the triangle
+  auto against = [&](uint32_t owner, uint32_t count, uint32_t other) {
+    const uvec4 tri = triangles[other];
+    for (uint32_t i = 0; i < count; ++i) {
+      const uint32_t v = own_particles_[owner * 3 + i];
+      const uvec4 q(v, tri.x, tri.y, tri.z);
+      if (v == tri.x || v == tri.y || v == tri.z || !keep(q)) continue;
+      if (ballsApart(glm::vec4(at(v), 0.0f), ball_[other], reach)) continue;
+      if (pointTriangleDistance2(at(v), at(tri.x), at(tri.y), at(tri.z)) < reach2) vf.push_back(q);
+    }
+  };
+  against(t, mine.w >> 2, o);
+  against(o, theirs.w >> 2, t);
+}
+
+// Particle v, which no triangle holds, against every triangle within `reach` of it.
+void CpuContact::searchLoner(uint32_t v, const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles,
+                             float reach, float inv_cell, std::vector<uvec4>& vf) const {
+  const vec3 p = vec3(pos[v]);
+  visitBox(grid_, p - vec3(reach), p + vec3(reach), inv_cell, 0, [&](uint32_t t) {
+    const uvec4 tri = triangles[t];
+    const vec3 a = vec3(pos[tri.x]), b = vec3(pos[tri.y]), c = vec3(pos[tri.z]);
+    if (pointTriangleDistance2(p, a, b, c) < reach * reach) vf.push_back(uvec4(v, tri.x, tri.y, tri.z));
+  });
+}
+
 void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
                             float radius) {
-  const float reach = contactReach(radius), reach2 = reach * reach;
+  const float reach = contactReach(radius);
   const uint32_t n = uint32_t(pos.size());
-  auto at = [&](uint32_t i) { return vec3(pos[i]); };
   vf_.clear();
   ee_.clear();
   lists_ = false;
@@ -94,55 +140,22 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
   // Particles no triangle holds (torn free) look for their triangles on their own.
   boxTriangles(pos, triangles, count);
   grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
-  auto close_to = [&](uint32_t v, uvec4 tri) {
-    return v != tri.x && v != tri.y && v != tri.z &&
-           pointTriangleDistance2(at(v), at(tri.x), at(tri.y), at(tri.z)) < reach2;
-  };
-  // A particle farther than the reach from a triangle's ball is farther from the triangle
-  auto near_ball = [&](uint32_t v, glm::vec4 ball) { return !ballsApart(glm::vec4(at(v), 0.0f), ball, reach); };
-  // Edges j and k as the lists hold them, the lower first (segmentDistance2 weighs them in that
-  // order), when they share no particle and come within the reach
-  auto close_edges = [&](uint32_t j, uint32_t k, std::vector<uvec4>& found) {
-    const uvec2 e = edges_[std::min(j, k)], f = edges_[std::max(j, k)];
-    if (f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
-    const vec3 a = at(e.x), b = at(e.y), c = at(f.x), d = at(f.y);
-    if (segmentsApart((a + b) * 0.5f, b - a, (c + d) * 0.5f, d - c, reach)) return;
-    if (segmentDistance2(a, b, c, d) < reach2) found.push_back(uvec4(e, f));
-  };
+  auto all = [](uvec4) { return true; };
   std::mutex merge;
   pool_.parallelFor(
       count, kGrainCollide,
       [&](uint32_t begin, uint32_t end) {
         std::vector<uvec4> vf, ee;
-        for (uint32_t t = begin; t < end; ++t) {
-          const uvec4 tri = triangles[t], mine = own_[t];
-          visitBox(grid_, lo_[t] - vec3(reach), hi_[t] + vec3(reach), inv_cell, t + 1, [&](uint32_t o) {
-            if (ballsApart(ball_[t], ball_[o], reach)) return;
-            const uvec4 other = triangles[o], theirs = own_[o];
-            for (uint32_t i = 0; i < (mine.w & 3u); ++i)
-              for (uint32_t j = 0; j < (theirs.w & 3u); ++j) close_edges(mine[int(i)], theirs[int(j)], ee);
-            for (uint32_t i = 0; i < (mine.w >> 2); ++i) {
-              const uint32_t v = own_particles_[t * 3 + i];
-              if (near_ball(v, ball_[o]) && close_to(v, other)) vf.push_back(uvec4(v, other.x, other.y, other.z));
-            }
-            for (uint32_t j = 0; j < (theirs.w >> 2); ++j) {
-              const uint32_t v = own_particles_[o * 3 + j];
-              if (near_ball(v, ball_[t]) && close_to(v, tri)) vf.push_back(uvec4(v, tri.x, tri.y, tri.z));
-            }
-          });
-        }
+        for (uint32_t t = begin; t < end; ++t)
+          visitBox(grid_, lo_[t] - vec3(reach), hi_[t] + vec3(reach), inv_cell, t + 1,
+                   [&](uint32_t o) { pairsOfTriangles(t, o, pos, triangles, reach, all, vf, ee); });
         const std::lock_guard<std::mutex> lock(merge);
         vf_.insert(vf_.end(), vf.begin(), vf.end());
         ee_.insert(ee_.end(), ee.begin(), ee.end());
       },
       kSearchShares);
-  for (uint32_t v = 0; v < n; ++v) {
-    if (v < owned_.size() && owned_[v]) continue;
-    const vec3 p = at(v);
-    visitBox(grid_, p - vec3(reach), p + vec3(reach), inv_cell, 0, [&](uint32_t t) {
-      if (close_to(v, triangles[t])) vf_.push_back(uvec4(v, triangles[t].x, triangles[t].y, triangles[t].z));
-    });
-  }
+  for (uint32_t v = 0; v < n; ++v)
+    if (v >= owned_.size() || !owned_[v]) searchLoner(v, pos, triangles, reach, inv_cell, vf_);
   // The same lists whatever the threads' order (visitBox meets each pair once)
   std::sort(vf_.begin(), vf_.end(), less4);
   std::sort(ee_.begin(), ee_.end(), less4);
@@ -197,16 +210,6 @@ void CpuContact::boxTriangles(const std::vector<glm::vec4>& pos, const std::vect
     hi_[t] = glm::max(a, glm::max(b, c));
     const vec3 m = (a + b + c) * (1.0f / 3.0f);
     ball_[t] = glm::vec4(m, std::sqrt(std::max({length2(a - m), length2(b - m), length2(c - m)})));
-  }
-}
-
-void CpuContact::boxEdges(const std::vector<glm::vec4>& pos) {
-  lo_.resize(edges_.size());
-  hi_.resize(edges_.size());
-  for (size_t k = 0; k < edges_.size(); ++k) {
-    const vec3 a = vec3(pos[edges_[k].x]), b = vec3(pos[edges_[k].y]);
-    lo_[k] = glm::min(a, b);
-    hi_[k] = glm::max(a, b);
   }
 }
 
@@ -290,59 +293,32 @@ std::optional<vec3> CpuContact::markMoved(const std::vector<glm::vec4>& pos, flo
 
 void CpuContact::searchMoved(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
                              float reach, float inv_cell, std::vector<uvec4>& added_vf, std::vector<uvec4>& added_ee) {
-  const uint32_t n = uint32_t(pos.size()), edge_count = uint32_t(edges_.size());
-  const float reach2 = reach * reach;
-  auto at = [&](uint32_t i) { return vec3(pos[i]); };
-  // Calls look(k, found) for each of `dirty_` in parallel and gathers what they find into `added`
-  auto search = [&](std::vector<uvec4>& added, auto&& look) {
-    gatherPairs(pool_, uint32_t(dirty_.size()), kGrainRepair, 1, added,
-                [&](uint32_t k, std::vector<uvec4>& found) { look(dirty_[k], found); });
-  };
-  // The particles that moved against every triangle near them
+  // The pairs with a particle that moved, as buildLists finds them: each triangle that holds one
+  // against every triangle near it (two such, from the first of them), what they own (only the
+  // pairs with a particle that moved); the moved particles no triangle holds on their own
+  auto touched = [&](uvec4 q) { return (moved_[q.x] | moved_[q.y] | moved_[q.z] | moved_[q.w]) != 0; };
   boxTriangles(pos, triangles, count);
   grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
-  search(added_vf, [&](uint32_t v, std::vector<uvec4>& found) {
-    const vec3 p = at(v);
-    visitBox(grid_, p - vec3(reach), p + vec3(reach), inv_cell, 0, [&](uint32_t t) {
-      const uvec4 tri = triangles[t];
-      if (v == tri.x || v == tri.y || v == tri.z) return;
-      if (pointTriangleDistance2(p, at(tri.x), at(tri.y), at(tri.z)) < reach2)
-        found.push_back(uvec4(v, tri.x, tri.y, tri.z));
-    });
-  });
-  // The triangles with a particle that moved against every other particle near them (those that
-  // moved found theirs above)
-  points_.resize(n);
-  for (uint32_t i = 0; i < n; ++i) points_[i] = at(i);
-  points_grid_.build(points_, points_, inv_cell, pool_, grid_part_boxes_);
   dirty_.clear();
   for (uint32_t t = 0; t < count; ++t)
-    if (moved_[triangles[t].x] | moved_[triangles[t].y] | moved_[triangles[t].z]) dirty_.push_back(t);
-  search(added_vf, [&](uint32_t t, std::vector<uvec4>& found) {
-    const uvec4 tri = triangles[t];
-    const vec3 a = at(tri.x), b = at(tri.y), c = at(tri.z);
-    visitBox(points_grid_, lo_[t] - vec3(reach), hi_[t] + vec3(reach), inv_cell, 0, [&](uint32_t v) {
-      if (moved_[v] || v == tri.x || v == tri.y || v == tri.z) return;
-      if (pointTriangleDistance2(at(v), a, b, c) < reach2) found.push_back(uvec4(v, tri.x, tri.y, tri.z));
-    });
+    if (touched(uvec4(triangles[t].x, triangles[t].y, triangles[t].z, triangles[t].x))) dirty_.push_back(t);
+  std::mutex merge;
+  pool_.parallelFor(uint32_t(dirty_.size()), kGrainRepair, [&](uint32_t begin, uint32_t end) {
+    std::vector<uvec4> vf, ee;
+    for (uint32_t k = begin; k < end; ++k) {
+      const uint32_t t = dirty_[k];
+      visitBox(grid_, lo_[t] - vec3(reach), hi_[t] + vec3(reach), inv_cell, 0, [&](uint32_t o) {
+        const uvec4 other = triangles[o];
+        if (o == t || (o < t && touched(uvec4(other.x, other.y, other.z, other.x)))) return;
+        pairsOfTriangles(t, o, pos, triangles, reach, touched, vf, ee);
+      });
+    }
+    const std::lock_guard<std::mutex> lock(merge);
+    added_vf.insert(added_vf.end(), vf.begin(), vf.end());
+    added_ee.insert(added_ee.end(), ee.begin(), ee.end());
   });
-  // The edges with a particle that moved against every edge near them, a pair of two such from the
-  // first of them
-  boxEdges(pos);
-  grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
-  dirty_.clear();
-  for (uint32_t k = 0; k < edge_count; ++k)
-    if (moved_[edges_[k].x] | moved_[edges_[k].y]) dirty_.push_back(k);
-  search(added_ee, [&](uint32_t k, std::vector<uvec4>& found) {
-    const uvec2 e = edges_[k];
-    visitBox(grid_, lo_[k] - vec3(reach), hi_[k] + vec3(reach), inv_cell, 0, [&](uint32_t j) {
-      const uvec2 f = edges_[j];
-      if (j == k || f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y) return;
-      if ((moved_[f.x] | moved_[f.y]) && j < k) return;
-      if (segmentDistance2(at(e.x), at(e.y), at(f.x), at(f.y)) < reach2)
-        found.push_back(j < k ? uvec4(f, e) : uvec4(e, f));
-    });
-  });
+  for (uint32_t v = 0; v < uint32_t(pos.size()); ++v)
+    if (moved_[v] && (v >= owned_.size() || !owned_[v])) searchLoner(v, pos, triangles, reach, inv_cell, added_vf);
 }
 
 } // namespace tender
