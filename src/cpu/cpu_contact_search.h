@@ -1,16 +1,14 @@
 #pragma once
 /// The searches of the CPU contact's pair lists (cpu_contact_lists.cpp) and crossing check
 /// (cpu_contact.cpp): the grid's cells, a walk over the entries whose boxes meet a box, each once,
-/// and the threads' gathering of what the walks find.
+/// and the separating axes that part most neighbours before their exact distance.
 #include <cmath>
 #include <cstdint>
-#include <mutex>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "shaderio.h"
-#include "worker_pool.h"
 
 namespace tender::contact_search {
 
@@ -93,23 +91,6 @@ inline bool less4(glm::uvec4 a, glm::uvec4 b) {
   if (a.y != b.y) return a.y < b.y;
   if (a.z != b.z) return a.z < b.z;
   return a.w < b.w;
-}
-
-/// Calls look(k, found) for each k of [0, count) on the pool's threads (`shares` a worker) and
-/// appends what each finds to `out`, in any order (the lists are sorted after).
-template <typename Look>
-void gatherPairs(WorkerPool& pool, uint32_t count, uint32_t grain, uint32_t shares, std::vector<glm::uvec4>& out,
-                 Look&& look) {
-  std::mutex merge;
-  pool.parallelFor(
-      count, grain,
-      [&](uint32_t begin, uint32_t end) {
-        std::vector<glm::uvec4> found;
-        for (uint32_t k = begin; k < end; ++k) look(k, found);
-        const std::lock_guard<std::mutex> lock(merge);
-        out.insert(out.end(), found.begin(), found.end());
-      },
-      shares);
 }
 
 } // namespace tender::contact_search
