@@ -311,17 +311,24 @@ void CpuSolver::settlePass(const SimUniforms& u, uint32_t s) {
   auto at = [&](uint32_t k) { return Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]}; };
   SettleElements e{u,       pos_.data(), start_.data(), push_.data(),    bound_.data(),
                    nullptr, nullptr,     nullptr,       contact_.frame()};
-  // Sweeps the colours' edges with `body`; true when it returned true for one
+  // Sweeps the colours' edges with `body` in one job, a phase a colour with edges (shared on a small
+  // sheet too: a sweep costs about a projection iteration); true when it returned true for one
+  settle_colours_.clear();
+  uint32_t largest = 0;
+  for (uint32_t c = 0; c < colors; ++c)
+    if (edges[c] > 0) settle_colours_.push_back(c);
+  for (const uint32_t c : settle_colours_) largest = std::max(largest, edges[c]);
+  const uint32_t chunks = pool_->chunksFor(largest, grain_.heavy(kGrainSettle));
   auto sweep = [&](auto&& body) {
     std::atomic<bool> any{false};
-    for (uint32_t c = 0; c < colors; ++c) {
-      if (edges[c] == 0) continue;
-      pool_->parallelFor(edges[c], grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
-        bool mine = false;
-        for (uint32_t k = colors_[c].first + begin; k < colors_[c].first + end; ++k) mine = body(at(k)) || mine;
-        if (mine) any.store(true, std::memory_order_relaxed);
-      });
-    }
+    pool_->runPhases(uint32_t(settle_colours_.size()), chunks, [&](uint32_t phase, uint32_t chunk) {
+      const uint32_t c = settle_colours_[phase];
+      const uint32_t first = colors_[c].first, begin = WorkerPool::chunkBound(edges[c], chunks, chunk),
+                     end = WorkerPool::chunkBound(edges[c], chunks, chunk + 1);
+      bool mine = false;
+      for (uint32_t k = first + begin; k < first + end; ++k) mine = body(at(k)) || mine;
+      if (mine) any.store(true, std::memory_order_relaxed);
+    });
     return any.load();
   };
   if (!sweep([&](Constraint c) { return e.settleOver(c, s); })) return;

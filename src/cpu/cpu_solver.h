@@ -163,6 +163,7 @@ private:
   std::vector<shaderio::Constraint> constraints_;
   std::vector<ColorRange> colors_;
   std::vector<uint32_t> project_passes_; ///< projectColors' passes that project (scratch)
+  std::vector<uint32_t> settle_colours_; ///< settlePass's colours with edges (scratch)
   std::vector<uint32_t> colour_edges_;   ///< the structural edges at the head of each colour (countColourEdges)
   /// limitPass's rings from several roots: each particle's root, the particles in the rings'
   /// order from where ring 1 starts, for those roots

@@ -10,6 +10,7 @@ inline constexpr uint32_t kGrainParticles = 4096;   ///< integrate, floor, hash,
 inline constexpr uint32_t kGrainConstraints = 1024; ///< projection of one colour, tear marking: ~2 ns each
 inline constexpr uint32_t kGrainCollide = 256;      ///< collision gather: ~100 ns per particle
 inline constexpr uint32_t kGrainRepair = 32;        ///< a contact list repair's search: ~1 us per primitive
+inline constexpr uint32_t kGrainSettle = 256;       ///< the settle's sweeps: ~10 ns per edge
 /// Shares per worker of the collision loops: the cost of a particle varies with the crowd around it.
 inline constexpr uint32_t kCollideChunksPerWorker = 4;
 /// Below this many particles a whole substep takes tens of microseconds, and sharing its loops
@@ -23,6 +24,8 @@ struct Grain {
 
   /// The share of a loop whose tuned share is `tuned` elements.
   uint32_t operator()(uint32_t tuned) const { return min_chunk ? min_chunk : small_sheet ? ~0u : tuned; }
+  /// The share of a loop that costs enough to share on a small sheet too (contact's).
+  uint32_t heavy(uint32_t tuned) const { return min_chunk ? min_chunk : tuned; }
 };
 
 } // namespace tender
