@@ -46,8 +46,10 @@ void visitBox(const Grid& grid, vec3 lo, vec3 hi, float inv_cell, uint32_t first
           const auto& slot = grid.entry[k];
           if (slot.id < first) break;
           const vec3 elo = slot.lo, ehi = slot.hi;
-          if (!(lo.x <= ehi.x && elo.x <= hi.x && lo.y <= ehi.y && elo.y <= hi.y && lo.z <= ehi.z && elo.z <= hi.z))
-            continue;
+          // Without branches between the axes: most entries part on one, which one is a coin toss
+          const bool meet =
+              (lo.x <= ehi.x) & (elo.x <= hi.x) & (lo.y <= ehi.y) & (elo.y <= hi.y) & (lo.z <= ehi.z) & (elo.z <= hi.z);
+          if (!meet) continue;
           if (glm::max(a, slot.cell) == cell) f(slot.id);
         }
       }
