@@ -164,6 +164,22 @@ TEST(Replay, RecordedParameterEditsReplayBitwise) {
   EXPECT_NE(other.pos.size(), got.pos.size());
 }
 
+// A script's wind events turn the wind off, on and over at their ticks, and an event the switch
+// already holds changes nothing.
+TEST(Script, WindEventsSetTheWindAtTheirTicks) {
+  CpuSolver solver;
+  Simulation sim(cloth({"cols=8", "rows=8"}), solver);
+  std::string error;
+  const auto events = parseScript("0 wind off\n1 wind off\n2 wind on\n3 wind toggle\n4 wind toggle\n", error);
+  ASSERT_TRUE(events) << error;
+  sim.setScript(*events);
+  ASSERT_TRUE(sim.wind()); // cloth's default
+  for (bool want : {false, false, true, false, true}) {
+    sim.tick();
+    EXPECT_EQ(sim.wind(), want) << "after tick " << sim.physicsTicks();
+  }
+}
+
 // Set events are checked before a run: a bad value, a key of the solver, a rule broken by a
 // tick's settings together, a grab of a particle a rebuild removed, a layout change in a fleet.
 TEST(Script, SetEventsAreCheckedAgainstTheSheet) {
