@@ -262,6 +262,7 @@ nlohmann::json runCase(const BenchOptions& o, const Peaks& peaks, const Size& si
   r["ms_min"] = *std::min_element(ms.begin(), ms.end());
   r["particle_substeps_per_s"] = median > 0.0 ? double(p.particleCount()) * p.substeps * 1000.0 / median : 0.0;
   r["dispatches_per_tick"] = solver->dispatchesPerTick();
+  r["barrier_phases_per_tick"] = solver->barrierPhasesPerTick();
   r["memory_bytes"] = solver->memoryBytes();
   nlohmann::json passes = nlohmann::json::object();
   for (auto& [name, v] : times.pass_ms) passes[name] = percentile(v, 0.5);

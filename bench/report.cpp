@@ -18,8 +18,9 @@ std::string humanBytes(uint64_t b) {
 }
 
 void printTable(const nlohmann::json& results) {
-  std::printf("%-11s %-12s %9s %7s %10s %10s %14s %11s %10s %10s %8s %6s\n", "size", "backend", "particles", "threads",
-              "ms median", "ms p95", "part-substep/s", "dispatches", "memory", "MB/tick", "GB/s", "%peak");
+  std::printf("%-11s %-12s %9s %7s %10s %10s %14s %11s %7s %10s %10s %8s %6s\n", "size", "backend", "particles",
+              "threads", "ms median", "ms p95", "part-substep/s", "dispatches", "phases", "memory", "MB/tick", "GB/s",
+              "%peak");
   for (const auto& r : results) {
     if (r["status"] != "ok") {
       std::printf("%-11s %-12s %9llu  skipped: %s\n", r["size"].get<std::string>().c_str(),
@@ -29,11 +30,12 @@ void printTable(const nlohmann::json& results) {
       continue;
     }
     const std::string pct = r.contains("peak_pct") ? std::to_string(std::lround(r["peak_pct"].get<double>())) : "-";
-    std::printf("%-11s %-12s %9llu %7u %10.3f %10.3f %14.3g %11u %10s %10.1f %8.2f %6s\n",
+    std::printf("%-11s %-12s %9llu %7u %10.3f %10.3f %14.3g %11u %7u %10s %10.1f %8.2f %6s\n",
                 r["size"].get<std::string>().c_str(), r["backend"].get<std::string>().c_str(),
                 static_cast<unsigned long long>(r["particles"].get<uint64_t>()), r["threads"].get<uint32_t>(),
                 r["ms_median"].get<double>(), r["ms_p95"].get<double>(), r["particle_substeps_per_s"].get<double>(),
-                r["dispatches_per_tick"].get<uint32_t>(), humanBytes(r["memory_bytes"].get<uint64_t>()).c_str(),
+                r["dispatches_per_tick"].get<uint32_t>(), r.value("barrier_phases_per_tick", 0u),
+                humanBytes(r["memory_bytes"].get<uint64_t>()).c_str(),
                 double(r["bytes_per_tick"].get<uint64_t>()) / 1e6, r["achieved_gbps"].get<double>(), pct.c_str());
     if (!r["pass_ms"].empty()) {
       std::printf("%-11s   passes (ms, GB/s):", "");
@@ -69,7 +71,8 @@ void printBatchTable(const nlohmann::json& batches) {
 std::string csvText(const nlohmann::json& results) {
   std::ostringstream f;
   f << "size,cols,rows,particles,backend,status,threads,ticks_measured,ms_median,ms_p95,ms_mean,ms_min,"
-       "particle_substeps_per_s,dispatches_per_tick,memory_bytes,bytes_per_tick,achieved_gbps,peak_gbps,peak_pct,torn,"
+       "particle_substeps_per_s,dispatches_per_tick,barrier_phases_per_tick,memory_bytes,bytes_per_tick,achieved_gbps,"
+       "peak_gbps,peak_pct,torn,"
        "state_hash,passes,pass_bytes,pass_gbps\n";
   for (const auto& r : results) {
     auto num = [&](const char* k) -> std::string { return r.contains(k) ? r[k].dump() : ""; };
@@ -86,8 +89,8 @@ std::string csvText(const nlohmann::json& results) {
       << r["backend"].get<std::string>() << ',' << r["status"].get<std::string>() << ',' << num("threads") << ','
       << num("ticks_measured") << ',' << num("ms_median") << ',' << num("ms_p95") << ',' << num("ms_mean") << ','
       << num("ms_min") << ',' << num("particle_substeps_per_s") << ',' << num("dispatches_per_tick") << ','
-      << num("memory_bytes") << ',' << num("bytes_per_tick") << ',' << num("achieved_gbps") << ',' << num("peak_gbps")
-      << ',' << num("peak_pct") << ',' << num("torn") << ','
+      << num("barrier_phases_per_tick") << ',' << num("memory_bytes") << ',' << num("bytes_per_tick") << ','
+      << num("achieved_gbps") << ',' << num("peak_gbps") << ',' << num("peak_pct") << ',' << num("torn") << ','
       << (r.contains("state_hash") ? r["state_hash"].get<std::string>() : "") << ',' << list("pass_ms") << ','
       << list("pass_bytes") << ',' << list("pass_gbps") << '\n';
   }

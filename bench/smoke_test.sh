@@ -53,9 +53,11 @@ for r in rs:
         print("gpu skipped:", r.get("reason")); continue
     assert r["status"] == "ok", r
     for k in ["ms_median", "ms_p95", "ms_mean", "ms_min", "ticks_measured", "particle_substeps_per_s",
-              "dispatches_per_tick", "memory_bytes", "pass_ms", "threads", "spacing", "cell_size", "torn",
-              "state_hash"]:
+              "dispatches_per_tick", "barrier_phases_per_tick", "memory_bytes", "pass_ms", "threads", "spacing",
+              "cell_size", "torn", "state_hash"]:
         assert k in r, (k, r)
+    # Barrier phases: the fused tick's alone (the per-colour passes' and the CPU's are dispatches)
+    assert (r["barrier_phases_per_tick"] > 0) == (r["pass_ms"].get("fused_tick", 0) > 0), r
     assert r["particles"] == r["cols"] * r["rows"] and r["ticks_measured"] == 3, r
     assert 0 < r["ms_min"] <= r["ms_median"] <= r["ms_p95"], r
     assert r["memory_bytes"] > r["particles"] * 32 and r["dispatches_per_tick"] > 0, r

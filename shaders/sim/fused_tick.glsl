@@ -30,6 +30,7 @@ void sync() {
   memoryBarrierBuffer();
   memoryBarrierShared();
   barrier();
+  if (gl_LocalInvocationID.x == 0u) counters.phases += 1u; // Counters::phases, what tender-bench counts
 }
 
 // Diagnosis (`tender diff`): the tick stops after pass p.stop of the tick (the numbering of
@@ -378,6 +379,7 @@ void main() {
   }
 #endif
   uint n = p.count;
+  if (lid == 0u && p.first_substep == 0u) counters.phases = 0u; // a new tick (sync counts its barriers)
   for (uint i = lid; i < n; i += kInvocations) s_pos[i] = pos[i];
   runSubsteps(n);
   storePositions(n);

@@ -70,6 +70,10 @@ public:
   virtual PassTimes passTimes() const { return {}; }
   /// Dispatches (or pass invocations) recorded per tick.
   virtual uint32_t dispatchesPerTick() const { return 0; }
+  /// The workgroup barriers of the last tick of a sheet alone that one workgroup ran whole (the
+  /// GPU's fused tick, where a barrier takes a dispatch's place); 0 where it ran as dispatches, in
+  /// a fleet, or on the CPU. Waits for the tick.
+  virtual uint32_t barrierPhasesPerTick() { return 0; }
   /// With contact on: the particles within the contact radius of a primitive at the start of the
   /// last substep (-1: the solver has no contact, or it is off).
   virtual int64_t contacts() const { return -1; }

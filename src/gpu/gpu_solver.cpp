@@ -158,6 +158,7 @@ void GpuSolver::tick(const SimUniforms& u) {
     ctx_.submit(flight.reset, flight.fence);
     flight.pending = true;
     dispatches_per_tick_ = 1;
+    fused_tick_ = false;
     return;
   }
   const RecordKey key{substepCount(u.substeps), usesFusedPath(u), substepPlan(u, stop_after_)};
@@ -168,6 +169,19 @@ void GpuSolver::tick(const SimUniforms& u) {
   flight.timed = true;
   last_tick_ = int(index);
   dispatches_per_tick_ = flight.dispatches;
+  fused_tick_ = key.fused;
+}
+
+uint32_t GpuSolver::barrierPhasesPerTick() {
+  if (!fused_tick_) return 0;
+  finish();
+  ctx_.submitOnce([&](VkCommandBuffer cmd) {
+    const VkBufferCopy region{offsetof(shaderio::Counters, phases), 0, sizeof(uint32_t)};
+    vkCmdCopyBuffer(cmd, buf_[SIM_BIND_COUNTERS].buffer, small_readback_.buffer, 1, &region);
+  });
+  uint32_t phases = 0;
+  std::memcpy(&phases, small_readback_.mapped, sizeof(phases));
+  return phases;
 }
 
 void GpuSolver::finish() {

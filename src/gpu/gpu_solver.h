@@ -81,6 +81,7 @@ public:
   void readback(SimState& out) override;
   PassTimes passTimes() const override;
   uint32_t dispatchesPerTick() const override { return dispatches_per_tick_; }
+  uint32_t barrierPhasesPerTick() override;
   uint64_t memoryBytes() const override;
   Arithmetic arithmetic() const override;
   void stopNextTickAfter(uint32_t last_pass) override { stop_after_ = last_pass; }
@@ -207,6 +208,7 @@ private:
   bool last_contact_ = false; ///< the last tick had contact on
   uint32_t query_capacity_ = 0;
   uint32_t dispatches_per_tick_ = 0;
+  bool fused_tick_ = false;           ///< the last tick ran fused (barrierPhasesPerTick)
   VkPipeline bound_ = VK_NULL_HANDLE; ///< pipeline bound while recording
   uint32_t recorded_dispatches_ = 0;
   bool fused_allowed_ = true;

@@ -1,7 +1,9 @@
 // The behaviour every solver shares (tests/common/solver_cases.h) on both GPU paths: the fused
-// small-sheet tick and the per-colour passes, built as every program builds them.
+// small-sheet tick and the per-colour passes, built as every program builds them; and the fused
+// tick's count of its barriers.
 #include "backend/backend.h"
 #include "common/solver_cases.h"
+#include "gpu/gpu_solver.h"
 #include "gpu_test_env.h"
 
 using namespace tender;
@@ -32,3 +34,24 @@ namespace tender::test {
 using GpuBackends = ::testing::Types<GpuBackend<kFused>, GpuBackend<kPerColor>>;
 INSTANTIATE_TYPED_TEST_SUITE_P(Gpu, SolverCase, GpuBackends, BackendName);
 } // namespace tender::test
+
+TEST_F(GpuTest, TheFusedTickCountsABarrierForEachColourOfEachIteration) {
+  // Counters::phases, what tender-bench prints as a tick's phases: an iteration more adds a barrier
+  // for each colour of each substep (the first tick from rest, the same in both but for the
+  // iterations), and the per-colour passes, whose dispatches take the barriers' place, count none
+  auto phases = [&](std::initializer_list<const char*> sets, bool fused) {
+    SimParams p = cloth({"cols=12", "rows=16", "contact_factor=0", "wind=off"});
+    p = withSets(p, std::vector<std::string>(sets.begin(), sets.end()));
+    gpu::GpuSolver solver(ctx());
+    solver.setFusedPath(fused);
+    Simulation sim(p, solver);
+    sim.tick();
+    return std::pair(solver.barrierPhasesPerTick(), sim.topology().colorCount());
+  };
+  const auto [four, colours] = phases({"iterations=4", "substeps=2"}, true);
+  const auto [five, unused] = phases({"iterations=5", "substeps=2"}, true);
+  std::printf("fused tick of 2 substeps: %u barriers at 4 iterations, %u at 5 (%u colours)\n", four, five, colours);
+  EXPECT_GT(four, 2u * 4u * colours);
+  EXPECT_EQ(five - four, 2u * colours);
+  EXPECT_EQ(phases({"iterations=4", "substeps=2"}, false).first, 0u);
+}
