@@ -34,7 +34,7 @@ void printTable(const nlohmann::json& results) {
                 r["size"].get<std::string>().c_str(), r["backend"].get<std::string>().c_str(),
                 static_cast<unsigned long long>(r["particles"].get<uint64_t>()), r["threads"].get<uint32_t>(),
                 r["ms_median"].get<double>(), r["ms_p95"].get<double>(), r["particle_substeps_per_s"].get<double>(),
-                r["dispatches_per_tick"].get<uint32_t>(), r.value("barrier_phases_per_tick", 0u),
+                r["dispatches_per_tick"].get<uint32_t>(), r["barrier_phases_per_tick"].get<uint32_t>(),
                 humanBytes(r["memory_bytes"].get<uint64_t>()).c_str(),
                 double(r["bytes_per_tick"].get<uint64_t>()) / 1e6, r["achieved_gbps"].get<double>(), pct.c_str());
     if (!r["pass_ms"].empty()) {
@@ -71,8 +71,7 @@ void printBatchTable(const nlohmann::json& batches) {
 std::string csvText(const nlohmann::json& results) {
   std::ostringstream f;
   f << "size,cols,rows,particles,backend,status,threads,ticks_measured,ms_median,ms_p95,ms_mean,ms_min,"
-       "particle_substeps_per_s,dispatches_per_tick,memory_bytes,bytes_per_tick,achieved_gbps,"
-       "peak_gbps,peak_pct,torn,"
+       "particle_substeps_per_s,dispatches_per_tick,memory_bytes,bytes_per_tick,achieved_gbps,peak_gbps,peak_pct,torn,"
        "state_hash,passes,pass_bytes,pass_gbps,barrier_phases_per_tick\n";
   for (const auto& r : results) {
     auto num = [&](const char* k) -> std::string { return r.contains(k) ? r[k].dump() : ""; };

@@ -155,7 +155,7 @@ struct Counters {
   uint torn_total;        // constraints torn since the last reset
   uint torn_new;          // constraints marked in the current substep
   uint triangle_count;    // live triangles
-  uint phases;            // the fused tick's workgroup barriers since the tick began (sync, fused_tick.glsl)
+  uint phases;            // the fused tick's workgroup barriers in its last tick (sync, fused_tick.glsl)
   uvec4 compact_dispatch; // indirect dispatch for compaction (x = 0 when nothing tore)
   uvec4 draw_args;        // indirect draw: vertexCount, instanceCount, firstVertex, firstInstance
   // Collision candidate lists: x 1 when usable, y substeps since they were built, z substeps to

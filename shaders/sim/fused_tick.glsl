@@ -26,11 +26,15 @@ shared vec4 s_pos[kFusedCapacity];
 const uint kInvocations = gl_WorkGroupSize.x;
 
 // Everything written before it, to shared memory and to buffers, is seen by the whole workgroup.
+// The barriers this invocation has passed in this dispatch (Counters::phases, what tender-bench
+// counts: written once, at the end)
+uint g_phases = 0u;
+
 void sync() {
   memoryBarrierBuffer();
   memoryBarrierShared();
   barrier();
-  if (gl_LocalInvocationID.x == 0u) counters.phases += 1u; // Counters::phases, what tender-bench counts
+  g_phases += 1u;
 }
 
 // Diagnosis (`tender diff`): the tick stops after pass p.stop of the tick (the numbering of
@@ -379,8 +383,9 @@ void main() {
   }
 #endif
   uint n = p.count;
-  if (lid == 0u && p.first_substep == 0u) counters.phases = 0u; // a new tick (sync counts its barriers)
   for (uint i = lid; i < n; i += kInvocations) s_pos[i] = pos[i];
   runSubsteps(n);
   storePositions(n);
+  // A tick's barriers: this dispatch's, after those of its earlier substeps' (a CPU device)
+  if (lid == 0u) counters.phases = (p.first_substep == 0u ? 0u : counters.phases) + g_phases;
 }
