@@ -74,10 +74,21 @@ void writeOutput(const std::string& path, const std::function<std::optional<std:
   }
 }
 
-std::string unknownPreset(const std::string& name) {
-  std::string names;
-  for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
-  return "unknown preset '" + name + "' (one of " + names + ")";
+SimParams baseParams(const std::optional<std::string>& preset, const std::optional<std::string>& preset_file) {
+  if (preset && preset_file) raise(PyExc_ValueError, "preset and preset_file: give one, not both");
+  SimParams p;
+  if (preset_file) {
+    if (auto err = loadPresetFile(*preset_file, p)) raise(PyExc_ValueError, "preset_file: " + *err);
+    return p;
+  }
+  const std::string name = preset.value_or("tender");
+  auto q = presetParams(name);
+  if (!q) {
+    std::string names;
+    for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
+    raise(PyExc_ValueError, "unknown preset '" + name + "' (one of " + names + ")");
+  }
+  return *q;
 }
 
 glm::vec3 coordinates(double x, double y, double z, const char* what) {

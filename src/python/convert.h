@@ -38,8 +38,10 @@ bool truthValue(const py::handle& value, const char* what);
 /// Writes through an OutputSet (`stage` stages the file); a path that cannot be written raises
 /// OSError (as open() does), an empty one ValueError.
 void writeOutput(const std::string& path, const std::function<std::optional<std::string>(OutputSet&)>& stage);
-/// "unknown preset 'x' (one of ...)".
-std::string unknownPreset(const std::string& name);
+/// The parameters a Simulation or a Fleet starts from: the built-in `preset` ('tender' when neither
+/// is given), or the preset file `preset_file` read as `--preset-file` reads it (ValueError: an
+/// unknown preset, a file that cannot be read or is malformed, or both given).
+SimParams baseParams(const std::optional<std::string>& preset, const std::optional<std::string>& preset_file);
 /// A point within the coordinates an input may name (ValueError naming `what` otherwise).
 glm::vec3 coordinates(double x, double y, double z, const char* what);
 /// A closure of the hand (0 open .. 1 closed; ValueError otherwise).

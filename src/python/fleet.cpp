@@ -28,11 +28,11 @@ namespace {
 /// and optional script. Sheet i gives the same state as tender.Simulation of its parameters.
 class PyFleet {
 public:
-  PyFleet(const py::object& sheets, const std::string& preset, const std::string& backend, std::optional<int> device,
-          const std::optional<std::vector<std::string>>& scripts, const py::kwargs& params) {
-    auto base = presetParams(preset);
-    if (!base) raise(PyExc_ValueError, unknownPreset(preset));
-    for (auto item : params) applyKey(*base, keyOf(item.first, "params"), item.second);
+  PyFleet(const py::object& sheets, const std::optional<std::string>& preset, const std::string& backend,
+          std::optional<int> device, const std::optional<std::vector<std::string>>& scripts,
+          const std::optional<std::string>& preset_file, const py::kwargs& params) {
+    SimParams base = baseParams(preset, preset_file);
+    for (auto item : params) applyKey(base, keyOf(item.first, "params"), item.second);
     if (backend != "cpu" && backend != "gpu") raise(PyExc_ValueError, "unknown backend '" + backend + "' (cpu or gpu)");
     if (device && *device < 0) raise(PyExc_ValueError, "device: expected an index >= 0 (see tender.devices())");
     // sheets: a count of sheets of the common parameters, or one dict of keys per sheet over them
@@ -44,14 +44,14 @@ public:
       if (sheets < py::int_(1) || sheets > py::int_(kMaxBatchSheets))
         raise(PyExc_ValueError, "sheets: expected 1 to " + std::to_string(kMaxBatchSheets) + ", got " +
                                     py::str(sheets).cast<std::string>());
-      list.assign(sheets.cast<size_t>(), FleetSheet{*base, {}});
+      list.assign(sheets.cast<size_t>(), FleetSheet{base, {}});
     } else if (py::isinstance<py::sequence>(sheets) && !py::isinstance<py::str>(sheets)) {
       size_t i = 0;
       for (const py::handle& item : sheets) {
         const std::string where = "sheets[" + std::to_string(i++) + "]";
         if (!py::isinstance<py::dict>(item)) raise(PyExc_TypeError, where + ": expected a dict, got " + typeName(item));
         if (i > kMaxBatchSheets) break;
-        FleetSheet s{*base, {}};
+        FleetSheet s{base, {}};
         for (auto kv : item.cast<py::dict>()) applyKey(s.params, keyOf(kv.first, where), kv.second);
         list.push_back(std::move(s));
       }
@@ -191,13 +191,15 @@ private:
 void bindFleet(py::module_& m) {
   py::class_<PyFleet>(m, "Fleet",
                       "Sheets of one grid that tick as one batch: Fleet(sheets=N or [dict per sheet], "
-                      "preset='tender', backend='cpu'|'gpu', device=None, scripts=None, **params). Each dict "
-                      "overrides the common params for its sheet (any key but the grid's); scripts: one input "
-                      "script text per sheet. Sheet i ends where tender.Simulation of its params ends.")
-      .def(py::init<const py::object&, const std::string&, const std::string&, std::optional<int>,
-                    const std::optional<std::vector<std::string>>&, const py::kwargs&>(),
-           py::arg("sheets"), py::arg("preset") = "tender", py::arg("backend") = "cpu", py::arg("device") = py::none(),
-           py::arg("scripts") = py::none())
+                      "preset='tender', backend='cpu'|'gpu', device=None, scripts=None, preset_file=None, "
+                      "**params). Each dict overrides the common params for its sheet (any key but the grid's); "
+                      "scripts: one input script text per sheet; preset_file: a preset file to start from instead "
+                      "of a preset. Sheet i ends where tender.Simulation of its params ends.")
+      .def(py::init<const py::object&, const std::optional<std::string>&, const std::string&, std::optional<int>,
+                    const std::optional<std::vector<std::string>>&, const std::optional<std::string>&,
+                    const py::kwargs&>(),
+           py::arg("sheets"), py::arg("preset") = py::none(), py::arg("backend") = "cpu",
+           py::arg("device") = py::none(), py::arg("scripts") = py::none(), py::arg("preset_file") = py::none())
       .def("step", &PyFleet::step, py::arg("ticks") = 1, "Runs `ticks` steps of every sheet, each as one batch.")
       .def_property_readonly(
           "positions", [](PyFleet& f) { return f.positions(false); }, "(B, N, 3) float32, a copy")

@@ -58,17 +58,16 @@ namespace {
 
 class PySimulation {
 public:
-  PySimulation(const std::string& preset, const std::string& backend, std::optional<int> device,
-               const py::kwargs& params) {
-    auto p = presetParams(preset);
-    if (!p) raise(PyExc_ValueError, unknownPreset(preset));
-    for (auto item : params) applyKey(*p, keyOf(item.first, "params"), item.second);
+  PySimulation(const std::optional<std::string>& preset, const std::string& backend, std::optional<int> device,
+               const std::optional<std::string>& preset_file, const py::kwargs& params) {
+    SimParams p = baseParams(preset, preset_file);
+    for (auto item : params) applyKey(p, keyOf(item.first, "params"), item.second);
     if (backend != "cpu" && backend != "gpu") raise(PyExc_ValueError, "unknown backend '" + backend + "' (cpu or gpu)");
     if (device && *device < 0) raise(PyExc_ValueError, "device: expected an index >= 0 (see tender.devices())");
-    if (auto err = validate(*p, backend)) raise(PyExc_ValueError, *err);
+    if (auto err = validate(p, backend)) raise(PyExc_ValueError, *err);
     backend_name_ = backend;
     device_ = device.value_or(-1);
-    build(*p);
+    build(p);
   }
 
   void step(int64_t ticks) {
@@ -249,9 +248,12 @@ py::list devices() {
 void bindSimulation(py::module_& m) {
   py::class_<PySimulation>(m, "Simulation",
                            "A sheet on a backend: Simulation(preset='tender', backend='cpu'|'gpu', device=None, "
-                           "**params), params as `--set` keys with Python values.")
-      .def(py::init<const std::string&, const std::string&, std::optional<int>, const py::kwargs&>(),
-           py::arg("preset") = "tender", py::arg("backend") = "cpu", py::arg("device") = py::none())
+                           "preset_file=None, **params), params as `--set` keys with Python values; preset_file: "
+                           "a preset file to start from instead of a preset (as `--preset-file`).")
+      .def(py::init<const std::optional<std::string>&, const std::string&, std::optional<int>,
+                    const std::optional<std::string>&, const py::kwargs&>(),
+           py::arg("preset") = py::none(), py::arg("backend") = "cpu", py::arg("device") = py::none(),
+           py::arg("preset_file") = py::none())
       .def("step", &PySimulation::step, py::arg("ticks") = 1, "Runs `ticks` ticks (as `tender sim --ticks`).")
       .def("grab", &PySimulation::grab, py::arg("particle"), "Grabs a particle where it is.")
       .def("grab_ray", &PySimulation::grabRay, py::arg("origin"), py::arg("direction"),

@@ -13,6 +13,8 @@ import tender
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 TENDER = os.environ.get("TENDER")
+# The seeds' cloth without contact, as a preset file (tests/scenes: a test scene no preset changes)
+CLOTH = os.path.join(ROOT, "tests", "scenes", "cloth.json")
 
 
 def cli_hash(*args):
@@ -26,6 +28,11 @@ def test_same_hash_as_tender_sim():
     sim.step(30)
     assert sim.state_hash() == cli_hash("--backend", "cpu", "--preset", "crumple", "--ticks", "30")
     assert sim.stats()["state_hash"] == sim.state_hash()
+    # A preset file, read by the same code as `--preset-file`
+    sim = tender.Simulation(preset_file=CLOTH, backend="cpu", cols=8, rows=12)
+    sim.step(10)
+    assert sim.state_hash() == cli_hash("--backend", "cpu", "--preset-file", CLOTH, "--set", "cols=8", "--set",
+                                        "rows=12", "--ticks", "10")
 
 
 @pytest.mark.skipif(not TENDER, reason="TENDER (the tender program) not set")
@@ -126,6 +133,10 @@ def test_bad_input_raises():
         tender.Simulation(backend="cpu", nope=1)
     with pytest.raises(ValueError, match="unknown preset 'nope'"):
         tender.Simulation(preset="nope", backend="cpu")
+    with pytest.raises(ValueError, match="^preset and preset_file: give one, not both$"):
+        tender.Simulation(preset="tender", preset_file=CLOTH)
+    with pytest.raises(ValueError, match="^preset_file: /nonexistent.json: cannot read: "):
+        tender.Fleet(2, preset_file="/nonexistent.json")
     with pytest.raises(ValueError, match="unknown backend"):
         tender.Simulation(backend="metal")
     with pytest.raises(ValueError, match="^gravity: "):
@@ -250,10 +261,8 @@ def test_fleet_sheets_match_their_runs_alone(backend, cols, rows):
         pytest.skip("no usable Vulkan device")
     sheets = fleet_sheets()
     scripts = [YANK if i % 2 == 0 else "" for i in range(len(sheets))]
-    # The seeds' cloth: the tender preset with its contact off (a fleet with contact:
-    # test_the_hand_crumples_a_sheet_into_a_ball)
-    fleet = tender.Fleet(sheets, preset="tender", backend=backend, cols=cols, rows=rows, contact_factor=0.0,
-                         scripts=scripts)
+    # The seeds' cloth (a fleet with contact: test_the_hand_crumples_a_sheet_into_a_ball)
+    fleet = tender.Fleet(sheets, preset_file=CLOTH, backend=backend, cols=cols, rows=rows, scripts=scripts)
     fleet.step(20)
     assert len(fleet) == 5 and fleet.backend == backend
     pos = fleet.positions
@@ -262,7 +271,7 @@ def test_fleet_sheets_match_their_runs_alone(backend, cols, rows):
     hashes = fleet.state_hashes()
     torn = [fleet.stats(i)["torn"] for i in range(5)]
     for i, extra in enumerate(sheets):
-        sim = tender.Simulation(preset="tender", backend=backend, cols=cols, rows=rows, contact_factor=0.0, **extra)
+        sim = tender.Simulation(preset_file=CLOTH, backend=backend, cols=cols, rows=rows, **extra)
         if scripts[i]:
             for step in range(20):
                 if step == 0:
@@ -296,7 +305,7 @@ def test_fleet_bad_input_raises():
     # A fleet sizes contact's buffers when its sheets are made: a script may not turn it on later
     # (refused when the fleet is made, on every backend, not after some ticks on the GPU)
     with pytest.raises(ValueError, match=r"^scripts\[0\]: tick 2: set contact_factor: "):
-        tender.Fleet(2, preset="crumple", backend="cpu", cols=8, rows=8, contact_factor=0,
+        tender.Fleet(2, preset_file=CLOTH, backend="cpu", cols=8, rows=8,
                      scripts=["0 grab particle 27\n2 set contact_factor 0.5\n", "0 grab particle 27\n"])
     fleet = tender.Fleet(2, cols=8, rows=8)
     with pytest.raises(IndexError):
