@@ -105,19 +105,20 @@ echo "ok: the wheel closes the hand a quarter a step, H opens it; the recording 
 
 # A toss to the left, from tick 120: far out of the crumple start view (target 0, -1.8, 0). The grab
 # lifts its particle from the floor at once, which tears paper: tearing is off, so that the whole
-# sheet flies (a torn-off corner flies alone, and the rest stays in view). Contact is off: the drag
-# with it runs more substeps a tick (README, Contact) than two busy cores keep up with in 15 s.
+# sheet flies (a torn-off corner flies alone, and the rest stays in view). The preset's paper on a
+# 20 x 30 grid: the drag with contact runs more substeps a tick (README, Contact) than two busy cores
+# keep up with in 15 s at the preset's 40 x 60.
 toss="$tmp/toss.txt"
 {
   echo "0 pins off"
-  echo "120 grab particle 1220"
+  echo "120 grab particle 310"
   for i in $(seq 80); do echo "$((120 + i)) move $(awk "BEGIN { print -0.3 * $i, 1 + 0.1 * $i }") 0"; done
   echo "201 release"
 } >"$toss"
 # Runs the toss to its step 240, where --quit-at ends the session (F pressed first when $1 is
 # "off"); prints the camera's exit line.
 toss_camera() {
-  start_demo --backend cpu --preset crumple --set tear_factor=0 --set contact_factor=0 --width 400 --height 300 \
+  start_demo --backend cpu --preset crumple --set cols=20 --set rows=30 --set tear_factor=0 --width 400 --height 300 \
     --replay "$toss" --quit-at 240
   [ "$1" = off ] && xdotool key --window "$wid" f
   local i steps

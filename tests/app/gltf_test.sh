@@ -11,7 +11,7 @@ passed=0
 ok() { echo "ok: $*"; passed=$((passed + 1)); }
 
 # A 16 x 24 sheet yanked by its free corner until it tears.
-sim=(sim --backend cpu --set cols=16 --set rows=24 --set substeps=4 --set iterations=2 --set contact_factor=0)
+sim=(sim --backend cpu "${cloth[@]}" --set cols=16 --set rows=24 --set substeps=4 --set iterations=2)
 printf '0 grab particle 383\n1 move 0 -40 4\n' >"$tmp/yank.txt"
 run=("${sim[@]}" --script "$tmp/yank.txt" --ticks 24)
 

@@ -10,7 +10,7 @@ printf '0 grab particle 383\n1 move 4 -4 6\n40 release\n' >"$tmp/yank.txt"
 # The seeds' cloth at 16 x 24 (contact's arithmetic on the inexact device:
 # gpu.parity_on_inexact_device), to just past the release: the yank has torn all it tears (19
 # constraints, by tick 5)
-run=(sim --ticks 45 --set cols=16 --set rows=24 --set contact_factor=0 --script "$tmp/yank.txt")
+run=(sim --ticks 45 "${cloth[@]}" --set cols=16 --set rows=24 --script "$tmp/yank.txt")
 "$T" "${run[@]}" --backend cpu --stats "$tmp/cpu.json" >/dev/null || fail "cpu run failed"
 TENDER_EMULATE_INEXACT_MATH=1 "$T" "${run[@]}" --backend gpu --stats "$tmp/gpu.json" >/dev/null || fail "gpu run failed"
 TENDER_EMULATE_INEXACT_MATH=1 TENDER_UNCORRECTED_MATH=1 "$T" "${run[@]}" --backend gpu --stats "$tmp/raw.json" >/dev/null ||

@@ -7,6 +7,7 @@ export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 failures=0
+. "$(dirname "${BASH_SOURCE[0]}")/scenes.sh"
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 
 expect_bad() {

@@ -3,12 +3,10 @@
 # (a pty from util-linux's `script`), a line rewritten in place once the run has taken a second,
 # erased at the end. Exit 77 (skipped) without `script`.
 set -uo pipefail
-T=${TENDER:?}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-# About two and a half seconds of ticks on one CPU thread here (the seeds' cloth: the preset's
-# contact off); longer under load is fine.
-run=(sim --backend cpu --set threads=1 --set cols=64 --set rows=96 --set contact_factor=0 --ticks 500)
+. "$(dirname "$0")/lib.sh"
+# About two and a half seconds of ticks on one CPU thread here (the seeds' cloth, without
+# contact); longer under load is fine.
+run=(sim --backend cpu "${cloth[@]}" --set threads=1 --set cols=64 --set rows=96 --ticks 500)
 
 start=$(date +%s%N)
 "$T" "${run[@]}" >"$tmp/out" 2>"$tmp/err" || { echo "FAIL: tender sim: $(cat "$tmp/err")"; exit 1; }

@@ -50,12 +50,12 @@ printf 'garbage\n' >"$tmp/garbage.txt"
 expect_bad_nodisplay --backend cpu --width 64 --height 64 --replay "$tmp/garbage.txt"
 expect_bad_nodisplay --backend cpu --width 64 --height 64 --record /nonexistent/dir/r.txt
 printf '0 wind off\n0 grab particle 1520\n1 move 0 -9 0\n' >"$tmp/replay.txt"
-# (the seeds' cloth: with the preset's contact a hand 9 units off drags at 32 substeps a tick)
-(cd "$tmp" && env -u DISPLAY -u WAYLAND_DISPLAY "$T" --backend cpu --set contact_factor=0 --width 64 --height 64 --replay replay.txt --record rec.txt >/dev/null 2>&1) &&
+# (the seeds' cloth without contact: with the tender preset's a hand 9 units off drags at 32 substeps a tick)
+(cd "$tmp" && env -u DISPLAY -u WAYLAND_DISPLAY "$T" --backend cpu "${cloth[@]}" --width 64 --height 64 --replay replay.txt --record rec.txt >/dev/null 2>&1) &&
   grep -q "move 0 -9 0" "$tmp/rec.txt" && echo "ok: no display: the replay is rendered and recorded" ||
   fail "no display: --replay/--record not honoured"
 # --quit-at 1: the picture of step 1, and the recording holds the events before it
-(cd "$tmp" && env -u DISPLAY -u WAYLAND_DISPLAY "$T" --backend cpu --set contact_factor=0 --width 64 --height 64 --replay replay.txt --record rec1.txt --quit-at 1 >/dev/null 2>&1) &&
+(cd "$tmp" && env -u DISPLAY -u WAYLAND_DISPLAY "$T" --backend cpu "${cloth[@]}" --width 64 --height 64 --replay replay.txt --record rec1.txt --quit-at 1 >/dev/null 2>&1) &&
   grep -q "grab particle 1520" "$tmp/rec1.txt" && ! grep -q "move 0 -9 0" "$tmp/rec1.txt" &&
   echo "ok: no display: --quit-at 1 renders and records the session to step 1" ||
   fail "no display: --quit-at not honoured: $(cat "$tmp/rec1.txt")"
@@ -63,7 +63,7 @@ printf '0 wind off\n0 grab particle 1520\n1 move 0 -9 0\n' >"$tmp/replay.txt"
 # A Vulkan error at run time (the driver cannot allocate under a memory limit) is one line, exit 2.
 # 1024 x 1024 without contact: its buffers pass the binding check, its topology fits in the limit
 # (out of memory below about 900 MB), and the driver's memory does not (it does above 2 GB).
-(ulimit -v 1250000; exec "$T" sim --backend gpu --set cols=1024 --set rows=1024 --set contact_factor=0 --ticks 0) \
+(ulimit -v 1250000; exec "$T" sim --backend gpu "${cloth[@]}" --set cols=1024 --set rows=1024 --ticks 0) \
   >"$tmp/o" 2>"$tmp/e"
 rc=$?
 if [ "$rc" -ne 2 ] || [ "$(wc -l <"$tmp/e")" -ne 1 ] || ! grep -q '^tender: error: Vulkan error ' "$tmp/e"; then
@@ -81,9 +81,9 @@ expect_bad sim --backend gpu --script "$tmp/grow.txt" --ticks 1
 if [ "$(awk '/^MemAvailable:/ {print $2}' /proc/meminfo)" -lt $((26 * 1024 * 1024)) ]; then
   grep -q "grow.txt: tick 0: set: a 4096x4096 sheet needs about" "$tmp/err" || fail "a script's 4096x4096 sheet: $(cat "$tmp/err")"
 fi
-# The GPU runs below are the seeds' cloth, the tender preset's contact off: a CPU device takes seconds
+# The GPU runs below are the seeds' cloth without contact: a CPU device takes seconds
 # to build contact's kernels (contact on the GPU: Parity.*Contact*, the crumple sweeps and diffs).
-seeds=(--set contact_factor=0)
+seeds=("${cloth[@]}")
 # Loader notices are not validation messages: the layer enabled through the environment too.
 VK_INSTANCE_LAYERS=VK_LAYER_KHRONOS_validation "$T" render --validation --backend gpu "${seeds[@]}" --ticks 3 --width 64 \
   --height 64 --out "$tmp/v.png" >"$tmp/o" 2>"$tmp/e" && echo "ok: VK_INSTANCE_LAYERS with --validation" ||

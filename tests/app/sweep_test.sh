@@ -6,8 +6,8 @@ set -u
 . "$(dirname "$0")/lib.sh"
 
 PY=${PYTHON:-python3}
-# The seeds' cloth, the tender preset's contact off (a sweep with contact: the crumple's below)
-small=(--backend cpu --set cols=8 --set rows=12 --set contact_factor=0)
+# The seeds' cloth without contact (a sweep with contact: the crumple's below)
+small=(--backend cpu "${cloth[@]}" --set cols=8 --set rows=12)
 # Grab the bottom right corner (particle 95 of 8x12) and yank it hard: tear_factor decides.
 printf '0 grab particle 95\n1 move 4 -4 6\n40 release\n' >"$tmp/yank.txt"
 
@@ -99,7 +99,7 @@ EOF
 
 # A small GPU sweep ends where the CPU's does (bitwise), where this build has Vulkan
 if "$T" devices >/dev/null 2>&1; then
-  sweep --backend gpu --set cols=8 --set rows=12 --set contact_factor=0 --script "$tmp/yank.txt" --vary tear_factor=0,1.5,50 \
+  sweep --backend gpu "${cloth[@]}" --set cols=8 --set rows=12 --script "$tmp/yank.txt" --vary tear_factor=0,1.5,50 \
     --vary damping=0.98,0.99 --ticks 60 --batch 4 --out "$tmp/gpu"
   cmp -s <(lines "$tmp/gpu" | sed 's/"arithmetic": {[^}]*}, "backend": "[a-z]*", //') \
     <(lines "$tmp/tear" | sed 's/"arithmetic": {[^}]*}, "backend": "[a-z]*", //') ||
@@ -113,7 +113,7 @@ if "$T" devices >/dev/null 2>&1; then
     <(lines "$tmp/cpu_contact" | sed 's/"arithmetic": {[^}]*}, "backend": "[a-z]*", //') ||
     fail "gpu and cpu sweeps with contact differ"
   # Sheets too large for the fused tick run the per-colour passes batched, with the same results
-  big=(--set cols=64 --set rows=96 --set contact_factor=0 --vary damping=0.98,0.99 --ticks 4)
+  big=("${cloth[@]}" --set cols=64 --set rows=96 --vary damping=0.98,0.99 --ticks 4)
   sweep --backend gpu "${big[@]}" --out "$tmp/gpu_big"
   sweep --backend cpu "${big[@]}" --out "$tmp/cpu_big"
   "$PY" - "$tmp/gpu_big" "$tmp/cpu_big" <<'EOF' || fail "large sheets on gpu: $(cat "$tmp/gpu_big/sheets.jsonl")"

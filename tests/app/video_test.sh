@@ -36,7 +36,7 @@ fi
   echo "ok: --ticks 61 at 25 fps -> 13 frames" || fail "--ticks 61 --fps 25: $(cat "$tmp/out")"
 
 # The GPU backend (its buffers drawn directly): 0.2 s at 30 fps is 6 frames.
-"$T" render --backend gpu --set contact_factor=0 --width 96 --height 64 --seconds 0.2 --fps 30 --video "$tmp/g.mp4" >"$tmp/out" 2>&1 &&
+"$T" render --backend gpu "${cloth[@]}" --width 96 --height 64 --seconds 0.2 --fps 30 --video "$tmp/g.mp4" >"$tmp/out" 2>&1 &&
   [ "$(ffprobe -v error -count_frames -show_entries stream=nb_read_frames -of csv=p=0 "$tmp/g.mp4")" = 6 ] &&
   echo "ok: the gpu backend -> 6 frames" || fail "--backend gpu: $(cat "$tmp/out")"
 

@@ -226,8 +226,8 @@ TEST(Script, ASheetAScriptRebuildsPassesTheMemoryCheck) {
 // again, but not on in a sheet made without it (on every backend, so that a sweep's sheets run the
 // same on the CPU and the GPU).
 TEST(Script, AFleetsScriptsDoNotTurnContactOnInASheetMadeWithoutIt) {
-  const SimParams off = preset("crumple", {"contact_factor=0", "cols=8", "rows=8"});
-  const SimParams on = preset("crumple", {"cols=8", "rows=8"});
+  const SimParams off = paperSheet({"cols=8", "rows=8"});
+  const SimParams on = paperSheet({"cols=8", "rows=8", "contact_factor=0.5"});
   std::string error;
   const auto later = parseScript("0 grab particle 27\n2 set contact_factor 0.5\n", error);
   ASSERT_TRUE(later) << error;

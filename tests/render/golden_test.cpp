@@ -34,12 +34,11 @@ constexpr int kChannelTolerance = 24;
 constexpr double kMaxDifferentFraction = 0.005;
 constexpr double kMaxMeanError = 1.5;
 
-render::HeadlessResult renderPreset(const std::string& preset, uint64_t ticks, const std::string& script_text,
-                                    const std::string& backend = "cpu", const std::vector<std::string>& sets = {}) {
+render::HeadlessResult renderScene(const SimParams& params, uint64_t ticks, const std::string& script_text,
+                                   const std::string& backend = "cpu") {
   gpu::preferLavapipeForTests();
   render::HeadlessOptions o;
-  o.params = *presetParams(preset);
-  for (const std::string& s : sets) EXPECT_FALSE(applyOverride(o.params, s).has_value()) << s;
+  o.params = params;
   o.backend = backend;
   o.validation = true;
   o.ticks = ticks;
@@ -52,6 +51,11 @@ render::HeadlessResult renderPreset(const std::string& preset, uint64_t ticks, c
     if (s) o.script = *s;
   }
   return render::renderHeadless(o);
+}
+
+render::HeadlessResult renderPreset(const std::string& preset, uint64_t ticks, const std::string& script_text,
+                                    const std::string& backend = "cpu") {
+  return renderScene(*presetParams(preset), ticks, script_text, backend);
 }
 
 /// The folder of the golden PNGs: $TENDER_TEST_DATA, or the source tree's folder built in.
@@ -151,11 +155,12 @@ TEST(Golden, TenderPresetHangingFromItsPins) {
 
 TEST(Golden, TornSheetShowsTheGap) {
   // Pull the bottom edge down hard: the sheet tears at its pins and the compacted triangles leave
-  // gaps. The seeds' cloth, its contact off (a CPU device builds contact's kernels in seconds)
-  auto r = renderPreset("tender", 40,
-                        "0 wind off\n0 grab particle 1520\n1 move 0 -4.5 0\n5 move 0 -6 0\n10 move 0 -8 0\n"
-                        "15 move 0 -10 0\n",
-                        "cpu", {"contact_factor=0"});
+  // gaps. The seeds' cloth, SimParams' defaults: no contact (a CPU device builds contact's kernels
+  // in seconds)
+  auto r = renderScene(SimParams{}, 40,
+                       "0 wind off\n0 grab particle 1520\n1 move 0 -4.5 0\n5 move 0 -6 0\n10 move 0 -8 0\n"
+                       "15 move 0 -10 0\n",
+                       "cpu");
   SKIP_OR_FAIL_ON_ERROR(r);
   EXPECT_EQ(r.validation_messages, 0u);
   compareWithGolden("tender_torn", r);
@@ -191,10 +196,10 @@ TEST(Golden, GpuSolverBuffersDrawTheSamePicture) {
 }
 
 TEST(Golden, GpuSolverTornSheet) {
-  auto r = renderPreset("tender", 40,
-                        "0 wind off\n0 grab particle 1520\n1 move 0 -4.5 0\n5 move 0 -6 0\n10 move 0 -8 0\n"
-                        "15 move 0 -10 0\n",
-                        "gpu", {"contact_factor=0"});
+  auto r = renderScene(SimParams{}, 40,
+                       "0 wind off\n0 grab particle 1520\n1 move 0 -4.5 0\n5 move 0 -6 0\n10 move 0 -8 0\n"
+                       "15 move 0 -10 0\n",
+                       "gpu");
   SKIP_OR_FAIL_ON_ERROR(r);
   EXPECT_EQ(r.validation_messages, 0u);
   if (std::getenv("TENDER_UPDATE_GOLDEN")) GTEST_SKIP() << "the CPU render is the golden";
