@@ -140,7 +140,7 @@ SIM_INLINE uvec2 limitParents(uint i, uint root, uint cols) {
 /// before its rings: nothing holds the sheet (no grab, no pins). The rings alone draw the sheet
 /// after their root, one-sidedly, and with no hand or pin to root them at, the free middle they
 /// root at keeps a crumpled ball moving: 1.8 to 3.5 units/s 8 s after a fast crumple
-/// (bench/README.md, "Stretch under the hand").
+/// (`bench/rest.py`, measured at 2bf6ebd).
 SIM_INLINE bool limitShortens(float reach, uint grab_index, uint flags) {
   return reach > 0.0f && grab_index == SIM_NONE && (flags & SIM_FLAG_PINS) == 0u;
 }

@@ -263,7 +263,7 @@
 // passes on to the other primitive (contactPassed): the pull or push the sheet had against a layer
 // moves the layer instead of vanishing. A half passes the motion of pressed layers to and fro so
 // that a crumple on a floor never comes to rest; a tenth lets it rest and frees a strip held under
-// a fold of the sheet it hangs from (bench/README.md, Contact)
+// a fold of the sheet it hangs from (Contact.AStripHeldUnderAFoldIsPulledFree)
 #define SIM_CONTACT_PASS_FRACTION 0.1f
 // How far a pair's normal (slideConstraint) may turn from rounding, per unit of the largest
 // coordinate of its particles (and one) over their distance: far above the rounding of the nearest
