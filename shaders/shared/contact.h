@@ -1,5 +1,6 @@
-// Penetration-free self-contact, shared by GLSL and C++: the distances between the sheet's
-// primitives and the bounded step of a particle (included at the end of xpbd.h, after VerletState).
+// Penetration-free self-contact, shared by GLSL and C++: the bounded step of a particle, from the
+// distances between the sheet's primitives (distance.h; included at the end of xpbd.h, after
+// VerletState).
 //
 // The guarantee (the conservative bound of Offset Geometric Contact, Chen et al. 2025): at the
 // start of a substep every particle v gets a bound b(v) = fraction x d(v), fraction < 1/2, where
@@ -49,114 +50,14 @@
 // speeding it up: passedState).
 #ifndef SIM_CONTACT_H
 #define SIM_CONTACT_H
+#include "distance.h"
 #include "exact_math.h"
-
-/// The nearest points of a contact pair of four particles: w the weights that make the vector
-/// from the second primitive's nearest point to the first's, sum_k w[k] x[k], and d2 its squared
-/// length.
-struct ContactPair {
-  vec4 w;
-  float d2;
-};
-
-/// Parameter in [0, 1] of the point of the segment a-b nearest to p (0 when a == b).
-SIM_INLINE float segmentParameter(vec3 p, vec3 a, vec3 b) {
-  vec3 ab = b - a;
-  float l2 = dot3(ab, ab);
-  return l2 > 0.0f ? clamp(simDiv(dot3(p - a, ab), l2), 0.0f, 1.0f) : 0.0f;
-}
-
-/// Particle p against the segment a-b: weights (1, -(1 - t), -t) and the squared distance.
-SIM_INLINE ContactPair pointSegment(vec3 p, vec3 a, vec3 b) {
-  float t = segmentParameter(p, a, b);
-  vec3 d = (p - a) - (b - a) * t;
-  ContactPair c;
-  c.w = vec4(1.0f, t - 1.0f, -t, 0.0f);
-  c.d2 = dot3(d, d);
-  return c;
-}
-
-/// Particle p against the triangle a, b, c: its plane when p lies over the inside, otherwise the
-/// nearest edge. Weights (1, -barycentric a, b, c). A triangle of no area is its edges. Finite for
-/// finite input.
-SIM_INLINE ContactPair pointTriangle(vec3 p, vec3 a, vec3 b, vec3 c) {
-  vec3 n = cross3(b - a, c - a);
-  float n2 = dot3(n, n);
-  float wa = dot3(cross3(c - b, p - b), n), wb = dot3(cross3(a - c, p - c), n), wc = dot3(cross3(b - a, p - a), n);
-  ContactPair r;
-  if (n2 > 0.0f && wa >= 0.0f && wb >= 0.0f && wc >= 0.0f) {
-    float plane = dot3(p - a, n);
-    r.w = vec4(1.0f, -simDiv(wa, n2), -simDiv(wb, n2), -simDiv(wc, n2));
-    r.d2 = simDiv(plane * plane, n2);
-    if (r.d2 >= 0.0f && r.d2 <= 3.0e38f) return r;
-  }
-  ContactPair ab = pointSegment(p, a, b), bc = pointSegment(p, b, c), ca = pointSegment(p, c, a);
-  r = ab;
-  if (bc.d2 < r.d2) r = ContactPair(vec4(1.0f, 0.0f, bc.w.y, bc.w.z), bc.d2);
-  if (ca.d2 < r.d2) r = ContactPair(vec4(1.0f, ca.w.z, 0.0f, ca.w.y), ca.d2);
-  return r;
-}
-
-/// Squared distance from p to the triangle a, b, c (pointTriangle).
-SIM_INLINE float pointTriangleDistance2(vec3 p, vec3 a, vec3 b, vec3 c) { return pointTriangle(p, a, b, c).d2; }
-
-/// The segments p0-p1 and q0-q1: weights (1 - s, s, -(1 - t), -t) of their nearest points by
-/// clamped parameters (parallel and zero-length segments included). Finite for finite input.
-SIM_INLINE ContactPair segmentSegment(vec3 p0, vec3 p1, vec3 q0, vec3 q1) {
-  vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
-  float a = dot3(d1, d1), e = dot3(d2, d2), f = dot3(d2, r);
-  float s = 0.0f, t = 0.0f;
-  float b = dot3(d1, d2);
-  float denom = a * e - b * b;
-  if (a <= 0.0f && e <= 0.0f) {
-    s = 0.0f;
-    t = 0.0f;
-  } else if (a <= 0.0f) {
-    t = clamp(simDiv(f, e), 0.0f, 1.0f);
-  } else {
-    float c = dot3(d1, r);
-    if (e <= 0.0f) {
-      s = clamp(simDiv(-c, a), 0.0f, 1.0f);
-    } else {
-      s = denom > 0.0f ? clamp(simDiv(b * f - c * e, denom), 0.0f, 1.0f) : 0.0f;
-      t = simDiv(b * s + f, e);
-      if (t < 0.0f) {
-        t = 0.0f;
-        s = clamp(simDiv(-c, a), 0.0f, 1.0f);
-      } else if (t > 1.0f) {
-        t = 1.0f;
-        s = clamp(simDiv(b - c, a), 0.0f, 1.0f);
-      }
-    }
-  }
-  vec3 d = (p0 + d1 * s) - (q0 + d2 * t);
-  ContactPair best;
-  best.w = vec4(1.0f - s, s, t - 1.0f, -t);
-  best.d2 = dot3(d, d);
-  if (!(best.d2 >= 0.0f && best.d2 <= 3.0e38f)) best.d2 = 3.0e38f;
-  // Parallel segments are nearest at an end of one of them; nearly parallel ones (the division
-  // above then rounds wide) compare the ends too
-  if (denom <= 1e-4f * a * e) {
-    ContactPair k = pointSegment(p0, q0, q1);
-    if (k.d2 < best.d2) best = ContactPair(vec4(1.0f, 0.0f, k.w.y, k.w.z), k.d2);
-    k = pointSegment(p1, q0, q1);
-    if (k.d2 < best.d2) best = ContactPair(vec4(0.0f, 1.0f, k.w.y, k.w.z), k.d2);
-    k = pointSegment(q0, p0, p1);
-    if (k.d2 < best.d2) best = ContactPair(vec4(-k.w.y, -k.w.z, -1.0f, 0.0f), k.d2);
-    k = pointSegment(q1, p0, p1);
-    if (k.d2 < best.d2) best = ContactPair(vec4(-k.w.y, -k.w.z, 0.0f, -1.0f), k.d2);
-  }
-  return best;
-}
-
-/// Squared distance between the segments p0-p1 and q0-q1 (segmentSegment).
-SIM_INLINE float segmentDistance2(vec3 p0, vec3 p1, vec3 q0, vec3 q1) { return segmentSegment(p0, p1, q0, q1).d2; }
 
 /// The push that parts a contact pair closer than `thickness` (x: its four particles, their
 /// inverse masses in w; c: pointTriangle or segmentSegment of them): each particle's share of the
 /// projection of |sum w x| >= thickness, in k. Zero when the pair is apart, touches exactly, or
 /// cannot move.
-SIM_INLINE vec3 contactPush(vec4 x0, vec4 x1, vec4 x2, vec4 x3, ContactPair c, float thickness, uint k) {
+SIM_INLINE vec3 contactPush(vec4 x0, vec4 x1, vec4 x2, vec4 x3, NearestPoints c, float thickness, uint k) {
   float wsum = c.w.x * c.w.x * x0.w + c.w.y * c.w.y * x1.w + c.w.z * c.w.z * x2.w + c.w.w * c.w.w * x3.w;
   if (!(c.d2 < thickness * thickness) || !(c.d2 > 0.0f) || !(wsum > 0.0f)) return vec3(0.0f);
   vec3 sep = vec3(x0) * c.w.x + vec3(x1) * c.w.y + vec3(x2) * c.w.z + vec3(x3) * c.w.w;
@@ -302,7 +203,7 @@ struct SlideHalf {
 /// the slab between the two planes keeps (1 - 2 fraction) d + 2 fraction m, however far they move
 /// along them. The normal that rounds off the true one by e carries a step s along it by e |s| more
 /// than it says: the slack.
-SIM_INLINE SlideHalf slideConstraint(vec3 x0, vec3 x1, vec3 x2, vec3 x3, ContactPair c, bool edge, float radius,
+SIM_INLINE SlideHalf slideConstraint(vec3 x0, vec3 x1, vec3 x2, vec3 x3, NearestPoints c, bool edge, float radius,
                                      float fraction, uint k) {
   SlideHalf r;
   r.h = vec4(0.0f, 0.0f, 0.0f, -1.0f);
@@ -348,7 +249,7 @@ SIM_INLINE bool contactOpposite(uint j, uint k, bool edge) {
 /// are summed in fixed point and their mean added to its step (passedPosition) before its own
 /// half-spaces cut it, so every step is still cut and no pair can close: contact passes momentum
 /// on instead of only taking it out.
-SIM_INLINE vec3 contactPassed(vec3 e, ContactPair c, uint k) {
+SIM_INLINE vec3 contactPassed(vec3 e, NearestPoints c, uint k) {
   float wk = k == 0u ? c.w.x : (k == 1u ? c.w.y : (k == 2u ? c.w.z : c.w.w));
   return e * (-SIM_CONTACT_PASS_FRACTION * abs(wk));
 }

@@ -109,7 +109,7 @@ vec3 passedMean(uint i) { return contactAverage(ivec4(contact_particles[i].passe
 // mean (passedPosition) summed into its particle's sums (NEAR_EXCESS), or the share of that step
 // less that excess's mean that keeps them lowering its share (NEAR_SHARE), or listed by particle
 // (NEAR_HALF_*)
-void slidePair(uvec4 q, vec3 x0, vec3 x1, vec3 x2, vec3 x3, ContactPair c, bool edge, uint only) {
+void slidePair(uvec4 q, vec3 x0, vec3 x1, vec3 x2, vec3 x3, NearestPoints c, bool edge, uint only) {
   vec3 frame = contactFrameNow();
   for (uint j = 0u; j < 4u; ++j) {
     SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, contactKeys().x, contactKeys().y, j);
@@ -162,7 +162,7 @@ void weighPair(uint k, uint other, bool particle, uvec2 edge, uint into, uint on
   if (free && into == SIM_NONE) return;
   vec3 x0 = vec3(nearPosition(q.x, only)), x1 = vec3(nearPosition(q.y, only)), x2 = vec3(nearPosition(q.z, only)),
        x3 = vec3(nearPosition(q.w, only));
-  ContactPair c = particle ? pointTriangle(x0, x1, x2, x3) : segmentSegment(x0, x1, x2, x3);
+  NearestPoints c = particle ? pointTriangle(x0, x1, x2, x3) : segmentSegment(x0, x1, x2, x3);
   if (only >= NEAR_PASS) {
     if (!free) slidePair(q, x0, x1, x2, x3, c, !particle, only);
     return;

@@ -209,7 +209,7 @@ void addPassed(uint i, vec3 passed) {
   atomicAdd(contact_particles[i].passed.w, 1u);
 }
 
-void contactPair(uvec4 q, ContactPair c) {
+void contactPair(uvec4 q, NearestPoints c) {
   float r = contactKeys().x, thickness = contactKeys().z;
   if (!(c.d2 < r * r)) return;
   lowerNearest(q.x, c.d2);

@@ -162,7 +162,7 @@ void CpuContact::lowerNearest(const std::vector<glm::vec4>& pos, float radius, f
         const uvec4 q = list[k];
         if (free_[q.x] | free_[q.y] | free_[q.z] | free_[q.w]) continue;
         const vec3 x0 = at(q.x), x1 = at(q.y), x2 = at(q.z), x3 = at(q.w);
-        const ContactPair c = edge ? segmentSegment(x0, x1, x2, x3) : pointTriangle(x0, x1, x2, x3);
+        const NearestPoints c = edge ? segmentSegment(x0, x1, x2, x3) : pointTriangle(x0, x1, x2, x3);
         if (!(c.d2 < r2)) continue;
         for (uint32_t i : {q.x, q.y, q.z, q.w}) lower(nearest2_[i], c.d2);
         Weighed& w = weighed_[first + k];
@@ -208,7 +208,7 @@ void CpuContact::slide(const std::vector<glm::vec4>& start, const std::vector<gl
   auto pairs = [&](auto&& visit) { visitHalfSpaces(visit); };
   // What each step's excess passes on to the other primitive of its pairs
   sums_.assign(n, glm::ivec4(0));
-  pairs([&](const uvec4& q, const ContactPair& c, bool edge, uint32_t j, const SlideHalf& h) {
+  pairs([&](const uvec4& q, const NearestPoints& c, bool edge, uint32_t j, const SlideHalf& h) {
     const vec3 e = slideExcess(h, vec3(pos[q[j]]) - (vec3(start[q[j]]) + frame_));
     if (e == vec3(0.0f)) return;
     for (uint32_t k = 0; k < 4; ++k)
@@ -220,14 +220,14 @@ void CpuContact::slide(const std::vector<glm::vec4>& start, const std::vector<gl
     return passedPosition(pos[i], vec3(passed[i]), u.floor_y) - (vec3(start[i]) + frame_);
   };
   sums_.assign(n, glm::ivec4(0));
-  pairs([&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf& h) {
+  pairs([&](const uvec4& q, const NearestPoints&, bool, uint32_t j, const SlideHalf& h) {
     const vec3 e = slideExcess(h, step(q[j]));
     if (e != vec3(0.0f)) addFixed(sums_, q[j], e, scale);
   });
   for (uint32_t i = 0; i < n; ++i) excess[i] = glm::vec4(contactAverage(sums_[i], scale), 0.0f);
   std::vector<uint32_t>& bits = share_bits_;
   bits.assign(n, std::bit_cast<uint32_t>(1.0f));
-  pairs([&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf& h) {
+  pairs([&](const uvec4& q, const NearestPoints&, bool, uint32_t j, const SlideHalf& h) {
     const float s = slideShare(h, step(q[j]) + vec3(excess[q[j]]));
     if (s < 1.0f) lower(bits[q[j]], s);
   });
@@ -238,14 +238,14 @@ void CpuContact::listHalfSpaces(uint32_t n) {
   // Counted, scanned, filled (a particle's in any order: room() takes their minimum)
   half_start_.assign(n + 1, 0u);
   if (!lists_) return;
-  visitHalfSpaces([&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf&) {
+  visitHalfSpaces([&](const uvec4& q, const NearestPoints&, bool, uint32_t j, const SlideHalf&) {
     std::atomic_ref<uint32_t>(half_start_[q[j] + 1]).fetch_add(1u, std::memory_order_relaxed);
   });
   for (uint32_t i = 0; i < n; ++i) half_start_[i + 1] += half_start_[i];
   half_.resize(half_start_[n]);
   half_slack_.resize(half_start_[n]);
   half_fill_.assign(half_start_.begin(), half_start_.end() - 1);
-  visitHalfSpaces([&](const uvec4& q, const ContactPair&, bool, uint32_t j, const SlideHalf& h) {
+  visitHalfSpaces([&](const uvec4& q, const NearestPoints&, bool, uint32_t j, const SlideHalf& h) {
     const uint32_t k = std::atomic_ref<uint32_t>(half_fill_[q[j]]).fetch_add(1u, std::memory_order_relaxed);
     half_[k] = h.h;
     half_slack_[k] = h.slack;

@@ -111,7 +111,7 @@ private:
   /// a flat one, and a triangle looks only at the triangles after it, so the first cost the most
   static constexpr uint32_t kSearchShares = 8;
 
-  /// Calls visit(pair, ContactPair, edge, j, SlideHalf) for each half-space the pairs closer than
+  /// Calls visit(pair, NearestPoints, edge, j, SlideHalf) for each half-space the pairs closer than
   /// the radius set their particles (particle j of the pair) where computeBounds had them (as
   /// lowerNearest weighed them), from the pool's threads.
   template <class Visit>
@@ -217,7 +217,7 @@ private:
   /// A pair closer than the radius where computeBounds had its particles: its nearest points and
   /// the half-space it sets each of them
   struct Weighed {
-    shaderio::ContactPair c;
+    shaderio::NearestPoints c;
     shaderio::SlideHalf h[4];
   };
   std::vector<Weighed> weighed_;     ///< each pair of vf_, then of ee_, where near_ marks it

@@ -1,4 +1,4 @@
-// The distances penetration-free contact is built on (shaders/shared/contact.h) against closed
+// The distances penetration-free contact is built on (shaders/shared/distance.h) against closed
 // forms and sampled points, the bounded step, and the half-space of a pair within the margin.
 #include <gtest/gtest.h>
 
@@ -24,10 +24,10 @@ namespace tender::test {
 namespace {
 
 using glm::vec3;
-using shaderio::ContactPair;
+using shaderio::NearestPoints;
 
-/// The vector between the nearest points a ContactPair names.
-vec3 separation(const ContactPair& c, vec3 x0, vec3 x1, vec3 x2, vec3 x3) {
+/// The vector between the nearest points a NearestPoints names.
+vec3 separation(const NearestPoints& c, vec3 x0, vec3 x1, vec3 x2, vec3 x3) {
   return x0 * c.w.x + x1 * c.w.y + x2 * c.w.z + x3 * c.w.w;
 }
 
@@ -60,7 +60,7 @@ TEST(ContactDistance, NeverAboveTheNearestSampledPointsAndTheWeightsNameThem) {
   for (int trial = 0; trial < 400; ++trial) {
     vec3 a = point(), b = point(), c = point(), p = point();
     if (trial % 10 == 0) c = a + (b - a) * 0.3f; // no area
-    const ContactPair vf = shaderio::pointTriangle(p, a, b, c);
+    const NearestPoints vf = shaderio::pointTriangle(p, a, b, c);
     float sampled = 1e30f, longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
     for (int i = 0; i <= kSteps; ++i)
       for (int j = 0; i + j <= kSteps; ++j) {
@@ -74,7 +74,7 @@ TEST(ContactDistance, NeverAboveTheNearestSampledPointsAndTheWeightsNameThem) {
 
     vec3 q0 = point(), q1 = point();
     if (trial % 10 == 1) q1 = q0 + (b - a) * 0.5f; // parallel
-    const ContactPair ee = shaderio::segmentSegment(a, b, q0, q1);
+    const NearestPoints ee = shaderio::segmentSegment(a, b, q0, q1);
     sampled = 1e30f;
     for (int i = 0; i <= kSteps; ++i)
       for (int j = 0; j <= kSteps; ++j) {
@@ -141,7 +141,7 @@ TEST(ContactDistance, APairWithinTheMarginMayPartAndSlideButNotClose) {
   // until its push, a tenth of its distance less half the margin, parted it)
   const float radius = 1.0f, m = SIM_CONTACT_MARGIN * radius, f = SIM_CONTACT_FRACTION;
   const vec3 p(0.25f, 0.25f, m / 3.0f), a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
-  const ContactPair pair = shaderio::pointTriangle(p, a, b, c);
+  const NearestPoints pair = shaderio::pointTriangle(p, a, b, c);
   ASSERT_LT(pair.d2, m * m);
   EXPECT_EQ(shaderio::slideBound(pair.d2, radius, f), shaderio::stepBound(radius * radius, radius, f));
   const shaderio::SlideHalf up = shaderio::slideConstraint(p, a, b, c, pair, false, radius, f, 0);
@@ -158,7 +158,7 @@ TEST(ContactDistance, APairWithinTheMarginMayPartAndSlideButNotClose) {
   EXPECT_EQ(shaderio::slideShare(down, towards), 1.0f);
   EXPECT_EQ(shaderio::slideShare(down, away), 0.0f);
   // Two primitives that touch have no normal: nothing moves
-  const ContactPair touching = shaderio::pointTriangle(vec3(0.25f, 0.25f, 0.0f), a, b, c);
+  const NearestPoints touching = shaderio::pointTriangle(vec3(0.25f, 0.25f, 0.0f), a, b, c);
   EXPECT_EQ(shaderio::slideBound(touching.d2, radius, f), 0.0f);
   EXPECT_LT(shaderio::slideConstraint(vec3(0.25f, 0.25f, 0.0f), a, b, c, touching, false, radius, f, 0).h.w, 0.0f);
 }

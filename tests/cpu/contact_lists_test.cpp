@@ -25,7 +25,7 @@ namespace tender::test {
 namespace {
 
 using glm::vec3;
-using shaderio::ContactPair;
+using shaderio::NearestPoints;
 
 // `layers` layers of a side x side grid 0.15 apart, a triangle mesh each: layer l at height gap x l,
 // moved by shift x l in its plane
@@ -209,7 +209,7 @@ TEST(ContactLists, TwoLayersClosingInHaveTheirListsBuiltBeforeTheyMeet) {
 // A half-space a pair closer than the radius sets particle j of it (slideConstraint).
 struct Half {
   glm::uvec4 q;
-  ContactPair c;
+  NearestPoints c;
   bool edge;
   uint32_t j;
   shaderio::SlideHalf h;
@@ -232,7 +232,7 @@ BruteBounds bruteForceBounds(const std::vector<glm::vec4>& pos, const std::vecto
   std::vector<float> nearest2(n, r2);
   std::vector<glm::ivec4> sums(n, glm::ivec4(0));
   BruteBounds want;
-  auto weigh = [&](glm::uvec4 q, ContactPair c, bool edge) {
+  auto weigh = [&](glm::uvec4 q, NearestPoints c, bool edge) {
     if (!(c.d2 < r2)) return;
     for (uint32_t j = 0; j < 4; ++j) {
       const shaderio::SlideHalf h =

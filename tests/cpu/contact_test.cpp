@@ -25,7 +25,7 @@ namespace tender::test {
 namespace {
 
 using glm::vec3;
-using shaderio::ContactPair;
+using shaderio::NearestPoints;
 
 /// A sheet of the `crumple` preset lying flat on its floor, 20 x 30, with contact on (or off).
 SimParams flatCrumple(bool contact, std::vector<std::string> sets = {}) {
