@@ -17,6 +17,11 @@ TENDER = os.environ.get("TENDER")
 CLOTH = os.path.join(ROOT, "tests", "scenes", "cloth.json")
 
 
+sys.path.insert(0, os.path.join(ROOT, "bench"))
+import gestures  # noqa: E402 (bench/gestures.py: the hand's gestures as input scripts)
+import stretch  # noqa: E402
+
+
 def cli_hash(*args):
     out = subprocess.run([TENDER, "sim", *args], check=True, capture_output=True, text=True).stdout
     return out.strip().split("state hash ")[-1]
@@ -389,3 +394,22 @@ def test_set_of_a_layout_key_rebuilds_the_sheet_as_a_script_does(tmp_path):
     script.write_text("5 set tilt 45\n")
     assert cli_hash("--backend", "cpu", "--set", "cols=8", "--set", "rows=8", "--script", str(script),
                     "--ticks", "20") == sim.state_hash()
+
+
+def test_gesture_scripts_replay_their_gestures(tmp_path):
+    # Each gesture of bench/stretch.py, recorded as it runs on a small crumple sheet, replays through
+    # `tender sim --script` to the module's state (the GPU kit's real-time check runs the scripts)
+    for name, gesture in stretch.GESTURES:
+        sc, keys, text = gestures.record("crumple", gesture, {"cols": 10, "rows": 15}, True)
+        script = tmp_path / f"{name}.txt"
+        script.write_text(text)
+        assert cli_hash("--backend", "cpu", *keys.split(), "--script", str(script)) == sc.sim.state_hash(), name
+
+
+def test_bench_gestures_are_what_gestures_py_writes(tmp_path):
+    # bench/gestures/ holds the scripts of the presets' gestures as bench/gestures.py writes them
+    written = os.path.join(ROOT, "bench", "gestures")
+    for preset in ("crumple", "tender"):
+        for name, gesture in stretch.GESTURES:
+            with open(os.path.join(written, f"{preset}-{name}.txt")) as f:
+                assert f.read() == gestures.record(preset, gesture, {}, False)[2], f"{preset}-{name}"
