@@ -63,7 +63,7 @@ if [ "$rc" -ne 0 ]; then
 fi
 if [ -f "$report" ]; then
   for check in environment devices gpu-tests render-tests diff-tender-hanging diff-tender-yank diff-crumple-hanging \
-    diff-crumple-yank diff-crumple-contact contact bench fleet fleet-large; do
+    diff-crumple-yank diff-crumple-contact contact realtime bench fleet fleet-large; do
     grep -q "^| $check | .* | pass | " "$report" || fail "report.md: check $check did not pass or is missing"
   done
   grep -q '^\*\*PASS\*\*: .* (smoke mode)' "$report" || fail "report.md does not say PASS in smoke mode"
@@ -72,6 +72,9 @@ if [ -f "$report" ]; then
     --gtest_filter='Camera.*:Receipt.*:Golden.TornSheetShowsTheGap' | grep -c '^  ')
   grep -q "^| render-tests | .* | $render_count tests, $render_count passed (2 processes) |" "$report" ||
     fail "report.md: render-tests did not count $render_count tests from 2 processes"
+  # The real-time table: the smoke mode's one gesture, 2 ticks, against the crumple preset's period
+  grep -q '^| crumple | toss | 2 | [0-9.]* | [0-9.]* | 16.7 | [0-9.]* | [0-9.]* | 0 |$' "$report" ||
+    fail "report.md has no real-time row for the crumple's toss"
   grep -q '^| dispatch cost | [0-9.]* us per empty dispatch' "$report" || fail "report.md has no dispatch cost"
   grep -q '^| 64x64 | 4096 | gpu-percolor | [0-9]' "$report" || fail "report.md has no benchmark table"
   [ -s "$tmp/report/bench.json" ] && [ -s "$tmp/report/bench.csv" ] || fail "no bench.json or bench.csv"
