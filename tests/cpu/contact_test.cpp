@@ -12,6 +12,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "common/fast_crumple.h"
 #include "common/sim_helpers.h"
 #include "core/intersections.h"
 #include "core/stats.h"
@@ -26,15 +27,6 @@ namespace {
 
 using glm::vec3;
 using shaderio::NearestPoints;
-
-/// A sheet of the `crumple` preset lying flat on its floor, 20 x 30, with contact on (or off).
-SimParams flatCrumple(bool contact, std::vector<std::string> sets = {}) {
-  sets.insert(sets.begin(), {"cols=20", "rows=30", "tilt=90", "pins=none", "wind=off",
-                             contact ? "contact_factor=0.5" : "contact_factor=0"});
-  SimParams p = preset(std::string("crumple"), sets);
-  p.top_y = p.floor_y + 0.5f * p.spacing;
-  return p;
-}
 
 /// The most intersecting pairs of triangles seen every `every` ticks of `ticks` ticks of `text`
 /// (and in `torn`, when given, the constraints torn at the end).
@@ -52,41 +44,6 @@ uint64_t mostPairs(const SimParams& p, const std::string& text, int ticks, int e
     if (torn) *torn = tornCount(s);
   }
   return most;
-}
-
-/// Where the hand of the fast crumple is at tick t (1 to 39): the middle of the flat sheet is
-/// snatched up (a third of the sheet's length in a twelfth of a second) as the hand closes, then
-/// swung round in circles; `pace` times as fast (the path of tick t x pace at tick t).
-vec3 fastCrumpleHand(const SimParams& p, const SimState& flat, int t, float pace = 1.0f) {
-  const vec3 m(flat.pos[(p.rows / 2) * p.cols + p.cols / 2]);
-  const float length = float(p.rows - 1) * p.spacing, at = float(t) * pace;
-  if (at <= 5.0f) return vec3(m.x, m.y + length * 0.07f * at, m.z);
-  const float a = 0.35f * (at - 6.0f);
-  return vec3(m.x + 0.14f * length * std::cos(a), m.y + length * (0.35f - 0.09f * std::sin(a)),
-              m.z + 0.14f * length * std::sin(a));
-}
-
-/// A crumple at a hand's speed (fastCrumpleHand), let go at tick 40.
-std::string fastCrumple(const SimParams& p, const SimState& flat, float pace = 1.0f) {
-  std::string text = "0 grab particle " + std::to_string((p.rows / 2) * p.cols + p.cols / 2) + "\n";
-  char line[160];
-  for (int t = 1; t < 40; ++t) {
-    const vec3 q = fastCrumpleHand(p, flat, t, pace);
-    std::snprintf(line, sizeof(line), "%d move %.6f %.6f %.6f\n", t, q.x, q.y, q.z);
-    text += line;
-    if (float(t) * pace <= 5.0f) {
-      std::snprintf(line, sizeof(line), "%d squeeze %.6f\n", t, std::min(0.2f * float(t) * pace, 1.0f));
-      text += line;
-    }
-  }
-  return text + "40 release\n";
-}
-
-/// The flat sheet of flatCrumple before its first tick.
-SimState flatState() {
-  CpuSolver solver;
-  Simulation sim(flatCrumple(true), solver);
-  return run(sim, 0);
 }
 
 /// Expects the script `text` to pass the flat sheet through itself with the particle repulsion
@@ -117,30 +74,6 @@ TEST(Contact, NoHandIsFastEnoughToPassTheSheetThroughItself) {
   const uint64_t with = mostPairs(p, text, 60, 1);
   std::printf("fast crumple at twice the pace: %llu intersecting pairs at most\n", (unsigned long long)with);
   EXPECT_EQ(with, 0u);
-}
-
-/// The fastest particle but the held one in the fast crumple of `p`, while the hand moves (ticks
-/// up to 40), and the fastest after it lets go; `each_tick(t, state)` sees every tick's state.
-struct Fastest {
-  float moving = 0.0f, let_go = 0.0f;
-};
-template <typename F>
-Fastest fastestInTheFastCrumple(const SimParams& p, const SimState& flat, int ticks, F&& each_tick) {
-  const uint32_t held = (p.rows / 2) * p.cols + p.cols / 2;
-  CpuSolver solver;
-  Simulation sim(p, solver);
-  sim.setScript(script(fastCrumple(p, flat).c_str()));
-  Fastest f;
-  for (int t = 1; t <= ticks; ++t) {
-    const SimState s = run(sim, 1);
-    each_tick(t, s);
-    for (uint32_t i = 0; i < s.pos.size(); ++i) {
-      const float v = glm::length(vec3(s.pos[i] - s.prev[i])) / sim.lastSubstepDt();
-      if (t <= 40 && i != held) f.moving = std::max(f.moving, v);
-      if (t > 40) f.let_go = std::max(f.let_go, v);
-    }
-  }
-  return f;
 }
 
 TEST(Contact, AFastCrumpleLeftOnTheFloorStaysApartAndComesToRest) {
@@ -176,26 +109,6 @@ TEST(Contact, AFastCrumpleLeftOnTheFloorStaysApartAndComesToRest) {
   EXPECT_LE(with.moving, without.moving);
   EXPECT_LE(with.let_go, hand);
   EXPECT_LT(speed, 0.5f);
-}
-
-TEST(Limit, AFastCrumpleLetGoComesToRestWithinTheLimit) {
-  // Without contact: the fast crumple, then eight seconds on the floor. With nothing holding the
-  // sheet, the stretch limit first shortens the over-long edges from both ends (the shorten stage),
-  // then runs its rings: the ball comes to rest, every edge within the limit. (The rings alone,
-  // rooted at the free middle, kept it moving at 1.8 to 3.5 units/s at 0.7 to 1.3 times this pace.)
-  const SimParams p = flatCrumple(false);
-  ASSERT_FLOAT_EQ(p.stretch_limit, 1.01f);
-  float stretch = 0.0f;
-  SimState s;
-  fastestInTheFastCrumple(p, flatState(), 40 + 480, [&](int, const SimState& at) {
-    stretch = std::max(stretch, computeStats(at, p.substepDt()).max_stretch);
-    s = at;
-  });
-  const float speed = computeStats(s, p.substepDt()).max_speed;
-  std::printf("fast crumple without contact, 8 s after: %.3f units/s at most, stretch %.4f at most, %u torn\n",
-              double(speed), double(stretch), tornCount(s));
-  EXPECT_LT(speed, 0.5f);
-  EXPECT_LE(stretch, 1.0101f);
 }
 
 /// The demo's toss on a 20 x 30 `crumple` sheet lying on its floor: its middle carried off 0.32
