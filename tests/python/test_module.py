@@ -397,9 +397,10 @@ def test_set_of_a_layout_key_rebuilds_the_sheet_as_a_script_does(tmp_path):
 
 
 def test_gesture_scripts_replay_their_gestures(tmp_path):
-    # Each gesture of bench/stretch.py, recorded as it runs on a small crumple sheet, replays through
-    # `tender sim --script` to the module's state (the GPU kit's real-time check runs the scripts)
-    for name, gesture in stretch.GESTURES:
+    # Gestures of bench/stretch.py, recorded as they run on a small crumple sheet, replay through
+    # `tender sim --script` to the module's state (the GPU kit's real-time check runs the scripts).
+    # Three hold every event a gesture sends: grab, move, squeeze (crumple, fast) and release.
+    for name, gesture in [g for g in stretch.GESTURES if g[0] in ("crumple", "fast", "yank")]:
         sc, keys, text = gestures.record("crumple", gesture, {"cols": 10, "rows": 15}, True)
         script = tmp_path / f"{name}.txt"
         script.write_text(text)
