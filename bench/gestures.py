@@ -68,7 +68,7 @@ def record(preset, gesture, overrides, run):
     sc = stretch.Scene(preset, overrides)
     sc.sim = Recorder(sc.sim, run)
     gesture(sc)
-    keys = {"tilt": 90, "pins": "none", "wind": "off", **overrides, "top_y": f32(sc.p["top_y"])}
+    keys = {**stretch.FLOOR_KEYS, **overrides, "top_y": f32(sc.p["top_y"])}
     head = " ".join(["--preset", preset] + [f"--set {k}={v}" for k, v in keys.items()])
     head += f" --ticks {sc.sim.tick}"
     return sc, head, f"# keys: {head}\n# period_ms: {1000.0 / sc.hz:.3f}\n" + "\n".join(sc.sim.lines) + "\n"

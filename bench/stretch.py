@@ -29,10 +29,13 @@ def number(text):
         return text
 
 
+# What every scene sets over its preset: the sheet lying on its floor, nothing holding it, no wind
+FLOOR_KEYS = {"tilt": 90, "pins": "none", "wind": "off"}
+
+
 class Scene:
     def __init__(self, preset, overrides):
-        keys = {"tilt": 90, "pins": "none", "wind": "off"}
-        keys.update(overrides)
+        keys = {**FLOOR_KEYS, **overrides}
         self.sim = tender.Simulation(preset, **keys)
         p = {k: number(v) for k, v in self.sim.params.items()}
         self.sim.set("top_y", p["floor_y"] + 0.5 * p["spacing"])  # flat on the floor

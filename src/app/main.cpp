@@ -44,11 +44,7 @@ std::optional<std::string> resolve(CommonOptions& o) {
   } else {
     p = presetParams(o.preset);
   }
-  if (!p) {
-    std::string names;
-    for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
-    return "unknown preset '" + o.preset + "' (one of " + names + ")";
-  }
+  if (!p) return unknownPreset(o.preset);
   for (auto& s : o.sets)
     if (auto err = applyOverride(*p, s)) return *err;
   if (o.backend != "cpu" && o.backend != "gpu") return "unknown backend '" + o.backend + "' (cpu or gpu)";

@@ -11,11 +11,7 @@ int runPresets(const std::string& name) {
     return 0;
   }
   std::optional<SimParams> p = presetParams(name);
-  if (!p) {
-    std::string names;
-    for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
-    return fail("unknown preset '" + name + "' (one of " + names + ")");
-  }
+  if (!p) return fail(unknownPreset(name));
   const std::string text = presetJson(*p);
   if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
     return fail("cannot write the preset to standard output");

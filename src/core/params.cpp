@@ -220,6 +220,12 @@ std::vector<std::string> presetNames() {
   return names;
 }
 
+std::string unknownPreset(const std::string& name) {
+  std::string names;
+  for (const std::string& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
+  return "unknown preset '" + name + "' (one of " + names + ")";
+}
+
 float SimParams::airPressureFactor() const {
   return air_density * drag_coefficient / (2.0f * (paper_weight * 1e-3f) * spacing * spacing);
 }

@@ -134,6 +134,8 @@ const std::vector<BuiltinPreset>& builtinPresets();
 std::vector<std::string> presetNames();
 /// Looks up a preset; nullopt when unknown.
 std::optional<SimParams> presetParams(const std::string& name);
+/// "unknown preset 'NAME' (one of tender, crumple, ...)": what every program says of an unknown name.
+std::string unknownPreset(const std::string& name);
 
 /// What a change of a parameter touches: the running sheet only, the sheet's layout (rebuilt at
 /// rest), its topology (the constraint graph: every sheet of a batch shares it; rebuilt too), or the

@@ -127,11 +127,7 @@ std::optional<std::string> applyPresetText(const std::string& text, const std::s
   SimParams p = out;
   if (from) {
     std::optional<SimParams> named = presetParams(*from);
-    if (!named) {
-      std::string names;
-      for (auto& name : presetNames()) names += (names.empty() ? "" : ", ") + name;
-      return origin + ": unknown preset '" + *from + "' (one of " + names + ")";
-    }
+    if (!named) return origin + ": " + unknownPreset(*from);
     p = *named;
   }
   for (const auto& e : reader.entries) {

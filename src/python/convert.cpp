@@ -83,11 +83,7 @@ SimParams baseParams(const std::optional<std::string>& preset, const std::option
   }
   const std::string name = preset.value_or("tender");
   auto q = presetParams(name);
-  if (!q) {
-    std::string names;
-    for (auto& n : presetNames()) names += (names.empty() ? "" : ", ") + n;
-    raise(PyExc_ValueError, "unknown preset '" + name + "' (one of " + names + ")");
-  }
+  if (!q) raise(PyExc_ValueError, unknownPreset(name));
   return *q;
 }
 
