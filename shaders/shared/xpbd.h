@@ -86,13 +86,13 @@ SIM_INLINE vec4 handPull(vec4 position, vec4 previous, uint i, vec3 centre, vec4
   return vec4(p, position.w);
 }
 
-/// Particle i's integration at a substep. The grabbed particle (is_grabbed) follows grab_target
-/// when grab_target.w is 1 (held: infinite mass, previous position grab_prev) or is let go with the
-/// velocity grab_target - grab_prev when grab_target.w is 2 (a toss); otherwise damped Verlet, and
-/// while a grab is held, the hand's pull (handPull).
-SIM_INLINE VerletState integrateParticle(uint i, vec4 pos, vec4 prev, vec4 rest, float u, bool is_grabbed,
-                                         vec4 grab_target, vec4 grab_prev, vec4 hand, vec4 hand_motion, uint flags,
-                                         float gravity, vec4 wind, vec4 wind_twist, float damping, float dt2) {
+/// A particle's integration at a substep with the hand open. The grabbed particle (is_grabbed)
+/// follows grab_target when grab_target.w is 1 (held: infinite mass, previous position grab_prev)
+/// or is let go with the velocity grab_target - grab_prev when grab_target.w is 2 (a toss);
+/// otherwise damped Verlet.
+SIM_INLINE VerletState integrateOpenHand(vec4 pos, vec4 prev, vec4 rest, float u, bool is_grabbed, vec4 grab_target,
+                                         vec4 grab_prev, uint flags, float gravity, vec4 wind, vec4 wind_twist,
+                                         float damping, float dt2) {
   bool placed = is_grabbed && grab_target.w > 0.5f;
   bool held = placed && grab_target.w < 1.5f;
   float w = inverseMass(rest, held, flags);
@@ -102,8 +102,19 @@ SIM_INLINE VerletState integrateParticle(uint i, vec4 pos, vec4 prev, vec4 rest,
     s.previous = vec4(vec3(grab_prev), w);
   } else {
     s = verletStep(pos, prev, externalAccel(gravity, wind, wind_twist, u), damping, dt2, w);
-    s.position = handPull(s.position, s.previous, i, vec3(grab_target), hand, hand_motion);
   }
+  return s;
+}
+
+/// Particle i's integration at a substep: integrateOpenHand, then, while a grab is held, the hand's
+/// pull on every particle it did not place (handPull, which moves nothing while the hand is open).
+SIM_INLINE VerletState integrateParticle(uint i, vec4 pos, vec4 prev, vec4 rest, float u, bool is_grabbed,
+                                         vec4 grab_target, vec4 grab_prev, vec4 hand, vec4 hand_motion, uint flags,
+                                         float gravity, vec4 wind, vec4 wind_twist, float damping, float dt2) {
+  VerletState s = integrateOpenHand(pos, prev, rest, u, is_grabbed, grab_target, grab_prev, flags, gravity, wind,
+                                    wind_twist, damping, dt2);
+  if (!(is_grabbed && grab_target.w > 0.5f))
+    s.position = handPull(s.position, s.previous, i, vec3(grab_target), hand, hand_motion);
   return s;
 }
 

@@ -103,23 +103,23 @@ void CpuSolver::airPass(const SimUniforms& u) {
 
 void CpuSolver::integrate(const SimUniforms& u, uint32_t s) {
   const float dt2 = u.dt * u.dt;
-  const vec4 wind = u.wind[s], twist = u.wind_twist[s];
-  const vec4 target = u.grab_target[s], grab_prev = u.grab_prev[s];
+  const vec4 wind = u.wind[s], twist = u.wind_twist[s], target = u.grab_target[s], grab_prev = u.grab_prev[s];
   const bool air = (u.flags & SIM_FLAG_AIR) != 0u;
   if (air) airPass(u);
+  // integrateParticle in two loops: with the hand's pull in it, the step's loop cost twice as much
+  const float damping = substepDamping(u.damping, u.verlet, s);
   pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
-    vec4* pos = pos_.data();
-    vec4* prev = prev_.data();
-    const vec4* rest = rest_.data();
-    const vec2* uv = uv_.data();
+    vec4 *pos = pos_.data(), *prev = prev_.data();
     for (uint32_t i = begin; i < end; ++i) {
       const VerletState st =
-          integrateParticle(i, pos[i], prev[i], rest[i], uv[i].x, i == u.grab_index, target, grab_prev, u.hand,
-                            u.hand_motion, u.flags, u.gravity, air ? windWithAir(wind, air_[i], u.flags) : wind, twist,
-                            substepDamping(u.damping, u.verlet, s), dt2);
+          integrateOpenHand(pos[i], prev[i], rest_[i], uv_[i].x, i == u.grab_index, target, grab_prev, u.flags,
+                            u.gravity, air ? windWithAir(wind, air_[i], u.flags) : wind, twist, damping, dt2);
       pos[i] = st.position;
       prev[i] = st.previous;
     }
+    for (uint32_t i = begin; u.hand.y > 0.0f && i < end; ++i) // the hand closed: its pull
+      if (!(i == u.grab_index && target.w > 0.5f))
+        pos[i] = handPull(pos[i], prev[i], i, vec3(target), u.hand, u.hand_motion);
   });
 }
 
