@@ -86,6 +86,10 @@ SIM_INLINE vec4 handPull(vec4 position, vec4 previous, uint i, vec3 centre, vec4
   return vec4(p, position.w);
 }
 
+/// Whether the grab places particle i this substep (held, or let go as a toss), rather than the
+/// Verlet step and the hand's pull moving it.
+SIM_INLINE bool placedByGrab(bool is_grabbed, vec4 grab_target) { return is_grabbed && grab_target.w > 0.5f; }
+
 /// A particle's integration at a substep with the hand open. The grabbed particle (is_grabbed)
 /// follows grab_target when grab_target.w is 1 (held: infinite mass, previous position grab_prev)
 /// or is let go with the velocity grab_target - grab_prev when grab_target.w is 2 (a toss);
@@ -93,7 +97,7 @@ SIM_INLINE vec4 handPull(vec4 position, vec4 previous, uint i, vec3 centre, vec4
 SIM_INLINE VerletState integrateOpenHand(vec4 pos, vec4 prev, vec4 rest, float u, bool is_grabbed, vec4 grab_target,
                                          vec4 grab_prev, uint flags, float gravity, vec4 wind, vec4 wind_twist,
                                          float damping, float dt2) {
-  bool placed = is_grabbed && grab_target.w > 0.5f;
+  bool placed = placedByGrab(is_grabbed, grab_target);
   bool held = placed && grab_target.w < 1.5f;
   float w = inverseMass(rest, held, flags);
   VerletState s;
@@ -113,7 +117,7 @@ SIM_INLINE VerletState integrateParticle(uint i, vec4 pos, vec4 prev, vec4 rest,
                                          float gravity, vec4 wind, vec4 wind_twist, float damping, float dt2) {
   VerletState s = integrateOpenHand(pos, prev, rest, u, is_grabbed, grab_target, grab_prev, flags, gravity, wind,
                                     wind_twist, damping, dt2);
-  if (!(is_grabbed && grab_target.w > 0.5f))
+  if (!placedByGrab(is_grabbed, grab_target))
     s.position = handPull(s.position, s.previous, i, vec3(grab_target), hand, hand_motion);
   return s;
 }

@@ -118,7 +118,7 @@ void CpuSolver::integrate(const SimUniforms& u, uint32_t s) {
       prev[i] = st.previous;
     }
     for (uint32_t i = begin; u.hand.y > 0.0f && i < end; ++i) // the hand closed: its pull
-      if (!(i == u.grab_index && target.w > 0.5f))
+      if (!placedByGrab(i == u.grab_index, target))
         pos[i] = handPull(pos[i], prev[i], i, vec3(target), u.hand, u.hand_motion);
   });
 }
