@@ -110,7 +110,9 @@
 //             none in a substep that does not build the grid), Walk (contact_walk's, over the
 //             queries with pairs in their lists: none in a substep that builds them), Cross
 //             (contact_cross's, over the triangles: none in a substep whose crossing check looks
-//             at no triangle) or
+//             at no triangle), Settle (the settle's half-spaces' passes: none in a substep with no
+//             edge over the limit), Sweep (a settle sweep's, each colour's grid that of the largest:
+//             none after a sweep that moved nothing) or
 //             Compaction (the tear compaction's arguments): gpu::Grid
 //   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)
 //   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases), LIMIT
@@ -155,10 +157,10 @@
   X(floor, contact_share, CONTACT_QUERIES, Threads, CONTACT, CONTACT, Floor)                                           \
   X(floor, contact_step, PARTICLES, Threads, CONTACT, CONTACT, Floor)                                                  \
   X(settle, contact_settle_check, CONSTRAINTS, Threads, SETTLE, SETTLE, Floor)                                         \
-  X(settle, contact_half_count, CONTACT_QUERIES, Threads, SETTLE, SETTLE, Floor)                                       \
+  X(settle, contact_half_count, CONTACT_QUERIES, Settle, SETTLE, SETTLE, Floor)                                        \
   X(settle, scan, CONTACT_HALF_CELLS, Threads, SETTLE, SETTLE, Floor)                                                  \
-  X(settle, contact_half_fill, CONTACT_QUERIES, Threads, SETTLE, SETTLE, Floor)                                        \
-  X(settle, contact_settle, SWEEPS, Threads, SETTLE, SETTLE, Floor)                                                    \
+  X(settle, contact_half_fill, CONTACT_QUERIES, Settle, SETTLE, SETTLE, Floor)                                         \
+  X(settle, contact_settle, SWEEPS, Sweep, SETTLE, SETTLE, Floor)                                                      \
   X(tear, tear_mark, CONSTRAINTS, Threads, TICK, CONSTRAINTS, Tear)                                                    \
   X(tear, tear_unsupported, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                       \
   X(tear, tear_flags, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                             \

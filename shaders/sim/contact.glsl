@@ -368,9 +368,11 @@ vec3 settleFrame() { return contactFrameNow(); }
 #include "settle_bodies.h"
 
 // contact_settle_check: constraint slot k over the limit in substep s (settleOver; a torn one past
-// its colour's live count may say so too: that only runs a stage that moves nothing)
-void contactSettleCheck(uint k, uint s) {
-  if (contactChecks().y > 0u && settleOver(constraints[k], s)) atomicOr(contact_words[CONTACT_SETTLE_OVER], 1u);
+// its colour's live count may say so too: that only runs a stage that moves nothing); true for the
+// one that starts the stage (the first of the substep found over)
+bool contactSettleCheck(uint k, uint s) {
+  return contactChecks().y > 0u && settleOver(constraints[k], s) &&
+         atomicOr(contact_words[CONTACT_SETTLE_OVER], 1u) == 0u;
 }
 // True when an edge is over the limit as the stage starts: else it lists nothing and moves nothing
 bool settleStarts() { return contact_words[CONTACT_SETTLE_OVER] != 0u; }
@@ -379,9 +381,29 @@ bool settleStarts() { return contact_words[CONTACT_SETTLE_OVER] != 0u; }
 bool settleSweeps(uint sweep) {
   return sweep == 0u ? settleStarts() : contact_words[CONTACT_SETTLE_SWEPT + sweep - 1u] != 0u;
 }
-// contact_settle: constraint c in sweep `sweep` of substep s
-void contactSettle(Constraint c, uint sweep, uint s) {
-  if (settleConstraint(c, s)) atomicOr(contact_words[CONTACT_SETTLE_SWEPT + sweep], 1u);
+// contact_settle: constraint c in sweep `sweep` of substep s; true for the first edge of the sweep
+// it works on (the sweep is not the last that moves anything)
+bool contactSettle(Constraint c, uint sweep, uint s) {
+  return settleConstraint(c, s) && atomicOr(contact_words[CONTACT_SETTLE_SWEPT + sweep], 1u) == 0u;
 }
+
+#ifndef SIM_FUSED_CONTACT
+// The per-colour passes dispatch the settle's indirectly (Grid::Settle, Grid::Sweep): none of its
+// passes runs a workgroup in a substep that does not need it. contact_begin disarms every slot;
+// the edge that starts the stage arms slot 0 (the half-spaces' passes) and 1 (the first sweep), the
+// first edge a sweep works on arms the next sweep's. A sheet of a fleet raises the batch's slot.
+void disarmSettle() {
+  for (uint k = 0u; k < SIM_CONTACT_SETTLE_SLOTS; ++k) hash_args[SIM_CONTACT_SETTLE_ARGS + k] = uvec4(0u, 1u, 1u, 0u);
+}
+void armSettle(uint slot) {
+  uint full = min(slot, 1u);
+#ifdef SIM_BATCH_PASS
+  batchArmArgs(SIM_BATCH_ARGS_LIVE_SETTLE + batch.substep * SIM_CONTACT_SETTLE_SLOTS + slot,
+               SIM_BATCH_ARGS_FULL_SETTLE + full);
+#else
+  hash_args[SIM_CONTACT_SETTLE_ARGS + slot] = hash_args[SIM_CONTACT_SETTLE_FULL + full];
+#endif
+}
+#endif
 
 #endif

@@ -8,5 +8,9 @@
 #include "sim_common.glsl"
 
 void main() {
-  if (threadIndex() == 0u) contactBegin(p.substep, true);
+  if (threadIndex() != 0u) return;
+  contactBegin(p.substep, true);
+#ifndef SIM_BATCH_PASS
+  disarmSettle(); // a fleet's host writes the batch's live arguments disarmed
+#endif
 }

@@ -1,7 +1,8 @@
 #version 460
 // The settle stage (settle_bodies.h): in sweep p.first, the structural edges of one colour (no two
 // share a particle, so no races) longer than the stretch limit shortened within what the contact
-// lets each end's step go; none after a sweep that moved nothing (settleSweeps).
+// lets each end's step go; none after a sweep that moved nothing (settleSweeps: its workgroups are
+// armed by the sweep before, armSettle).
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PROJECT
 #define SIM_PUSH_TYPE SimPush
@@ -13,5 +14,6 @@ void main() {
   uint t = threadIndex();
   uvec2 range = color_range[p.color];
   if (t >= range.y) return; // beyond the live count of this colour
-  contactSettle(constraints[range.x + t], p.first, p.substep);
+  if (contactSettle(constraints[range.x + t], p.first, p.substep) && p.first + 1u < contactChecks().y)
+    armSettle(p.first + 2u); // the next sweep
 }

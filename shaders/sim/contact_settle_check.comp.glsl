@@ -9,5 +9,8 @@
 
 void main() {
   uint k = threadIndex();
-  if (k < p.count) contactSettleCheck(k, p.substep);
+  if (k < p.count && contactSettleCheck(k, p.substep)) { // the stage starts: its half-spaces and first sweep
+    armSettle(0u);
+    armSettle(1u);
+  }
 }

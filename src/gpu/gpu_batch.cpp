@@ -218,7 +218,7 @@ void GpuBatch::finish() {
 void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
                     uint32_t substep, uint32_t gate, uint32_t gate_arg) {
   if (pass_sheet_ >= 0) {
-    passOfSheet(uint32_t(pass_sheet_), p, grid, count, push, push_size);
+    passOfSheet(uint32_t(pass_sheet_), p, grid, count, push, push_size, grid == Grid::Sweep ? gate_arg : 0);
     return;
   }
   if (push_size > sizeof(SimPush) || p.push_size != sizeof(BatchPassPush))
@@ -226,10 +226,11 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
   // The grid a sheet alone gets, with a workgroup z per sheet: from the element count; the hash
   // passes, the compaction and contact's indirect passes from the batch's live arguments, which
   // the sheets that need them arm (the gates skip the other sheets).
-  const bool counted = grid == Grid::Threads || grid == Grid::Hash || grid == Grid::Contact;
+  const bool counted = grid == Grid::Threads || grid == Grid::Hash || grid == Grid::Contact || grid == Grid::Settle ||
+                       grid == Grid::Sweep;
   if ((counted || grid == Grid::Walk || grid == Grid::Cross) && count == 0) return;
   const glm::uvec4 full = fullGrid(p, counted ? count : 1u, pass_sheets_);
-  const uint32_t hash_dispatch = hash_grids_.record(grid, full);
+  const uint32_t hash_dispatch = hash_grids_.record(grid, full, grid == Grid::Sweep ? gate_arg : 0);
   BatchPassPush bp{};
   if (push_size) std::memcpy(&bp.pass, push, push_size);
   const VkDeviceAddress table = table_address_;
@@ -268,19 +269,25 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
                           16ull * (SIM_BATCH_ARGS_LIVE_CONTACT + substep * SIM_BATCH_CONTACT_SLOTS + slot));
     break;
   }
+  case Grid::Settle:
+  case Grid::Sweep: // the settle's slot (hash_dispatch names the sheet's own)
+    vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer,
+                          16ull * (SIM_BATCH_ARGS_LIVE_SETTLE + substep * SIM_CONTACT_SETTLE_SLOTS + hash_dispatch -
+                                   SIM_CONTACT_SETTLE_ARGS));
+    break;
   }
   ++last_dispatches_;
 }
 
 void GpuBatch::passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
-                           uint32_t push_size) {
+                           uint32_t push_size, uint32_t sweep) {
   const SheetPassTarget target{cmd_,
                                sheet_layout_,
                                buf_[SIM_BIND_HASH_ARGS].buffer,
                                sliceOffset(SIM_BIND_HASH_ARGS, i),
                                buf_[SIM_BIND_COUNTERS].buffer,
                                sliceOffset(SIM_BIND_COUNTERS, i)};
-  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size)) ++last_dispatches_;
+  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size, sweep)) ++last_dispatches_;
 }
 
 void GpuBatch::barrier() { computeToCompute(cmd_); }

@@ -79,8 +79,8 @@ void GpuBatch::recordInputs(const FlushQueue& f) {
   VkBufferCopy queue_region{0, 0, 4ull * queue.size()};
   vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BATCH_QUEUE].buffer, 1, &queue_region);
   if (!f.passes.empty() && per_sheet_) {
-    // Each sheet's full grids of the hash passes and of contact's grid passes, which its
-    // candidates_decide and contact_arm copy to the live ones
+    // Each sheet's full grids of the hash passes, of contact's grid passes and of the settle's,
+    // which its candidates_decide, contact_arm and settle passes copy to the live ones
     std::vector<VkBufferCopy> grid_regions;
     for (uint32_t i : f.passes) {
       grid_regions.push_back(
@@ -89,6 +89,8 @@ void GpuBatch::recordInputs(const FlushQueue& f) {
           {f.args_at + 16ull * SIM_HASH_DISPATCHES,
            sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * (SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES),
            16ull * SIM_CONTACT_GRID_DISPATCHES});
+      grid_regions.push_back({f.args_at + 16ull * (SIM_HASH_DISPATCHES + SIM_CONTACT_GRID_DISPATCHES),
+                              sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * SIM_CONTACT_SETTLE_FULL, 32ull});
     }
     vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BIND_HASH_ARGS].buffer, uint32_t(grid_regions.size()),
                     grid_regions.data());
@@ -147,9 +149,11 @@ void GpuBatch::recordSheetPasses(const FlushQueue& f) {
       recordSubstep(*this, sheet_passes_, topo_, sizes_, sheet_plan, s, count);
   }
   pass_sheet_ = -1;
-  glm::uvec4 grids[SIM_HASH_DISPATCHES + SIM_CONTACT_GRID_DISPATCHES] = {};
+  glm::uvec4 grids[SIM_HASH_DISPATCHES + SIM_CONTACT_GRID_DISPATCHES + 2] = {};
   std::copy(hash_grids_.grids().begin(), hash_grids_.grids().end(), grids);
   std::copy(hash_grids_.contactGrids().begin(), hash_grids_.contactGrids().end(), grids + SIM_HASH_DISPATCHES);
+  std::copy(hash_grids_.settleGrids().begin(), hash_grids_.settleGrids().end(),
+            grids + SIM_HASH_DISPATCHES + SIM_CONTACT_GRID_DISPATCHES);
   std::memcpy(static_cast<char*>(inputs_.mapped) + f.args_at, grids, sizeof(grids));
 }
 
@@ -169,12 +173,13 @@ void GpuBatch::recordBatchedPasses(const FlushQueue& f) {
   for (uint32_t s = 0; s < f.pass_substeps; ++s) recordSubstep(*this, passes_, topo_, sizes_, f.plan, s, count);
   // The batch's indirect arguments (recordInputs's copy takes them at submission): the full grids,
   // and the live ones of every substep with no workgroups until a sheet needs them
-  glm::uvec4 args[SIM_BATCH_ARGS_COUNT] = {};
+  std::vector<glm::uvec4> args(SIM_BATCH_ARGS_COUNT, glm::uvec4(0u));
   const uint32_t compact_groups = (sizes_.tear_slots + SIM_WG_TEAR - 1) / SIM_WG_TEAR;
   args[SIM_BATCH_ARGS_FULL_COMPACT] = glm::uvec4(groupGrid(compact_groups), pass_sheets_, 0);
   for (uint32_t k = 0; k < hash_grids_.grids().size(); ++k) args[k] = hash_grids_.grids()[k];
   for (uint32_t k = 0; k < hash_grids_.contactGrids().size(); ++k)
     args[SIM_BATCH_ARGS_FULL_CONTACT + k] = hash_grids_.contactGrids()[k];
+  for (uint32_t k = 0; k < 2; ++k) args[SIM_BATCH_ARGS_FULL_SETTLE + k] = hash_grids_.settleGrids()[k];
   for (uint32_t s = 0; s < SIM_MAX_SUBSTEPS; ++s) {
     for (uint32_t k = 0; k < SIM_HASH_DISPATCHES; ++k)
       args[SIM_BATCH_ARGS_LIVE_HASH + s * SIM_HASH_DISPATCHES + k] = glm::uvec4(0, args[k].y, pass_sheets_, 0);
@@ -185,8 +190,12 @@ void GpuBatch::recordBatchedPasses(const FlushQueue& f) {
       args[live + k] = glm::uvec4(0, args[SIM_BATCH_ARGS_FULL_CONTACT + k].y, pass_sheets_, 0);
     args[live + SIM_CONTACT_GRID_DISPATCHES] = args[live + SIM_CONTACT_GRID_DISPATCHES + 1] =
         glm::uvec4(0, 0, pass_sheets_, 0);
+    // The settle's half-spaces' passes, then its sweeps (a sheet raises x where it arms its own)
+    for (uint32_t k = 0; k < SIM_CONTACT_SETTLE_SLOTS; ++k)
+      args[SIM_BATCH_ARGS_LIVE_SETTLE + s * SIM_CONTACT_SETTLE_SLOTS + k] =
+          glm::uvec4(0, args[SIM_BATCH_ARGS_FULL_SETTLE + std::min(k, 1u)].y, pass_sheets_, 0);
   }
-  std::memcpy(static_cast<char*>(inputs_.mapped) + f.args_at, args, sizeof(args));
+  std::memcpy(static_cast<char*>(inputs_.mapped) + f.args_at, args.data(), 16ull * args.size());
 }
 
 void GpuBatch::flush() {

@@ -16,9 +16,9 @@ void GpuSolver::bindSet(VkCommandBuffer cmd, uint32_t uniform_index) {
 }
 
 void GpuSolver::dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
-                         uint32_t push_size) {
+                         uint32_t push_size, uint32_t sweep) {
   const SheetPassTarget target{cmd, layout_, buf_[SIM_BIND_HASH_ARGS].buffer, 0, buf_[SIM_BIND_COUNTERS].buffer, 0};
-  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size)) ++recorded_dispatches_;
+  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size, sweep)) ++recorded_dispatches_;
 }
 
 void GpuSolver::timestamp(VkCommandBuffer cmd, InFlight& flight, PassCategory c) {
@@ -31,9 +31,9 @@ void GpuSolver::timestamp(VkCommandBuffer cmd, InFlight& flight, PassCategory c)
 }
 
 void GpuSolver::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
-                     uint32_t, uint32_t, uint32_t) {
-  // One sheet: it runs every pass recorded for it
-  dispatch(recording_->tick, p, grid, count, push, push_size);
+                     uint32_t, uint32_t, uint32_t gate_arg) {
+  // One sheet: it runs every pass recorded for it (a settle sweep's gate_arg is the sweep)
+  dispatch(recording_->tick, p, grid, count, push, push_size, grid == Grid::Sweep ? gate_arg : 0);
 }
 
 void GpuSolver::barrier() { computeToCompute(recording_->tick); }
@@ -78,10 +78,13 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
   computeToAll(cmd); // the renderer and copies see this tick
   VK_CHECK(vkEndCommandBuffer(cmd));
   flight.recorded = key;
-  // The full grids of the hash passes and of contact's grid passes, which candidates_decide and
-  // contact_arm copy to the live arguments
-  if (hash_grids_.grids() != hash_grids_uploaded_ || hash_grids_.contactGrids() != contact_grids_uploaded_) {
+  // The full grids of the hash passes, of contact's grid passes and of the settle's, which
+  // candidates_decide, contact_arm and the settle's passes copy to the live arguments
+  if (hash_grids_.grids() != hash_grids_uploaded_ || hash_grids_.contactGrids() != contact_grids_uploaded_ ||
+      hash_grids_.settleGrids() != settle_grids_uploaded_) {
     ctx_.submitOnce([&](VkCommandBuffer up) {
+      vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * SIM_CONTACT_SETTLE_FULL,
+                        sizeof(hash_grids_.settleGrids()), hash_grids_.settleGrids().data());
       const std::vector<glm::uvec4>&hash = hash_grids_.grids(), &contact = hash_grids_.contactGrids();
       if (!hash.empty())
         vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * SIM_HASH_DISPATCHES, 16 * hash.size(),
@@ -93,6 +96,7 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
     });
     hash_grids_uploaded_ = hash_grids_.grids();
     contact_grids_uploaded_ = hash_grids_.contactGrids();
+    settle_grids_uploaded_ = hash_grids_.settleGrids();
   }
   flight.dispatches = recorded_dispatches_;
 }

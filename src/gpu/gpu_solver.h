@@ -170,9 +170,10 @@ private:
   void bindSet(VkCommandBuffer cmd, uint32_t uniform_index);
   /// The one dispatch helper: binds the pipeline, checks and pushes the constants, and dispatches
   /// `count` elements (Threads), one workgroup (Workgroup), or the grid of an indirect argument
-  /// (Compaction, Hash: the next hash dispatch's live arguments, whose full grid candidates_decide copies in).
+  /// (Compaction, Hash: the next hash dispatch's live arguments, whose full grid candidates_decide copies in;
+  /// Sweep: settle sweep `sweep`'s).
   void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
-                uint32_t push_size);
+                uint32_t push_size, uint32_t sweep = 0);
   template <class Push>
   void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const Push& push) {
     dispatch(cmd, p, grid, count, &push, uint32_t(sizeof(Push)));
@@ -224,6 +225,7 @@ private:
   HashGrids hash_grids_;                                       ///< full grids of the hash passes, in recording order
   std::vector<glm::uvec4> hash_grids_uploaded_;                ///< what SIM_BIND_HASH_ARGS holds of them
   std::vector<glm::uvec4> contact_grids_uploaded_;             ///< ... and of contact's grid passes
+  std::array<glm::uvec4, 2> settle_grids_uploaded_{};          ///< ... and of the settle's
   uint32_t stop_after_ = SIM_NONE;                             ///< stopNextTickAfter
   mutable std::array<double, kCategoryCount> last_ms_{};
 };

@@ -12,8 +12,15 @@ glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets) {
   return glm::uvec4(groupGrid((count + p.workgroup - 1) / p.workgroup), sheets, 0u);
 }
 
-uint32_t HashGrids::record(Grid grid, glm::uvec4 full) {
-  if (grid == Grid::Cross) return 0; // its own slot, amid the contact grid's passes
+uint32_t HashGrids::record(Grid grid, glm::uvec4 full, uint32_t sweep) {
+  if (grid == Grid::Cross) return 0;                 // its own slot, amid the contact grid's passes
+  if (grid == Grid::Settle || grid == Grid::Sweep) { // a slot of the settle's, one full grid each kind
+    glm::uvec4& grids = settle_grids_[grid == Grid::Sweep ? 1 : 0];
+    if (grids == glm::uvec4(0u)) grids = full;
+    if (grids != full || sweep >= SIM_SETTLE_MAX_SWEEPS)
+      vkCheckFailed(VK_ERROR_UNKNOWN, "settle grid", __FILE__, __LINE__);
+    return SIM_CONTACT_SETTLE_ARGS + (grid == Grid::Sweep ? 1 + sweep : 0);
+  }
   if (grid != Grid::Hash && grid != Grid::Contact) {
     next_ = next_contact_ = 0;
     return 0;
@@ -29,12 +36,11 @@ uint32_t HashGrids::record(Grid grid, glm::uvec4 full) {
 }
 
 bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& hash_grids, const ComputePipeline& p,
-                     Grid grid, uint32_t count, const void* push, uint32_t push_size) {
+                     Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t sweep) {
   if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
-  if ((grid == Grid::Threads || grid == Grid::Contact || grid == Grid::Walk || grid == Grid::Cross) && count == 0)
-    return false;
+  if (grid != Grid::Workgroup && grid != Grid::Compaction && grid != Grid::Hash && count == 0) return false;
   const glm::uvec4 full = fullGrid(p, count);
-  const uint32_t hash_dispatch = hash_grids.record(grid, full);
+  const uint32_t hash_dispatch = hash_grids.record(grid, full, sweep);
   if (bound != p.pipeline) {
     vkCmdBindPipeline(t.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
     bound = p.pipeline;
@@ -52,7 +58,10 @@ bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& has
     break;
   case Grid::Hash:
   case Grid::Contact:
-    // The live arguments candidates_decide (contact_arm) copied from the full grids, or zero workgroups
+  case Grid::Settle:
+  case Grid::Sweep:
+    // The live arguments candidates_decide (contact_arm, the settle's passes) copied from the full
+    // grids, or zero workgroups
     vkCmdDispatchIndirect(t.cmd, t.hash_args, t.hash_offset + 16ull * hash_dispatch);
     break;
   case Grid::Walk:
@@ -247,16 +256,23 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
     record(sink, p, d.grid, flags, SimPush{sizes.contact_active, flags, s, 0}, s, d.gate);
     break;
   }
-  case Elements::SWEEPS:
-    // Each sweep, the colours with structural edges (shortensColour), a barrier after each
+  case Elements::SWEEPS: {
+    // Each sweep, the colours with structural edges (shortensColour), a barrier after each; every
+    // colour's dispatch has the largest one's grid (a sweep's indirect arguments are one slot)
+    auto edges = [&](uint32_t c) {
+      const ColorRange& range = topo.colors[c];
+      return range.count > 0 && shortensColour(topo.constraints[range.first].kind_id) ? range.count : 0u;
+    };
+    uint32_t largest = 0;
+    for (uint32_t c = 0; c < topo.colorCount(); ++c) largest = std::max(largest, edges(c));
     for (uint32_t sweep = 0; sweep < sweeps; ++sweep)
       for (uint32_t c = 0; c < topo.colorCount(); ++c) {
-        const ColorRange& range = topo.colors[c];
-        if (range.count == 0 || !shortensColour(topo.constraints[range.first].kind_id)) continue;
-        record(sink, p, d.grid, range.count, SimPush{sweep, range.count, s, c}, s, d.gate, sweep);
+        if (edges(c) == 0) continue;
+        record(sink, p, d.grid, largest, SimPush{sweep, edges(c), s, c}, s, d.gate, sweep);
         sink.barrier();
       }
     return;
+  }
   default: // wholeCount's and scanRange's rows, recorded above
     return;
   }

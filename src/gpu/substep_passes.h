@@ -3,6 +3,7 @@
 /// SIM_DISPATCHES, shaders/shared/sim_passes.h), recorded into a PassSink: the GPU solver dispatches them for its
 /// sheet; a fleet dispatches each for every sheet of a batch, and its gate (SIM_GATE_* in sim_config.h) picks the
 /// sheets that run it, those that would run it alone.
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -15,9 +16,11 @@ namespace tender::gpu {
 /// How a dispatch gets its grid: from the element count, one workgroup, the tear compaction's
 /// arguments (zero workgroups unless something tore), the next live hash-pass argument (zero
 /// workgroups when the candidate lists stand in for the hash), the next live argument of
-/// contact's grid passes (zero workgroups in a substep that does not build the grid), or
-/// contact_walk's (the queries with pairs in their lists; none in a substep that builds them).
-enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash, Contact, Walk, Cross };
+/// contact's grid passes (zero workgroups in a substep that does not build the grid),
+/// contact_walk's (the queries with pairs in their lists; none in a substep that builds them),
+/// contact_cross's, or the settle stage's: its half-spaces' passes (Settle) and each sweep's
+/// (Sweep), zero workgroups until an edge over the limit (or the sweep before) arms them.
+enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash, Contact, Walk, Cross, Settle, Sweep };
 
 /// Timestamp categories of a tick, in Solver::passTimes() order (SIM_DISPATCHES' category column
 /// names the first six). kFused: the fused small-sheet tick, every pass in one dispatch.
@@ -45,21 +48,25 @@ class HashGrids {
 public:
   /// A pass of grid `grid` is recorded. A hash (or contact grid) pass of full grid `full` is the
   /// next dispatch of its kind and returns the slot of its live argument in SIM_BIND_HASH_ARGS
-  /// (its grid checked against earlier substeps'); any other pass makes the next of each kind the
-  /// first.
-  uint32_t record(Grid grid, glm::uvec4 full);
+  /// (its grid checked against earlier substeps'); a settle pass returns its slot there (sweep
+  /// `sweep`'s for Grid::Sweep); any other pass makes the next of each kind the first.
+  uint32_t record(Grid grid, glm::uvec4 full, uint32_t sweep = 0);
   /// The hash passes' full grids (from slot SIM_HASH_DISPATCHES)
   const std::vector<glm::uvec4>& grids() const { return grids_; }
   /// Contact's grid passes' full grids (from slot SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES)
   const std::vector<glm::uvec4>& contactGrids() const { return contact_grids_; }
+  /// The settle's full grids: its half-spaces' passes and a sweep's (from SIM_CONTACT_SETTLE_FULL)
+  const std::array<glm::uvec4, 2>& settleGrids() const { return settle_grids_; }
   void clear() {
     grids_.clear();
     contact_grids_.clear();
+    settle_grids_ = {};
     next_ = next_contact_ = 0;
   }
 
 private:
   std::vector<glm::uvec4> grids_, contact_grids_;
+  std::array<glm::uvec4, 2> settle_grids_{};
   uint32_t next_ = 0, next_contact_ = 0;
 };
 
@@ -75,10 +82,10 @@ struct SheetPassTarget {
 
 /// Records a pass of one sheet on its descriptor set, as the solver dispatches it: `count`
 /// elements (Grid::Threads; none: nothing recorded), one workgroup, the compaction's indirect
-/// arguments, or the next hash dispatch's live arguments. `bound` is the pipeline bound on `t.cmd`.
-/// Returns false when nothing was recorded.
+/// arguments, or the next hash dispatch's live arguments (settle sweep `sweep`'s for Grid::Sweep).
+/// `bound` is the pipeline bound on `t.cmd`. Returns false when nothing was recorded.
 bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& hash_grids, const ComputePipeline& p,
-                     Grid grid, uint32_t count, const void* push, uint32_t push_size);
+                     Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t sweep = 0);
 
 /// Where the passes of a substep go.
 class PassSink {

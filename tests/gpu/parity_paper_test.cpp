@@ -367,5 +367,27 @@ TEST_F(Parity, TheSettleIsTheSameOnTheGpu) {
     const SimState gpu_end = run(g, kTicks);
     EXPECT_EQ(gpu.usesFusedPath(g.lastUniforms()), way.fused) << way.name;
     EXPECT_TRUE(sameState(cpu_end, gpu_end)) << way.name;
+    if (way.fused) continue;
+    // The per-colour passes dispatch the settle's passes indirectly: in the last substep the
+    // half-spaces' passes ran (slot 0) while an edge was over the limit, a sweep only after the one
+    // before it, and none past the key's; a sheet hanging at rest runs none of them.
+    auto armed = [&](gpu::GpuSolver& solver) {
+      std::vector<glm::uvec4> args(SIM_SHEET_ARGS);
+      solver.context().download(solver.buffer(SIM_BIND_HASH_ARGS), args.data(), 16ull * args.size());
+      std::vector<bool> slots;
+      for (uint32_t k = 0; k < SIM_CONTACT_SETTLE_SLOTS; ++k) slots.push_back(args[SIM_CONTACT_SETTLE_ARGS + k].x > 0);
+      return slots;
+    };
+    const std::vector<bool> fist = armed(gpu);
+    EXPECT_TRUE(fist[0] && fist[1]) << "the fist's last substep starts the settle";
+    for (uint32_t k = 1; k < SIM_CONTACT_SETTLE_SLOTS; ++k)
+      EXPECT_TRUE(!fist[k] || (fist[k - 1] && k <= p.contact_settle)) << "sweep " << k - 1;
+    const SimParams hanging =
+        preset("crumple", {"cols=12", "rows=16", "contact_factor=0.5", "collision=off", "contact_settle=4"});
+    gpu::GpuSolver still(ctx(), gpu::FusedShape{0, 0, 0.0f, way.contact});
+    still.setFusedPath(false);
+    Simulation h(hanging, still);
+    run(h, 2);
+    for (bool slot : armed(still)) EXPECT_FALSE(slot) << "a hanging sheet's settle";
   }
 }
