@@ -218,7 +218,7 @@ void GpuBatch::finish() {
 void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
                     uint32_t substep, uint32_t gate, uint32_t gate_arg) {
   if (pass_sheet_ >= 0) {
-    passOfSheet(uint32_t(pass_sheet_), p, grid, count, push, push_size, grid == Grid::Sweep ? gate_arg : 0);
+    passOfSheet(uint32_t(pass_sheet_), p, grid, count, push, push_size, gate_arg);
     return;
   }
   if (push_size > sizeof(SimPush) || p.push_size != sizeof(BatchPassPush))
@@ -230,7 +230,7 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
                        grid == Grid::Sweep;
   if ((counted || grid == Grid::Walk || grid == Grid::Cross) && count == 0) return;
   const glm::uvec4 full = fullGrid(p, counted ? count : 1u, pass_sheets_);
-  const uint32_t hash_dispatch = hash_grids_.record(grid, full, grid == Grid::Sweep ? gate_arg : 0);
+  const uint32_t hash_dispatch = hash_grids_.record(grid, full, gate_arg);
   BatchPassPush bp{};
   if (push_size) std::memcpy(&bp.pass, push, push_size);
   const VkDeviceAddress table = table_address_;
@@ -280,14 +280,14 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
 }
 
 void GpuBatch::passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
-                           uint32_t push_size, uint32_t sweep) {
+                           uint32_t push_size, uint32_t gate_arg) {
   const SheetPassTarget target{cmd_,
                                sheet_layout_,
                                buf_[SIM_BIND_HASH_ARGS].buffer,
                                sliceOffset(SIM_BIND_HASH_ARGS, i),
                                buf_[SIM_BIND_COUNTERS].buffer,
                                sliceOffset(SIM_BIND_COUNTERS, i)};
-  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size, sweep)) ++last_dispatches_;
+  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size, gate_arg)) ++last_dispatches_;
 }
 
 void GpuBatch::barrier() { computeToCompute(cmd_); }

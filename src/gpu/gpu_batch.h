@@ -96,7 +96,7 @@ private:
             uint32_t gate, uint32_t gate_arg) override;
   /// PerSheet: a pass of sheet i on its descriptor set (bound), as the solver dispatches it.
   void passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
-                   uint32_t push_size, uint32_t sweep);
+                   uint32_t push_size, uint32_t gate_arg);
   void barrier() override;
   void mark(PassCategory) override {}
   /// Allocates every buffer for the batch from the first sheet's topology.

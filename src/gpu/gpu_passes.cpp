@@ -16,9 +16,9 @@ void GpuSolver::bindSet(VkCommandBuffer cmd, uint32_t uniform_index) {
 }
 
 void GpuSolver::dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
-                         uint32_t push_size, uint32_t sweep) {
+                         uint32_t push_size, uint32_t gate_arg) {
   const SheetPassTarget target{cmd, layout_, buf_[SIM_BIND_HASH_ARGS].buffer, 0, buf_[SIM_BIND_COUNTERS].buffer, 0};
-  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size, sweep)) ++recorded_dispatches_;
+  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size, gate_arg)) ++recorded_dispatches_;
 }
 
 void GpuSolver::timestamp(VkCommandBuffer cmd, InFlight& flight, PassCategory c) {
@@ -32,8 +32,8 @@ void GpuSolver::timestamp(VkCommandBuffer cmd, InFlight& flight, PassCategory c)
 
 void GpuSolver::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
                      uint32_t, uint32_t, uint32_t gate_arg) {
-  // One sheet: it runs every pass recorded for it (a settle sweep's gate_arg is the sweep)
-  dispatch(recording_->tick, p, grid, count, push, push_size, grid == Grid::Sweep ? gate_arg : 0);
+  // One sheet: it runs every pass recorded for it
+  dispatch(recording_->tick, p, grid, count, push, push_size, gate_arg);
 }
 
 void GpuSolver::barrier() { computeToCompute(recording_->tick); }

@@ -171,9 +171,9 @@ private:
   /// The one dispatch helper: binds the pipeline, checks and pushes the constants, and dispatches
   /// `count` elements (Threads), one workgroup (Workgroup), or the grid of an indirect argument
   /// (Compaction, Hash: the next hash dispatch's live arguments, whose full grid candidates_decide copies in;
-  /// Sweep: settle sweep `sweep`'s).
+  /// Sweep: those of the settle sweep `gate_arg` names).
   void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
-                uint32_t push_size, uint32_t sweep = 0);
+                uint32_t push_size, uint32_t gate_arg = 0);
   template <class Push>
   void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const Push& push) {
     dispatch(cmd, p, grid, count, &push, uint32_t(sizeof(Push)));

@@ -12,14 +12,14 @@ glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets) {
   return glm::uvec4(groupGrid((count + p.workgroup - 1) / p.workgroup), sheets, 0u);
 }
 
-uint32_t HashGrids::record(Grid grid, glm::uvec4 full, uint32_t sweep) {
+uint32_t HashGrids::record(Grid grid, glm::uvec4 full, uint32_t gate_arg) {
   if (grid == Grid::Cross) return 0;                 // its own slot, amid the contact grid's passes
   if (grid == Grid::Settle || grid == Grid::Sweep) { // a slot of the settle's, one full grid each kind
     glm::uvec4& grids = settle_grids_[grid == Grid::Sweep ? 1 : 0];
     if (grids == glm::uvec4(0u)) grids = full;
-    if (grids != full || sweep >= SIM_SETTLE_MAX_SWEEPS)
+    if (grids != full || gate_arg >= SIM_SETTLE_MAX_SWEEPS)
       vkCheckFailed(VK_ERROR_UNKNOWN, "settle grid", __FILE__, __LINE__);
-    return SIM_CONTACT_SETTLE_ARGS + (grid == Grid::Sweep ? 1 + sweep : 0);
+    return SIM_CONTACT_SETTLE_ARGS + (grid == Grid::Sweep ? 1 + gate_arg : 0);
   }
   if (grid != Grid::Hash && grid != Grid::Contact) {
     next_ = next_contact_ = 0;
@@ -36,11 +36,11 @@ uint32_t HashGrids::record(Grid grid, glm::uvec4 full, uint32_t sweep) {
 }
 
 bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& hash_grids, const ComputePipeline& p,
-                     Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t sweep) {
+                     Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t gate_arg) {
   if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
   if (grid != Grid::Workgroup && grid != Grid::Compaction && grid != Grid::Hash && count == 0) return false;
   const glm::uvec4 full = fullGrid(p, count);
-  const uint32_t hash_dispatch = hash_grids.record(grid, full, sweep);
+  const uint32_t hash_dispatch = hash_grids.record(grid, full, gate_arg);
   if (bound != p.pipeline) {
     vkCmdBindPipeline(t.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
     bound = p.pipeline;

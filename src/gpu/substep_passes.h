@@ -48,9 +48,10 @@ class HashGrids {
 public:
   /// A pass of grid `grid` is recorded. A hash (or contact grid) pass of full grid `full` is the
   /// next dispatch of its kind and returns the slot of its live argument in SIM_BIND_HASH_ARGS
-  /// (its grid checked against earlier substeps'); a settle pass returns its slot there (sweep
-  /// `sweep`'s for Grid::Sweep); any other pass makes the next of each kind the first.
-  uint32_t record(Grid grid, glm::uvec4 full, uint32_t sweep = 0);
+  /// (its grid checked against earlier substeps'); a settle pass returns its slot there (for
+  /// Grid::Sweep the sweep `gate_arg` names, as for a fleet's gate); any other pass makes the next
+  /// of each kind the first.
+  uint32_t record(Grid grid, glm::uvec4 full, uint32_t gate_arg = 0);
   /// The hash passes' full grids (from slot SIM_HASH_DISPATCHES)
   const std::vector<glm::uvec4>& grids() const { return grids_; }
   /// Contact's grid passes' full grids (from slot SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES)
@@ -82,10 +83,11 @@ struct SheetPassTarget {
 
 /// Records a pass of one sheet on its descriptor set, as the solver dispatches it: `count`
 /// elements (Grid::Threads; none: nothing recorded), one workgroup, the compaction's indirect
-/// arguments, or the next hash dispatch's live arguments (settle sweep `sweep`'s for Grid::Sweep).
-/// `bound` is the pipeline bound on `t.cmd`. Returns false when nothing was recorded.
+/// arguments, or the next hash dispatch's live arguments (Grid::Sweep: those of the settle sweep
+/// `gate_arg` names). `bound` is the pipeline bound on `t.cmd`. Returns false when nothing was
+/// recorded.
 bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& hash_grids, const ComputePipeline& p,
-                     Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t sweep = 0);
+                     Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t gate_arg = 0);
 
 /// Where the passes of a substep go.
 class PassSink {
