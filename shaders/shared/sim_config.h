@@ -118,12 +118,13 @@
 #define SIM_BATCH_ENTRIES 35
 // Contact's passes alike: the full grids of its grid's passes, then per substep the live ones of
 // its grid's passes (contact_arm raises them to the full grid's x when a sheet builds its grid),
-// of contact_walk and of contact_cross (each sheet raises them to its own grid's x and y)
+// of contact_walk, of contact_cross and of the named queries (Grid::Named; each sheet raises them to
+// its own grid's x and y, the named ones again when contact_emit names them anew)
 #define SIM_BATCH_ARGS_FULL_COMPACT SIM_HASH_DISPATCHES
 #define SIM_BATCH_ARGS_LIVE_HASH (SIM_BATCH_ARGS_FULL_COMPACT + 1u)
 #define SIM_BATCH_ARGS_LIVE_COMPACT (SIM_BATCH_ARGS_LIVE_HASH + SIM_MAX_SUBSTEPS * SIM_HASH_DISPATCHES)
 #define SIM_BATCH_ARGS_FULL_CONTACT (SIM_BATCH_ARGS_LIVE_COMPACT + SIM_MAX_SUBSTEPS)
-#define SIM_BATCH_CONTACT_SLOTS (SIM_CONTACT_GRID_DISPATCHES + 2u)
+#define SIM_BATCH_CONTACT_SLOTS (SIM_CONTACT_GRID_DISPATCHES + 3u)
 #define SIM_BATCH_ARGS_LIVE_CONTACT (SIM_BATCH_ARGS_FULL_CONTACT + SIM_CONTACT_GRID_DISPATCHES)
 // The settle stage's alike: its two full grids, then per substep its live arguments (slots as in
 // SIM_BIND_HASH_ARGS, SIM_CONTACT_SETTLE_ARGS; a sheet raises x where it would arm its own)
@@ -246,7 +247,8 @@
 #define SIM_CONTACT_GRID_DISPATCHES 24u
 #define SIM_CONTACT_GRID_ARGS (2u * SIM_HASH_DISPATCHES)
 // ... then contact_walk's live arguments (w: the queries it walks), then those contact_emit wrote at
-// the last build of the lists
+// the last build of the lists (Grid::Named: every query with pairs in its list, which
+// contact_pass, contact_excess and contact_share take; the walk those within their slots)
 #define SIM_CONTACT_WALK_ARGS (SIM_CONTACT_GRID_ARGS + 2u * SIM_CONTACT_GRID_DISPATCHES)
 // ... then contact_cross's live arguments (contact_arm: every triangle, or none)
 #define SIM_CONTACT_CROSS_ARGS (SIM_CONTACT_WALK_ARGS + 2u)

@@ -110,7 +110,8 @@
 //             none in a substep that does not build the grid), Walk (contact_walk's, over the
 //             queries with pairs in their lists: none in a substep that builds them), Cross
 //             (contact_cross's, over the triangles: none in a substep whose crossing check looks
-//             at no triangle), Settle (the settle's half-spaces' passes: none in a substep with no
+//             at no triangle), Named (the queries with pairs in their lists, contact_emit's, as the
+//             elements' first slots), Settle (the settle's half-spaces' passes: none in a substep with no
 //             edge over the limit), Sweep (a settle sweep's, each colour's grid that of the largest:
 //             none after a sweep that moved nothing) or
 //             Compaction (the tear compaction's arguments): gpu::Grid
@@ -152,9 +153,9 @@
   X(limit, limit, RINGS, Threads, LIMIT, LIMIT, Project)                                                               \
   X(crease, crease, HINGES, Threads, CREASE, CREASE, Project)                                                          \
   X(floor, floor, PARTICLES, Threads, TICK, ALWAYS, Floor)                                                             \
-  X(floor, contact_pass, CONTACT_QUERIES, Threads, CONTACT, CONTACT, Floor)                                            \
-  X(floor, contact_excess, CONTACT_QUERIES, Threads, CONTACT, CONTACT, Floor)                                          \
-  X(floor, contact_share, CONTACT_QUERIES, Threads, CONTACT, CONTACT, Floor)                                           \
+  X(floor, contact_pass, CONTACT_QUERIES, Named, CONTACT, CONTACT, Floor)                                              \
+  X(floor, contact_excess, CONTACT_QUERIES, Named, CONTACT, CONTACT, Floor)                                            \
+  X(floor, contact_share, CONTACT_QUERIES, Named, CONTACT, CONTACT, Floor)                                             \
   X(floor, contact_step, PARTICLES, Threads, CONTACT, CONTACT, Floor)                                                  \
   X(settle, contact_settle_check, CONSTRAINTS, Threads, SETTLE, SETTLE, Floor)                                         \
   X(settle, contact_half_count, CONTACT_QUERIES, Settle, SETTLE, SETTLE, Floor)                                        \

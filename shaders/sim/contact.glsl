@@ -44,12 +44,13 @@ void contactCross(uint t, uint s) {
 
 // Which queries contactNear takes: all (the fused tick), those that search the grid (contact_near:
 // the lists are built, or theirs overflowed) or those that walk their lists (contact_walk, over the
-// queries contactActive names)
+// named queries within their slots: contactWalks)
 #define NEAR_ALL 0u
 #define NEAR_SEARCH 1u
 #define NEAR_WALK 2u
 // ... or every query's pairs at the start of the substep again, through its list or (overflowed)
-// the grid, for the half-spaces of the steps (contact_pass, contact_excess, contact_share: slidePair)
+// the grid, for the half-spaces of the steps (contact_pass, contact_excess, contact_share, over the
+// named queries, those with pairs: slidePair)
 #define NEAR_PASS 3u
 #define NEAR_EXCESS 4u
 #define NEAR_SHARE 5u
@@ -261,28 +262,37 @@ void contactNear(uint k, uint only) {
     contactNearOf(k, only, false);
 }
 
-// Where the queries that walk their lists are named, after the boxes (contact_emit)
+// Where the queries with pairs in their lists are named, after the boxes (contact_emit)
 uint activeWord() { return contactBoxWord(u.triangle_count + contactEdgeCount()); }
-// True when query k has pairs in its list, all in its slots (contact_walk walks it until the next build)
-bool contactActive(uint k) {
-  uint count = contact_lists[listOf(k)];
-  return count > 0u && count <= contactChecks().w;
-}
+// True when query k has pairs in its list (it is named until the next build)
+bool contactActive(uint k) { return contact_lists[listOf(k)] > 0u; }
+// True when query k has pairs in its list, all in its slots (contact_walk walks it until the next
+// build; one whose list overflowed searches the grid every substep, contact_near)
+bool contactWalks(uint k) { return contact_lists[listOf(k)] <= contactChecks().w; }
 
-// contact_active: query k's flag, 1 when it walks its list (the end, k = queries: 0), at scratch
-// offset `flags` (scanned in place next)
+// contact_active: query k's flag, 1 when it has pairs in its list (the end, k = queries: 0), at
+// scratch offset `flags` (scanned in place next)
 void contactActiveFlag(uint k, uint flags) {
   scratch[flags + k] = k < u.particle_count + contactEdgeCount() && !contactGoneWrong() && contactActive(k) ? 1u : 0u;
 }
 
 // contact_emit: active query k named at its place (the flags' scan); the end (k = queries) says how
-// many there are, in contact_walk's arguments for the substeps until the next build
+// many there are, in the named queries' arguments (Grid::Named) for the substeps until the next
+// build, which contact_walk's copy (contact_arm)
 void contactEmit(uint k, uint flags) {
   uint queries = u.particle_count + contactEdgeCount();
   if (k == queries) {
-    uint walkers = scratch[flags + queries];
-    hash_args[SIM_CONTACT_WALK_ARGS + 1u] =
-        uvec4(groupGrid((walkers + SIM_WG_PARTICLES - 1u) / SIM_WG_PARTICLES), 1u, walkers);
+    uint named = scratch[flags + queries];
+    uvec4 args = uvec4(groupGrid((named + SIM_WG_PARTICLES - 1u) / SIM_WG_PARTICLES), 1u, named);
+    hash_args[SIM_CONTACT_WALK_ARGS + 1u] = args;
+#ifdef SIM_BATCH_PASS
+    // A fleet: the batch's named queries of this substep cover this sheet's anew
+    UintRef batch_args = UintRef(batchSlice(SIM_BATCH_ARGS, 0u));
+    uint slot =
+        4u * (SIM_BATCH_ARGS_LIVE_CONTACT + batch.substep * SIM_BATCH_CONTACT_SLOTS + SIM_CONTACT_GRID_DISPATCHES + 2u);
+    atomicMax(batch_args.v[slot], args.x);
+    atomicMax(batch_args.v[slot + 1u], args.y);
+#endif
     // Named for this build (contact_bound counts it after the walk)
     if (listsRebuilt()) contact_lists[listHeader() + LIST_NAMED] = contact_lists[listHeader() + LIST_BUILDS] + 1u;
   } else if (k < queries && !contactGoneWrong() && contactActive(k)) {
@@ -290,9 +300,15 @@ void contactEmit(uint k, uint flags) {
   }
 }
 
-// contact_walk: the j-th query that walks its list
+// The j-th named query (Grid::Named), or SIM_NONE past them
+uint namedQuery(uint j) {
+  return j < hash_args[SIM_CONTACT_WALK_ARGS + 1u].w ? contact_words[activeWord() + j] : SIM_NONE;
+}
+
+// contact_walk: the j-th named query, when it walks its list
 void contactWalk(uint j) {
-  if (j < walkArgs().w) contactNear(contact_words[activeWord() + j], NEAR_WALK);
+  uint k = j < walkArgs().w ? contact_words[activeWord() + j] : SIM_NONE;
+  if (k != SIM_NONE && contactWalks(k)) contactNear(k, NEAR_WALK);
 }
 
 // contact_bound: particle i's step bound (stepBound; unbounded when free) and push

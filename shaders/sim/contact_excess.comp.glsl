@@ -8,6 +8,6 @@
 #include "sim_common.glsl"
 
 void main() {
-  uint k = threadIndex();
-  if (k < p.count) contactNear(k, NEAR_EXCESS);
+  uint k = namedQuery(threadIndex()); // the queries with pairs (Grid::Named)
+  if (k != SIM_NONE) contactNear(k, NEAR_EXCESS);
 }

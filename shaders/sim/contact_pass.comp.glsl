@@ -9,6 +9,6 @@
 #include "sim_common.glsl"
 
 void main() {
-  uint k = threadIndex();
-  if (k < p.count) contactNear(k, NEAR_PASS);
+  uint k = namedQuery(threadIndex()); // the queries with pairs (Grid::Named)
+  if (k != SIM_NONE) contactNear(k, NEAR_PASS);
 }

@@ -228,7 +228,7 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
   // the sheets that need them arm (the gates skip the other sheets).
   const bool counted = grid == Grid::Threads || grid == Grid::Hash || grid == Grid::Contact || grid == Grid::Settle ||
                        grid == Grid::Sweep;
-  if ((counted || grid == Grid::Walk || grid == Grid::Cross) && count == 0) return;
+  if ((counted || grid == Grid::Walk || grid == Grid::Cross || grid == Grid::Named) && count == 0) return;
   const glm::uvec4 full = fullGrid(p, counted ? count : 1u, pass_sheets_);
   const uint32_t hash_dispatch = hash_grids_.record(grid, full, gate_arg);
   BatchPassPush bp{};
@@ -260,11 +260,14 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
     break;
   case Grid::Contact:
   case Grid::Walk:
-  case Grid::Cross: {
-    // Contact's: its grid's pass k (hash_dispatch names the sheet's own slot), contact_walk, contact_cross
+  case Grid::Cross:
+  case Grid::Named: {
+    // Contact's: its grid's pass k (hash_dispatch names the sheet's own slot), contact_walk,
+    // contact_cross, the named queries
     const uint32_t slot = grid == Grid::Contact ? hash_dispatch - SIM_CONTACT_GRID_ARGS
                           : grid == Grid::Walk  ? SIM_CONTACT_GRID_DISPATCHES
-                                                : SIM_CONTACT_GRID_DISPATCHES + 1;
+                          : grid == Grid::Cross ? SIM_CONTACT_GRID_DISPATCHES + 1
+                                                : SIM_CONTACT_GRID_DISPATCHES + 2;
     vkCmdDispatchIndirect(cmd_, buf_[SIM_BATCH_ARGS].buffer,
                           16ull * (SIM_BATCH_ARGS_LIVE_CONTACT + substep * SIM_BATCH_CONTACT_SLOTS + slot));
     break;

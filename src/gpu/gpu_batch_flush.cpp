@@ -184,12 +184,12 @@ void GpuBatch::recordBatchedPasses(const FlushQueue& f) {
     for (uint32_t k = 0; k < SIM_HASH_DISPATCHES; ++k)
       args[SIM_BATCH_ARGS_LIVE_HASH + s * SIM_HASH_DISPATCHES + k] = glm::uvec4(0, args[k].y, pass_sheets_, 0);
     args[SIM_BATCH_ARGS_LIVE_COMPACT + s] = glm::uvec4(0, args[SIM_BATCH_ARGS_FULL_COMPACT].y, pass_sheets_, 0);
-    // Contact's grid passes, then contact_walk's and contact_cross's (each sheet raises x and y)
+    // Contact's grid passes, then contact_walk's, contact_cross's and the named queries' (each sheet
+    // raises x and y)
     const uint32_t live = SIM_BATCH_ARGS_LIVE_CONTACT + s * SIM_BATCH_CONTACT_SLOTS;
     for (uint32_t k = 0; k < SIM_CONTACT_GRID_DISPATCHES; ++k)
       args[live + k] = glm::uvec4(0, args[SIM_BATCH_ARGS_FULL_CONTACT + k].y, pass_sheets_, 0);
-    args[live + SIM_CONTACT_GRID_DISPATCHES] = args[live + SIM_CONTACT_GRID_DISPATCHES + 1] =
-        glm::uvec4(0, 0, pass_sheets_, 0);
+    for (uint32_t k = 0; k < 3; ++k) args[live + SIM_CONTACT_GRID_DISPATCHES + k] = glm::uvec4(0, 0, pass_sheets_, 0);
     // The settle's half-spaces' passes, then its sweeps (a sheet raises x where it arms its own)
     for (uint32_t k = 0; k < SIM_CONTACT_SETTLE_SLOTS; ++k)
       args[SIM_BATCH_ARGS_LIVE_SETTLE + s * SIM_CONTACT_SETTLE_SLOTS + k] =

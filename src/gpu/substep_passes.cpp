@@ -13,8 +13,8 @@ glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets) {
 }
 
 uint32_t HashGrids::record(Grid grid, glm::uvec4 full, uint32_t gate_arg) {
-  if (grid == Grid::Cross) return 0;                 // its own slot, amid the contact grid's passes
-  if (grid == Grid::Settle || grid == Grid::Sweep) { // a slot of the settle's, one full grid each kind
+  if (grid == Grid::Cross || grid == Grid::Named) return 0; // own slots, amid the contact grid's passes
+  if (grid == Grid::Settle || grid == Grid::Sweep) {        // a slot of the settle's, one full grid each kind
     glm::uvec4& grids = settle_grids_[grid == Grid::Sweep ? 1 : 0];
     if (grids == glm::uvec4(0u)) grids = full;
     if (grids != full || gate_arg >= SIM_SETTLE_MAX_SWEEPS)
@@ -71,6 +71,10 @@ bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& has
   case Grid::Cross:
     // Every triangle when the crossing check looks at one this substep, or none
     vkCmdDispatchIndirect(t.cmd, t.hash_args, t.hash_offset + 16ull * SIM_CONTACT_CROSS_ARGS);
+    break;
+  case Grid::Named:
+    // The queries with pairs in their lists (contact_emit)
+    vkCmdDispatchIndirect(t.cmd, t.hash_args, t.hash_offset + 16ull * (SIM_CONTACT_WALK_ARGS + 1));
     break;
   }
   return true;

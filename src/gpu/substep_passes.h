@@ -18,9 +18,10 @@ namespace tender::gpu {
 /// workgroups when the candidate lists stand in for the hash), the next live argument of
 /// contact's grid passes (zero workgroups in a substep that does not build the grid),
 /// contact_walk's (the queries with pairs in their lists; none in a substep that builds them),
-/// contact_cross's, or the settle stage's: its half-spaces' passes (Settle) and each sweep's
+/// contact_cross's, the queries with pairs in their lists (Named: contact_emit's, for the passes
+/// that weigh them again after the floor), or the settle stage's: its half-spaces' passes (Settle) and each sweep's
 /// (Sweep), zero workgroups until an edge over the limit (or the sweep before) arms them.
-enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash, Contact, Walk, Cross, Settle, Sweep };
+enum class Grid : uint8_t { Threads, Workgroup, Compaction, Hash, Contact, Walk, Cross, Named, Settle, Sweep };
 
 /// Timestamp categories of a tick, in Solver::passTimes() order (SIM_DISPATCHES' category column
 /// names the first six). kFused: the fused small-sheet tick, every pass in one dispatch.
