@@ -406,18 +406,25 @@ bool contactSettle(Constraint c, uint sweep, uint s) {
 #ifndef SIM_FUSED_CONTACT
 // The per-colour passes dispatch the settle's indirectly (Grid::Settle, Grid::Sweep): none of its
 // passes runs a workgroup in a substep that does not need it. contact_begin disarms every slot;
-// the edge that starts the stage arms slot 0 (the half-spaces' passes) and 1 (the first sweep), the
-// first edge a sweep works on arms the next sweep's. A sheet of a fleet raises the batch's slot.
+// the edge that starts the stage arms slot 0 (the half-spaces' passes, over the named queries:
+// namedQuery) and 1 (the first sweep), the first edge a sweep works on arms the next sweep's. A
+// sheet of a fleet raises the batch's slot.
 void disarmSettle() {
   for (uint k = 0u; k < SIM_CONTACT_SETTLE_SLOTS; ++k) hash_args[SIM_CONTACT_SETTLE_ARGS + k] = uvec4(0u, 1u, 1u, 0u);
 }
 void armSettle(uint slot) {
-  uint full = min(slot, 1u);
+  uvec4 named = hash_args[SIM_CONTACT_WALK_ARGS + 1u];
 #ifdef SIM_BATCH_PASS
-  batchArmArgs(SIM_BATCH_ARGS_LIVE_SETTLE + batch.substep * SIM_CONTACT_SETTLE_SLOTS + slot,
-               SIM_BATCH_ARGS_FULL_SETTLE + full);
+  uint live = SIM_BATCH_ARGS_LIVE_SETTLE + batch.substep * SIM_CONTACT_SETTLE_SLOTS + slot;
+  if (slot > 0u) {
+    batchArmArgs(live, SIM_BATCH_ARGS_FULL_SETTLE + 1u);
+  } else {
+    UintRef args = UintRef(batchSlice(SIM_BATCH_ARGS, 0u));
+    atomicMax(args.v[4u * live], named.x);
+    atomicMax(args.v[4u * live + 1u], named.y);
+  }
 #else
-  hash_args[SIM_CONTACT_SETTLE_ARGS + slot] = hash_args[SIM_CONTACT_SETTLE_FULL + full];
+  hash_args[SIM_CONTACT_SETTLE_ARGS + slot] = slot > 0u ? hash_args[SIM_CONTACT_SETTLE_FULL + 1u] : named;
 #endif
 }
 #endif

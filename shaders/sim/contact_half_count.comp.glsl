@@ -8,6 +8,6 @@
 #include "sim_common.glsl"
 
 void main() {
-  uint k = threadIndex();
-  if (k < p.count && contactChecks().y > 0u && settleStarts()) contactNear(k, NEAR_HALF_COUNT);
+  uint k = namedQuery(threadIndex()); // the queries with pairs (armed as Grid::Named's)
+  if (k != SIM_NONE && contactChecks().y > 0u && settleStarts()) contactNear(k, NEAR_HALF_COUNT);
 }

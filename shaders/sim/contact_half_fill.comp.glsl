@@ -9,6 +9,6 @@
 #include "sim_common.glsl"
 
 void main() {
-  uint k = threadIndex();
-  if (k < p.count && contactChecks().y > 0u && settleStarts()) contactNear(k, NEAR_HALF_FILL);
+  uint k = namedQuery(threadIndex()); // the queries with pairs (armed as Grid::Named's)
+  if (k != SIM_NONE && contactChecks().y > 0u && settleStarts()) contactNear(k, NEAR_HALF_FILL);
 }
