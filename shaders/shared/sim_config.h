@@ -126,10 +126,10 @@
 #define SIM_BATCH_ARGS_FULL_CONTACT (SIM_BATCH_ARGS_LIVE_COMPACT + SIM_MAX_SUBSTEPS)
 #define SIM_BATCH_CONTACT_SLOTS (SIM_CONTACT_GRID_DISPATCHES + 3u)
 #define SIM_BATCH_ARGS_LIVE_CONTACT (SIM_BATCH_ARGS_FULL_CONTACT + SIM_CONTACT_GRID_DISPATCHES)
-// The settle stage's alike: its two full grids, then per substep its live arguments (slots as in
-// SIM_BIND_HASH_ARGS, SIM_CONTACT_SETTLE_ARGS; a sheet raises x where it would arm its own)
+// The settle stage's alike: a sweep's full grid, then per substep its live arguments (slots as in
+// SIM_BIND_HASH_ARGS, SIM_CONTACT_SETTLE_ARGS; a sheet raises them where it would arm its own)
 #define SIM_BATCH_ARGS_FULL_SETTLE (SIM_BATCH_ARGS_LIVE_CONTACT + SIM_MAX_SUBSTEPS * SIM_BATCH_CONTACT_SLOTS)
-#define SIM_BATCH_ARGS_LIVE_SETTLE (SIM_BATCH_ARGS_FULL_SETTLE + 2u)
+#define SIM_BATCH_ARGS_LIVE_SETTLE (SIM_BATCH_ARGS_FULL_SETTLE + 1u)
 #define SIM_BATCH_ARGS_COUNT (SIM_BATCH_ARGS_LIVE_SETTLE + SIM_MAX_SUBSTEPS * SIM_CONTACT_SETTLE_SLOTS)
 // Which sheets of a batch a per-colour pass runs for (BatchArgs.gate). The batch records the
 // passes of its most substeps and iterations, with air and collision when any sheet has them; a
@@ -253,14 +253,14 @@
 // ... then contact_cross's live arguments (contact_arm: every triangle, or none)
 #define SIM_CONTACT_CROSS_ARGS (SIM_CONTACT_WALK_ARGS + 2u)
 // ... then the settle stage's live arguments (SIM_CONTACT_SETTLE_SLOTS): slot 0 its half-spaces'
-// passes (Grid::Settle), slot 1 + k its sweep k (Grid::Sweep), none until contact_settle_check
-// finds an edge over the limit (slots 0 and 1) or sweep k - 1 moves one (slot 1 + k); then their
-// two full grids (SIM_CONTACT_SETTLE_FULL: the half-spaces' passes, a sweep's)
+// passes (Grid::Settle: the named queries' grid), slot 1 + k its sweep k (Grid::Sweep), none until
+// contact_settle_check finds an edge over the limit (slots 0 and 1) or sweep k - 1 moves one (slot
+// 1 + k); then a sweep's full grid (SIM_CONTACT_SETTLE_FULL)
 #define SIM_CONTACT_SETTLE_ARGS (SIM_CONTACT_CROSS_ARGS + 1u)
 #define SIM_CONTACT_SETTLE_SLOTS (SIM_SETTLE_MAX_SWEEPS + 1u)
 #define SIM_CONTACT_SETTLE_FULL (SIM_CONTACT_SETTLE_ARGS + SIM_CONTACT_SETTLE_SLOTS)
 // The uvec4 of SIM_BIND_HASH_ARGS
-#define SIM_SHEET_ARGS (SIM_CONTACT_SETTLE_FULL + 2u)
+#define SIM_SHEET_ARGS (SIM_CONTACT_SETTLE_FULL + 1u)
 
 // Penetration-free contact (contact.h): the part of the distance to its nearest primitive a particle
 // may move in a substep; below 1/2, with room for rounding

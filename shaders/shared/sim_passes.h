@@ -110,9 +110,9 @@
 //             none in a substep that does not build the grid), Walk (contact_walk's, over the
 //             queries with pairs in their lists: none in a substep that builds them), Cross
 //             (contact_cross's, over the triangles: none in a substep whose crossing check looks
-//             at no triangle), Named (the queries with pairs in their lists, contact_emit's, as the
-//             elements' first slots), Settle (the settle's half-spaces' passes: none in a substep with no
-//             edge over the limit), Sweep (a settle sweep's, each colour's grid that of the largest:
+//             at no triangle), Named (contact_emit's: the queries with pairs in their lists),
+//             Settle (the settle's half-spaces' passes: the named queries' grid, none in a substep
+//             with no edge over the limit), Sweep (a settle sweep's, each colour's grid that of the largest:
 //             none after a sweep that moved nothing) or
 //             Compaction (the tear compaction's arguments): gpu::Grid
 //   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)

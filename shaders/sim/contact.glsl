@@ -417,14 +417,14 @@ void armSettle(uint slot) {
 #ifdef SIM_BATCH_PASS
   uint live = SIM_BATCH_ARGS_LIVE_SETTLE + batch.substep * SIM_CONTACT_SETTLE_SLOTS + slot;
   if (slot > 0u) {
-    batchArmArgs(live, SIM_BATCH_ARGS_FULL_SETTLE + 1u);
+    batchArmArgs(live, SIM_BATCH_ARGS_FULL_SETTLE);
   } else {
     UintRef args = UintRef(batchSlice(SIM_BATCH_ARGS, 0u));
     atomicMax(args.v[4u * live], named.x);
     atomicMax(args.v[4u * live + 1u], named.y);
   }
 #else
-  hash_args[SIM_CONTACT_SETTLE_ARGS + slot] = slot > 0u ? hash_args[SIM_CONTACT_SETTLE_FULL + 1u] : named;
+  hash_args[SIM_CONTACT_SETTLE_ARGS + slot] = slot > 0u ? hash_args[SIM_CONTACT_SETTLE_FULL] : named;
 #endif
 }
 #endif

@@ -90,7 +90,7 @@ void GpuBatch::recordInputs(const FlushQueue& f) {
            sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * (SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES),
            16ull * SIM_CONTACT_GRID_DISPATCHES});
       grid_regions.push_back({f.args_at + 16ull * (SIM_HASH_DISPATCHES + SIM_CONTACT_GRID_DISPATCHES),
-                              sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * SIM_CONTACT_SETTLE_FULL, 32ull});
+                              sliceOffset(SIM_BIND_HASH_ARGS, i) + 16ull * SIM_CONTACT_SETTLE_FULL, 16ull});
     }
     vkCmdCopyBuffer(cmd_, inputs_.buffer, buf_[SIM_BIND_HASH_ARGS].buffer, uint32_t(grid_regions.size()),
                     grid_regions.data());
@@ -149,11 +149,10 @@ void GpuBatch::recordSheetPasses(const FlushQueue& f) {
       recordSubstep(*this, sheet_passes_, topo_, sizes_, sheet_plan, s, count);
   }
   pass_sheet_ = -1;
-  glm::uvec4 grids[SIM_HASH_DISPATCHES + SIM_CONTACT_GRID_DISPATCHES + 2] = {};
+  glm::uvec4 grids[SIM_HASH_DISPATCHES + SIM_CONTACT_GRID_DISPATCHES + 1] = {};
   std::copy(hash_grids_.grids().begin(), hash_grids_.grids().end(), grids);
   std::copy(hash_grids_.contactGrids().begin(), hash_grids_.contactGrids().end(), grids + SIM_HASH_DISPATCHES);
-  std::copy(hash_grids_.settleGrids().begin(), hash_grids_.settleGrids().end(),
-            grids + SIM_HASH_DISPATCHES + SIM_CONTACT_GRID_DISPATCHES);
+  grids[SIM_HASH_DISPATCHES + SIM_CONTACT_GRID_DISPATCHES] = hash_grids_.sweepGrid();
   std::memcpy(static_cast<char*>(inputs_.mapped) + f.args_at, grids, sizeof(grids));
 }
 
@@ -179,7 +178,7 @@ void GpuBatch::recordBatchedPasses(const FlushQueue& f) {
   for (uint32_t k = 0; k < hash_grids_.grids().size(); ++k) args[k] = hash_grids_.grids()[k];
   for (uint32_t k = 0; k < hash_grids_.contactGrids().size(); ++k)
     args[SIM_BATCH_ARGS_FULL_CONTACT + k] = hash_grids_.contactGrids()[k];
-  for (uint32_t k = 0; k < 2; ++k) args[SIM_BATCH_ARGS_FULL_SETTLE + k] = hash_grids_.settleGrids()[k];
+  args[SIM_BATCH_ARGS_FULL_SETTLE] = hash_grids_.sweepGrid();
   for (uint32_t s = 0; s < SIM_MAX_SUBSTEPS; ++s) {
     for (uint32_t k = 0; k < SIM_HASH_DISPATCHES; ++k)
       args[SIM_BATCH_ARGS_LIVE_HASH + s * SIM_HASH_DISPATCHES + k] = glm::uvec4(0, args[k].y, pass_sheets_, 0);
@@ -190,10 +189,11 @@ void GpuBatch::recordBatchedPasses(const FlushQueue& f) {
     for (uint32_t k = 0; k < SIM_CONTACT_GRID_DISPATCHES; ++k)
       args[live + k] = glm::uvec4(0, args[SIM_BATCH_ARGS_FULL_CONTACT + k].y, pass_sheets_, 0);
     for (uint32_t k = 0; k < 3; ++k) args[live + SIM_CONTACT_GRID_DISPATCHES + k] = glm::uvec4(0, 0, pass_sheets_, 0);
-    // The settle's half-spaces' passes, then its sweeps (a sheet raises x where it arms its own)
+    // The settle's half-spaces' passes (a sheet raises x and y to its named queries' grid), then its
+    // sweeps (x to the full grid's)
     for (uint32_t k = 0; k < SIM_CONTACT_SETTLE_SLOTS; ++k)
       args[SIM_BATCH_ARGS_LIVE_SETTLE + s * SIM_CONTACT_SETTLE_SLOTS + k] =
-          glm::uvec4(0, args[SIM_BATCH_ARGS_FULL_SETTLE + std::min(k, 1u)].y, pass_sheets_, 0);
+          glm::uvec4(0, k > 0 ? args[SIM_BATCH_ARGS_FULL_SETTLE].y : 0u, pass_sheets_, 0);
   }
   std::memcpy(static_cast<char*>(inputs_.mapped) + f.args_at, args.data(), 16ull * args.size());
 }

@@ -81,10 +81,10 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
   // The full grids of the hash passes, of contact's grid passes and of the settle's, which
   // candidates_decide, contact_arm and the settle's passes copy to the live arguments
   if (hash_grids_.grids() != hash_grids_uploaded_ || hash_grids_.contactGrids() != contact_grids_uploaded_ ||
-      hash_grids_.settleGrids() != settle_grids_uploaded_) {
+      hash_grids_.sweepGrid() != sweep_grid_uploaded_) {
     ctx_.submitOnce([&](VkCommandBuffer up) {
-      vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * SIM_CONTACT_SETTLE_FULL,
-                        sizeof(hash_grids_.settleGrids()), hash_grids_.settleGrids().data());
+      const glm::uvec4 sweep = hash_grids_.sweepGrid();
+      vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * SIM_CONTACT_SETTLE_FULL, 16, &sweep);
       const std::vector<glm::uvec4>&hash = hash_grids_.grids(), &contact = hash_grids_.contactGrids();
       if (!hash.empty())
         vkCmdUpdateBuffer(up, buf_[SIM_BIND_HASH_ARGS].buffer, VkDeviceSize(16) * SIM_HASH_DISPATCHES, 16 * hash.size(),
@@ -96,7 +96,7 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
     });
     hash_grids_uploaded_ = hash_grids_.grids();
     contact_grids_uploaded_ = hash_grids_.contactGrids();
-    settle_grids_uploaded_ = hash_grids_.settleGrids();
+    sweep_grid_uploaded_ = hash_grids_.sweepGrid();
   }
   flight.dispatches = recorded_dispatches_;
 }

@@ -225,7 +225,7 @@ private:
   HashGrids hash_grids_;                                       ///< full grids of the hash passes, in recording order
   std::vector<glm::uvec4> hash_grids_uploaded_;                ///< what SIM_BIND_HASH_ARGS holds of them
   std::vector<glm::uvec4> contact_grids_uploaded_;             ///< ... and of contact's grid passes
-  std::array<glm::uvec4, 2> settle_grids_uploaded_{};          ///< ... and of the settle's
+  glm::uvec4 sweep_grid_uploaded_{0u};                         ///< ... and of a settle sweep
   uint32_t stop_after_ = SIM_NONE;                             ///< stopNextTickAfter
   mutable std::array<double, kCategoryCount> last_ms_{};
 };

@@ -14,12 +14,12 @@ glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets) {
 
 uint32_t HashGrids::record(Grid grid, glm::uvec4 full, uint32_t gate_arg) {
   if (grid == Grid::Cross || grid == Grid::Named) return 0; // own slots, amid the contact grid's passes
-  if (grid == Grid::Settle || grid == Grid::Sweep) {        // a slot of the settle's, one full grid each kind
-    glm::uvec4& grids = settle_grids_[grid == Grid::Sweep ? 1 : 0];
-    if (grids == glm::uvec4(0u)) grids = full;
-    if (grids != full || gate_arg >= SIM_SETTLE_MAX_SWEEPS)
+  if (grid == Grid::Settle) return SIM_CONTACT_SETTLE_ARGS; // armed with the named queries' grid
+  if (grid == Grid::Sweep) {                                // sweep gate_arg's slot; every sweep has the same full grid
+    if (sweep_grid_ == glm::uvec4(0u)) sweep_grid_ = full;
+    if (sweep_grid_ != full || gate_arg >= SIM_SETTLE_MAX_SWEEPS)
       vkCheckFailed(VK_ERROR_UNKNOWN, "settle grid", __FILE__, __LINE__);
-    return SIM_CONTACT_SETTLE_ARGS + (grid == Grid::Sweep ? 1 + gate_arg : 0);
+    return SIM_CONTACT_SETTLE_ARGS + 1 + gate_arg;
   }
   if (grid != Grid::Hash && grid != Grid::Contact) {
     next_ = next_contact_ = 0;

@@ -3,7 +3,6 @@
 /// SIM_DISPATCHES, shaders/shared/sim_passes.h), recorded into a PassSink: the GPU solver dispatches them for its
 /// sheet; a fleet dispatches each for every sheet of a batch, and its gate (SIM_GATE_* in sim_config.h) picks the
 /// sheets that run it, those that would run it alone.
-#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -57,18 +56,19 @@ public:
   const std::vector<glm::uvec4>& grids() const { return grids_; }
   /// Contact's grid passes' full grids (from slot SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES)
   const std::vector<glm::uvec4>& contactGrids() const { return contact_grids_; }
-  /// The settle's full grids: its half-spaces' passes and a sweep's (from SIM_CONTACT_SETTLE_FULL)
-  const std::array<glm::uvec4, 2>& settleGrids() const { return settle_grids_; }
+  /// A settle sweep's full grid (at SIM_CONTACT_SETTLE_FULL; the half-spaces' passes take the
+  /// named queries' grid)
+  glm::uvec4 sweepGrid() const { return sweep_grid_; }
   void clear() {
     grids_.clear();
     contact_grids_.clear();
-    settle_grids_ = {};
+    sweep_grid_ = glm::uvec4(0u);
     next_ = next_contact_ = 0;
   }
 
 private:
   std::vector<glm::uvec4> grids_, contact_grids_;
-  std::array<glm::uvec4, 2> settle_grids_{};
+  glm::uvec4 sweep_grid_{0u};
   uint32_t next_ = 0, next_contact_ = 0;
 };
 
