@@ -287,11 +287,8 @@ void contactEmit(uint k, uint flags) {
     hash_args[SIM_CONTACT_WALK_ARGS + 1u] = args;
 #ifdef SIM_BATCH_PASS
     // A fleet: the batch's named queries of this substep cover this sheet's anew
-    UintRef batch_args = UintRef(batchSlice(SIM_BATCH_ARGS, 0u));
-    uint slot =
-        4u * (SIM_BATCH_ARGS_LIVE_CONTACT + batch.substep * SIM_BATCH_CONTACT_SLOTS + SIM_CONTACT_GRID_DISPATCHES + 2u);
-    atomicMax(batch_args.v[slot], args.x);
-    atomicMax(batch_args.v[slot + 1u], args.y);
+    batchRaiseArgs(
+        SIM_BATCH_ARGS_LIVE_CONTACT + batch.substep * SIM_BATCH_CONTACT_SLOTS + SIM_CONTACT_GRID_DISPATCHES + 2u, args);
 #endif
     // Named for this build (contact_bound counts it after the walk)
     if (listsRebuilt()) contact_lists[listHeader() + LIST_NAMED] = contact_lists[listHeader() + LIST_BUILDS] + 1u;
@@ -307,7 +304,7 @@ uint namedQuery(uint j) {
 
 // contact_walk: the j-th named query, when it walks its list
 void contactWalk(uint j) {
-  uint k = j < walkArgs().w ? contact_words[activeWord() + j] : SIM_NONE;
+  uint k = j < walkArgs().w ? namedQuery(j) : SIM_NONE; // none while the lists are built
   if (k != SIM_NONE && contactWalks(k)) contactNear(k, NEAR_WALK);
 }
 
@@ -416,13 +413,10 @@ void armSettle(uint slot) {
   uvec4 named = hash_args[SIM_CONTACT_WALK_ARGS + 1u];
 #ifdef SIM_BATCH_PASS
   uint live = SIM_BATCH_ARGS_LIVE_SETTLE + batch.substep * SIM_CONTACT_SETTLE_SLOTS + slot;
-  if (slot > 0u) {
+  if (slot > 0u)
     batchArmArgs(live, SIM_BATCH_ARGS_FULL_SETTLE);
-  } else {
-    UintRef args = UintRef(batchSlice(SIM_BATCH_ARGS, 0u));
-    atomicMax(args.v[4u * live], named.x);
-    atomicMax(args.v[4u * live + 1u], named.y);
-  }
+  else
+    batchRaiseArgs(live, named);
 #else
   hash_args[SIM_CONTACT_SETTLE_ARGS + slot] = slot > 0u ? hash_args[SIM_CONTACT_SETTLE_FULL] : named;
 #endif

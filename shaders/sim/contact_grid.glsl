@@ -377,16 +377,10 @@ void contactArm() {
   uint live = SIM_BATCH_ARGS_LIVE_CONTACT + batch.substep * SIM_BATCH_CONTACT_SLOTS;
   if (built)
     for (uint k = 0u; k < SIM_CONTACT_GRID_DISPATCHES; ++k) batchArmArgs(live + k, SIM_BATCH_ARGS_FULL_CONTACT + k);
-  UintRef args = UintRef(batchSlice(SIM_BATCH_ARGS, 0u));
-  for (uint k = 0u; k < 3u; ++k) { // contact_walk's, contact_cross's, the named queries' (as named so far)
-    uvec4 own =
-        hash_args[k == 0u ? SIM_CONTACT_WALK_ARGS : (k == 1u ? SIM_CONTACT_CROSS_ARGS : SIM_CONTACT_WALK_ARGS + 1u)];
-    uint slot = 4u * (live + SIM_CONTACT_GRID_DISPATCHES + k);
-    if (own.x != 0u) {
-      atomicMax(args.v[slot], own.x);
-      atomicMax(args.v[slot + 1u], own.y);
-    }
-  }
+  for (uint k = 0u; k < 3u; ++k) // contact_walk's, contact_cross's, the named queries' (as named so far)
+    batchRaiseArgs(
+        live + SIM_CONTACT_GRID_DISPATCHES + k,
+        hash_args[k == 0u ? SIM_CONTACT_WALK_ARGS : (k == 1u ? SIM_CONTACT_CROSS_ARGS : SIM_CONTACT_WALK_ARGS + 1u)]);
 #endif
 }
 

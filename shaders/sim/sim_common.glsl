@@ -306,6 +306,14 @@ void batchArmArgs(uint live, uint full) {
   atomicMax(args.v[4u * live], args.v[4u * full]);
 }
 
+// The batch's indirect argument `live` covers a sheet's own grid `own` (x and y), when it has one.
+void batchRaiseArgs(uint live, uvec4 own) {
+  if (own.x == 0u) return;
+  UintRef args = UintRef(batchSlice(SIM_BATCH_ARGS, 0u));
+  atomicMax(args.v[4u * live], own.x);
+  atomicMax(args.v[4u * live + 1u], own.y);
+}
+
 void simPassMain();
 void main() {
   bindSheet(batchSheet(gl_WorkGroupID.z));
