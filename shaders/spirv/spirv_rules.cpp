@@ -33,7 +33,9 @@ bool isPreamble(uint32_t op) {
 FloatRules floatRulesFor(const FloatControls& fc) {
   FloatRules r;
   r.rounding_rte = fc.rounding_rte;
-  r.denormals = fc.denorm_flush ? Denormals::FlushToZero : Denormals::FlushInShader;
+  r.denormals = fc.denorm_flush ? Denormals::FlushToZero
+                : fc.host_flush ? Denormals::FlushByHost
+                                : Denormals::FlushInShader;
   return r;
 }
 
@@ -43,6 +45,8 @@ const char* denormalsName(Denormals d) {
     return "flush to zero (device)";
   case Denormals::FlushInShader:
     return "flush to zero (shader)";
+  case Denormals::FlushByHost:
+    return "flush to zero (the host's FTZ and DAZ)";
   case Denormals::AsWritten:
     break;
   }

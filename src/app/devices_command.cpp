@@ -29,10 +29,13 @@ int runDevices(const CommonOptions&) {
                 double(d.memory_bytes) / (1024.0 * 1024.0 * 1024.0), d.usable ? "" : " [not usable: needs Vulkan 1.3]");
     // What the simulation's shaders ask of its float arithmetic (shaders/spirv/spirv_rules.h)
     const gpu::FloatRules rules = gpu::floatRulesFor(d.floats);
-    std::printf("    float32 controls: round to nearest even %s, denormal preserve %s, flush %s -> denormals %s; "
+    // A CPU device may flush them with the host's FTZ and DAZ instead (gpu::simFloatRules: a probe)
+    const bool host = d.type == "cpu" && rules.denormals == gpu::Denormals::FlushInShader;
+    std::printf("    float32 controls: round to nearest even %s, denormal preserve %s, flush %s -> denormals %s%s; "
                 "subgroup %u, shared memory %u KiB (the fused tick: sheets of up to %u particles)\n",
                 d.floats.rounding_rte ? "yes" : "no", d.floats.denorm_preserve ? "yes" : "no",
-                d.floats.denorm_flush ? "yes" : "no", gpu::denormalsName(rules.denormals), d.subgroup_size,
+                d.floats.denorm_flush ? "yes" : "no", gpu::denormalsName(rules.denormals),
+                host ? ", or with the host's FTZ and DAZ where its threads have them" : "", d.subgroup_size,
                 d.shared_memory / 1024u, gpu::fusedCapacity(d.shared_memory));
   }
   std::printf("(* = used by default; choose another with --device N)\n");

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include "core/denormal_mode.h"
 #include "core/host_queries.h"
-#include "denormal_mode.h"
 #include "settle_elements.h"
 #include "simd_kernels.h"
 #include "worker_pool.h"

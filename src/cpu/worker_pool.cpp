@@ -6,7 +6,7 @@
 #include <immintrin.h>
 #endif
 
-#include "denormal_mode.h"
+#include "core/denormal_mode.h"
 
 namespace tender {
 namespace {

@@ -1,6 +1,7 @@
 #include "context.h"
 
 #include "barriers.h"
+#include "core/denormal_mode.h"
 
 #include <algorithm>
 #include <cstring>
@@ -206,9 +207,16 @@ Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextOption
   std::unique_ptr<VulkanContext> ctx(new VulkanContext());
   ctx->validation_ = o.validation;
   ctx->quiet_ = o.quiet;
-  if (auto err = ctx->createInstance(o)) return R::failure(*err);
-  if (auto err = ctx->choosePhysicalDevice(o)) return R::failure(*err);
-  if (auto err = ctx->createDevice(o)) return R::failure(*err);
+  {
+    // A thread starts with its creator's FTZ and DAZ (POSIX: the floating-point environment is
+    // inherited), so the threads a CPU device (lavapipe) starts for its instance and device run
+    // shaders with the CPU reference's denormal rules; gpu::simFloatRules proves it before it
+    // relies on it. This thread's own mode is restored.
+    const DenormalMode host_rules(true);
+    if (auto err = ctx->createInstance(o)) return R::failure(*err);
+    if (auto err = ctx->choosePhysicalDevice(o)) return R::failure(*err);
+    if (auto err = ctx->createDevice(o)) return R::failure(*err);
+  }
   VkCommandPoolCreateInfo pci{};
   pci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
   pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -379,6 +387,11 @@ std::optional<std::string> VulkanContext::createDevice(const ContextOptions& o) 
   }
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
   return std::nullopt;
+}
+
+FloatRules VulkanContext::floatRules(const std::function<FloatRules()>& decide) {
+  std::call_once(float_rules_once_, [&] { float_rules_ = decide(); });
+  return float_rules_;
 }
 
 VkPipeline VulkanContext::sharedPipeline(const std::string& name,

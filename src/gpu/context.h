@@ -151,6 +151,9 @@ public:
   const DeviceInfo& info() const { return info_; }
   /// The 32-bit float controls the device can be asked for.
   const FloatControls& floatControls() const { return info_.floats; }
+  /// The float rules of the simulation's shaders on this device: `decide`'s, asked once a context
+  /// (gpu::simFloatRules, which runs a probe on a CPU device) and shared by its solvers and fleets.
+  FloatRules floatRules(const std::function<FloatRules()>& decide);
   /// Validation warnings and errors reported so far (0 without validation).
   uint32_t validationMessages() const { return validation_messages_.load(); }
   bool validationEnabled() const { return validation_; }
@@ -210,6 +213,8 @@ private:
   bool validation_ = false, quiet_ = false;
   bool device_addresses_ = false;
   std::atomic<uint32_t> validation_messages_{0};
+  std::once_flag float_rules_once_;
+  FloatRules float_rules_; ///< floatRules'
   std::mutex pipelines_mutex_;
   std::map<std::string, std::pair<VkPipeline, VkShaderModule>> pipelines_; ///< sharedPipeline's
 };

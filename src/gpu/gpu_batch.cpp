@@ -82,7 +82,7 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
   pli.pushConstantRangeCount = 1;
   pli.pPushConstantRanges = &range;
   VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &layout_));
-  float_rules_ = floatRulesFor(ctx_.floatControls());
+  float_rules_ = simFloatRules(ctx_);
   math_ = MathSwitches::fromEnvironment();
   // The fused tick's shape on this kind of device (see FusedShape in gpu_solver.h); a sheet larger
   // than its capacity (fusedCapacity) runs the per-colour passes, as it does alone.

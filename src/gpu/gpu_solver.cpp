@@ -59,7 +59,7 @@ void GpuSolver::createPipelines(FusedShape fused) {
   // switches of exact_math.h: the environment may ask for an emulated inexact device
   // (TENDER_EMULATE_INEXACT_MATH=1) and, to show what the correction does, for none
   // (TENDER_UNCORRECTED_MATH=1).
-  float_rules_ = floatRulesFor(ctx_.floatControls());
+  float_rules_ = simFloatRules(ctx_);
   math_ = MathSwitches::fromEnvironment();
   // The fused tick keeps the positions in shared memory; its shape suits the device.
   const FusedShape shape = resolveFusedShape(ctx_, fused);

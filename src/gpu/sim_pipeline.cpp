@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
@@ -10,6 +11,7 @@
 #include <system_error>
 #include <thread>
 
+#include "core/denormal_mode.h"
 #include "gpu/barriers.h"
 #include "gpu/shaders.h"
 #include "shaderio.h"
@@ -233,7 +235,10 @@ void addContactPipelines(VulkanContext& ctx, const SimLayout& layout, const Floa
   makeComputePipelines(ctx, layout, rules, math, requests);
 }
 
-void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math, MathOp op) {
+namespace {
+
+/// runDeviceMath under `rules`
+void runMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math, MathOp op, const FloatRules& rules) {
   static_assert(sizeof(MathCase) == 16);
   if (cases.empty()) return;
   VkDevice dev = ctx.device();
@@ -277,8 +282,7 @@ void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitche
   pli.pSetLayouts = &o.set_layout;
   VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &o.layout));
   VK_CHECK(vkCreateDescriptorPool(dev, &dpi, nullptr, &o.pool));
-  o.pipeline =
-      createSimPipeline(ctx, "math_check.comp", o.layout, floatRulesFor(ctx.floatControls()), math, {}, o.module);
+  o.pipeline = createSimPipeline(ctx, "math_check.comp", o.layout, rules, math, {}, o.module);
 
   // At most 2^16 - 1 workgroups of 64 per row; the rest of a batch spills into Y
   const uint64_t per_batch = std::min<uint64_t>(cases.size(), 1u << 22);
@@ -306,6 +310,44 @@ void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitche
     });
     std::memcpy(cases.data() + first, o.buffer.mapped, count * sizeof(MathCase));
   }
+}
+
+/// True when the device's plain products and sums, with no flush of the shader's own, treat
+/// denormals as the host does with FTZ and DAZ set: in 64 workgroups, so that every thread of a CPU
+/// device's pool runs some, products that fall below the smallest normal (FTZ: zero), sums of a
+/// normal and a denormal that fall below it (DAZ: the normal), and denormals times 2^23 (DAZ: zero).
+bool flushesAsTheHost(VulkanContext& ctx) {
+  std::vector<MathCase> cases(64 * 64);
+  for (uint32_t k = 0; k < cases.size(); ++k) {
+    const uint32_t low = k & 0xFFu;
+    if (k % 3 == 0) cases[k] = {0x1E3CE508u + low, 0x1E3CE508u - low, 0, 0}; // about 1e-20 squared
+    if (k % 3 == 1) cases[k] = {0x00800000u + low, 0x80400000u | k, 0, 0};   // the smallest normals, less denormals
+    if (k % 3 == 2) cases[k] = {0x00400000u | k, 0x4B000000u, 0, 0};         // denormals times 2^23
+  }
+  runMath(ctx, cases, {}, MathOp::MulAdd, {floatRulesFor(ctx.floatControls()).rounding_rte, Denormals::FlushByHost});
+  const DenormalMode host(true);
+  for (const MathCase& c : cases) {
+    volatile float a = std::bit_cast<float>(c.a), b = std::bit_cast<float>(c.b);
+    volatile float product = a * b, sum = a + b;
+    if (c.sqrt_a != std::bit_cast<uint32_t>(float(product)) || c.a_over_b != std::bit_cast<uint32_t>(float(sum)))
+      return false;
+  }
+  return true;
+}
+
+} // namespace
+
+void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math, MathOp op) {
+  runMath(ctx, cases, math, op, simFloatRules(ctx));
+}
+
+FloatRules simFloatRules(VulkanContext& ctx) {
+  return ctx.floatRules([&] {
+    FloatControls fc = ctx.floatControls();
+    fc.host_flush =
+        !fc.denorm_flush && ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU && flushesAsTheHost(ctx);
+    return floatRulesFor(fc);
+  });
 }
 
 Arithmetic arithmeticOf(const FloatRules& rules, MathSwitches math) {

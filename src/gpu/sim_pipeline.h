@@ -123,8 +123,15 @@ struct MathCase {
 /// arithmetic treats denormals.
 enum class MathOp : uint32_t { ExactSqrtDiv = 0, MulAdd = 1 };
 
-/// Runs the check of every case on the device (the shader math_check.comp).
+/// Runs the check of every case on the device (the shader math_check.comp), under simFloatRules.
 void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math,
                    MathOp op = MathOp::ExactSqrtDiv);
+
+/// The float rules of the simulation's shaders on the device of `ctx`, decided once a context:
+/// floatRulesFor its float controls, where a CPU device that cannot be asked to flush denormals
+/// flushes them with the host's FTZ and DAZ (FloatControls::host_flush) when a probe shows that its
+/// threads have them (VulkanContext::create starts them so). There the shaders carry no flush of their
+/// own, which on lavapipe costs a quarter of a kernel's run and of its compile.
+FloatRules simFloatRules(VulkanContext& ctx);
 
 } // namespace tender::gpu

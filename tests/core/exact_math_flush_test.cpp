@@ -11,7 +11,7 @@
 
 #include <glm/glm.hpp>
 
-#include "cpu/denormal_mode.h"
+#include "core/denormal_mode.h"
 
 namespace flushed {
 using namespace glm;

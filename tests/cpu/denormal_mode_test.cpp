@@ -5,8 +5,8 @@
 #include <bit>
 #include <vector>
 
+#include "core/denormal_mode.h"
 #include "cpu/cpu_solver.h"
-#include "cpu/denormal_mode.h"
 #include "cpu/worker_pool.h"
 
 using namespace tender;

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <random>
 
-#include "cpu/denormal_mode.h"
+#include "core/denormal_mode.h"
 #include "gpu/sim_pipeline.h"
 #include "gpu_test_env.h"
 
