@@ -79,10 +79,11 @@ TEST_F(DeviceMath, WithoutTheCorrectionTheInexactDeviceDisagrees) {
 }
 
 // The CPU reference flushes denormals (FTZ and DAZ) and so do the shaders on every device, by the
-// device's float controls or by their own code (FloatRules): products and sums with denormal
-// results, and denormal inputs, which read as zero (a denormal times 2^50..2^100 is a normal number
-// where they are kept). NVIDIA's driver, which can be asked neither to keep nor to flush them, kept
-// them in this shader and flushed one in the projection pass before the shaders flushed them.
+// device's float controls, by their own code, or on a CPU device by the host's FTZ and DAZ in its
+// threads (gpu::simFloatRules): products and sums with denormal results, and denormal inputs, which
+// read as zero (a denormal times 2^50..2^100 is a normal number where they are kept). NVIDIA's
+// driver, which can be asked neither to keep nor to flush them, kept them in this shader and flushed
+// one in the projection pass before the shaders flushed them.
 TEST_F(DeviceMath, PlainArithmeticTreatsDenormalsLikeTheCpu) {
   std::vector<gpu::MathCase> cases;
   const uint32_t tiny = 0x1E3CE508u; // 1e-20: its square is a denormal
@@ -110,6 +111,15 @@ TEST_F(DeviceMath, PlainArithmeticTreatsDenormalsLikeTheCpu) {
                     << ")";
   }
   EXPECT_EQ(bad, 0) << "the device does not treat denormals as asked (tender devices: " << ctx().info().name << ")";
+}
+
+// Lavapipe cannot be asked to flush denormals, but the threads it starts for a context inherit the
+// host's FTZ and DAZ (VulkanContext::create sets them meanwhile), so its shaders need no flush of
+// their own, which cost a quarter of a kernel's run and of its compile there: the probe proves it.
+TEST_F(DeviceMath, ACpuDeviceFlushesWithTheHostsFtzAndDaz) {
+  if (ctx().properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) GTEST_SKIP() << "not a CPU device";
+  if (ctx().floatControls().denorm_flush) GTEST_SKIP() << "the device can be asked to flush them";
+  EXPECT_EQ(gpu::simFloatRules(ctx()).denormals, gpu::Denormals::FlushByHost);
 }
 
 // The shaders' exactSqrt and exactDiv, which flush denormals (SIM_FLUSH_DENORMALS) on every device, give the CPU's bits
