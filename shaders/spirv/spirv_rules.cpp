@@ -33,9 +33,7 @@ bool isPreamble(uint32_t op) {
 FloatRules floatRulesFor(const FloatControls& fc) {
   FloatRules r;
   r.rounding_rte = fc.rounding_rte;
-  r.denormals = fc.denorm_flush ? Denormals::FlushToZero
-                : fc.host_flush ? Denormals::FlushByHost
-                                : Denormals::FlushInShader;
+  r.denormals = fc.denorm_flush ? Denormals::FlushToZero : Denormals::FlushInShader;
   return r;
 }
 

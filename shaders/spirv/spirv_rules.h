@@ -14,9 +14,6 @@ struct FloatControls {
   bool rounding_rte = false;    ///< shaderRoundingModeRTEFloat32
   bool denorm_preserve = false; ///< shaderDenormPreserveFloat32
   bool denorm_flush = false;    ///< shaderDenormFlushToZeroFloat32
-  /// A CPU device whose shaders run on threads with the host's FTZ and DAZ set, proven on this device
-  /// (gpu::simFloatRules): it flushes as the CPU reference does, without being asked to
-  bool host_flush = false;
 };
 
 /// How the simulation's shaders flush denormals on a device. Every device and the CPU reference
@@ -26,7 +23,7 @@ struct FloatControls {
 enum class Denormals {
   FlushToZero,   ///< the device flushes them, asked to (DenormFlushToZero)
   FlushInShader, ///< the device cannot be asked to: every float result is flushed by the shader's own code
-  FlushByHost,   ///< a CPU device's threads flush them with the host's FTZ and DAZ (FloatControls::host_flush)
+  FlushByHost,   ///< a CPU device's threads flush them with the host's FTZ and DAZ (proven by gpu::simFloatRules)
   AsWritten,     ///< neither asked for nor written in (the build's pass before spirv-opt, which marks NoContraction)
 };
 

@@ -316,7 +316,7 @@ void runMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitches math
 /// denormals as the host does with FTZ and DAZ set: in 64 workgroups, so that every thread of a CPU
 /// device's pool runs some, products that fall below the smallest normal (FTZ: zero), sums of a
 /// normal and a denormal that fall below it (DAZ: the normal), and denormals times 2^23 (DAZ: zero).
-bool flushesAsTheHost(VulkanContext& ctx) {
+bool flushesAsTheHost(VulkanContext& ctx, bool rounding_rte) {
   std::vector<MathCase> cases(64 * 64);
   for (uint32_t k = 0; k < cases.size(); ++k) {
     const uint32_t low = k & 0xFFu;
@@ -324,7 +324,7 @@ bool flushesAsTheHost(VulkanContext& ctx) {
     if (k % 3 == 1) cases[k] = {0x00800000u + low, 0x80400000u | k, 0, 0};   // the smallest normals, less denormals
     if (k % 3 == 2) cases[k] = {0x00400000u | k, 0x4B000000u, 0, 0};         // denormals times 2^23
   }
-  runMath(ctx, cases, {}, MathOp::MulAdd, {floatRulesFor(ctx.floatControls()).rounding_rte, Denormals::FlushByHost});
+  runMath(ctx, cases, {}, MathOp::MulAdd, {rounding_rte, Denormals::FlushByHost});
   const DenormalMode host(true);
   for (const MathCase& c : cases) {
     volatile float a = std::bit_cast<float>(c.a), b = std::bit_cast<float>(c.b);
@@ -343,10 +343,11 @@ void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitche
 
 FloatRules simFloatRules(VulkanContext& ctx) {
   return ctx.floatRules([&] {
-    FloatControls fc = ctx.floatControls();
-    fc.host_flush =
-        !fc.denorm_flush && ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU && flushesAsTheHost(ctx);
-    return floatRulesFor(fc);
+    FloatRules rules = floatRulesFor(ctx.floatControls());
+    const bool cpu_device = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    if (rules.denormals == Denormals::FlushInShader && cpu_device && flushesAsTheHost(ctx, rules.rounding_rte))
+      rules.denormals = Denormals::FlushByHost;
+    return rules;
   });
 }
 

@@ -129,7 +129,7 @@ void runDeviceMath(VulkanContext& ctx, std::vector<MathCase>& cases, MathSwitche
 
 /// The float rules of the simulation's shaders on the device of `ctx`, decided once a context:
 /// floatRulesFor its float controls, where a CPU device that cannot be asked to flush denormals
-/// flushes them with the host's FTZ and DAZ (FloatControls::host_flush) when a probe shows that its
+/// flushes them with the host's FTZ and DAZ (Denormals::FlushByHost) when a probe shows that its
 /// threads have them (VulkanContext::create starts them so). There the shaders carry no flush of their
 /// own, which on lavapipe costs a quarter of a kernel's run and of its compile.
 FloatRules simFloatRules(VulkanContext& ctx);
