@@ -136,15 +136,6 @@ SIM_INLINE uvec2 limitParents(uint i, uint root, uint cols) {
   return uvec2(in_row, in_col);
 }
 
-/// True when the stretch limit first shortens the sheet's edges from both ends (the shorten stage)
-/// before its rings: nothing holds the sheet (no grab, no pins). The rings alone draw the sheet
-/// after their root, one-sidedly, and with no hand or pin to root them at, the free middle they
-/// root at keeps a crumpled ball moving: 1.8 to 3.5 units/s 8 s after a fast crumple
-/// (`bench/rest.py`, measured at 2bf6ebd).
-SIM_INLINE bool limitShortens(float reach, uint grab_index, uint flags) {
-  return reach > 0.0f && grab_index == SIM_NONE && (flags & SIM_FLAG_PINS) == 0u;
-}
-
 /// True when the shorten stage visits a colour whose first constraint is `kind_id`: a colour holds
 /// its structural edges first (buildSheet makes them first; the colouring's sort and the compaction
 /// keep the order), so one that starts with another kind (a shear's, a hinge's) holds no edge.

@@ -131,44 +131,32 @@
 #define SIM_BATCH_ARGS_FULL_SETTLE (SIM_BATCH_ARGS_LIVE_CONTACT + SIM_MAX_SUBSTEPS * SIM_BATCH_CONTACT_SLOTS)
 #define SIM_BATCH_ARGS_LIVE_SETTLE (SIM_BATCH_ARGS_FULL_SETTLE + 1u)
 #define SIM_BATCH_ARGS_COUNT (SIM_BATCH_ARGS_LIVE_SETTLE + SIM_MAX_SUBSTEPS * SIM_CONTACT_SETTLE_SLOTS)
-// Which sheets of a batch a per-colour pass runs for (BatchArgs.gate). The batch records the
-// passes of its most substeps and iterations, with air and collision when any sheet has them; a
-// sheet runs a pass exactly when the same sheet ticking alone records or dispatches it. Every
-// gate but SIM_GATE_RESET takes only the sheets that tick (no animated reset) and have the substep.
-// SIM_GATE_TICK: no further condition (integrate, floor, tear_mark)
-#define SIM_GATE_TICK 0u
-// SIM_GATE_AIR: the sheet has air (air)
-#define SIM_GATE_AIR 1u
-// SIM_GATE_ITERATION: the sheet has iteration BatchArgs.gate_arg (project)
-#define SIM_GATE_ITERATION 2u
-// SIM_GATE_COLLISION: the sheet has collision (candidates_*, collide)
-#define SIM_GATE_COLLISION 3u
-// SIM_GATE_HASH: the sheet has collision and its lists do not stand in for the hash this substep
-// (the hash passes, which alone run the grid candidates_decide gives them)
-#define SIM_GATE_HASH 4u
-// SIM_GATE_COMPACTION: something of the sheet tore this substep (the compaction passes, which
+// Which sheets of a batch a per-colour pass runs for: those that tick (no animated reset), have
+// the pass's substep and meet its conditions (BatchArgs.when: stageConditions, sim_passes.h), and
+// of those the ones its run-time gate takes (BatchArgs.live). The batch records the passes of its
+// most substeps and iterations, under the union of its sheets' conditions; a sheet runs a pass
+// exactly when the same sheet ticking alone records or dispatches it.
+// SIM_LIVE_NONE: no further condition
+#define SIM_LIVE_NONE 0u
+// SIM_LIVE_ITERATION: the sheet has iteration BatchArgs.arg (a colour's pass of project, shorten)
+#define SIM_LIVE_ITERATION 1u
+// SIM_LIVE_HASH: the sheet's lists do not stand in for the hash this substep (the hash passes,
+// which alone run the grid candidates_decide gives them)
+#define SIM_LIVE_HASH 2u
+// SIM_LIVE_COMPACTION: something of the sheet tore this substep (the compaction passes, which
 // alone run the grid tear_mark gives them)
-#define SIM_GATE_COMPACTION 5u
-// SIM_GATE_RESET: the sheet runs a frame of the animated reset (reset)
-#define SIM_GATE_RESET 6u
-// SIM_GATE_CREASE: the sheet has hinges and creases (crease)
-#define SIM_GATE_CREASE 7u
-// SIM_GATE_LIMIT: the sheet has a stretch limit (limit)
-#define SIM_GATE_LIMIT 8u
-// SIM_GATE_SHORTEN: the sheet's limit shortens edges (limitShortens) and it has iteration
-// BatchArgs.gate_arg (shorten)
-#define SIM_GATE_SHORTEN 9u
-// SIM_GATE_CONTACT: the sheet has contact (contact's passes of every substep)
-#define SIM_GATE_CONTACT 10u
-// SIM_GATE_CONTACT_GRID: the sheet has contact and builds its grid this substep (contact_arm
-// armed its grid's passes: they alone run the grid the batch's live arguments give them)
-#define SIM_GATE_CONTACT_GRID 11u
-// SIM_GATE_CONTACT_WALK, SIM_GATE_CONTACT_CROSS: the sheet has contact and its own arguments of
-// contact_walk (contact_cross) have workgroups this substep
-#define SIM_GATE_CONTACT_WALK 12u
-#define SIM_GATE_CONTACT_CROSS 13u
-// SIM_GATE_SETTLE: the sheet has contact and settle sweep BatchArgs.gate_arg (the settle stage)
-#define SIM_GATE_SETTLE 14u
+#define SIM_LIVE_COMPACTION 3u
+// SIM_LIVE_CONTACT_GRID: the sheet builds its contact grid this substep (contact_arm armed its
+// grid's passes: they alone run the grid the batch's live arguments give them)
+#define SIM_LIVE_CONTACT_GRID 4u
+// SIM_LIVE_CONTACT_WALK, SIM_LIVE_CONTACT_CROSS: the sheet's own arguments of contact_walk
+// (contact_cross) have workgroups this substep
+#define SIM_LIVE_CONTACT_WALK 5u
+#define SIM_LIVE_CONTACT_CROSS 6u
+// SIM_LIVE_SWEEP: the sheet has settle sweep BatchArgs.arg
+#define SIM_LIVE_SWEEP 7u
+// SIM_LIVE_RESET: the sheet runs a frame of the animated reset (reset; no other condition)
+#define SIM_LIVE_RESET 8u
 // Sheets per hardware thread that one dispatch of a fleet takes on a CPU device, which runs a
 // substep per dispatch: each thread keeps its sheet's arrays (under 1 MiB for 32 x 48) in its
 // cache through every substep before the next sheets start (lavapipe, 2 threads, 64 sheets of

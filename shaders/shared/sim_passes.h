@@ -14,6 +14,7 @@
 #define SIM_PASSES_H
 #include "prelude.h"
 #include "sim_config.h"
+#include "sim_types.h"
 
 // The per-colour kernels, in the order a substep dispatches them (normals runs once a frame,
 // reset during the animated reset).
@@ -67,29 +68,48 @@
   X(normals, SIM, 1, 0)                                                                                                \
   X(reset, SIM, 1, 1)
 
+// When a stage or a dispatch runs: the conditions of a sheet's uniforms it needs, as bits
+// (stageConditions gathers them; 0: always).
+#define SIM_WHEN_ALWAYS 0u
+// collision is on (SIM_FLAG_COLLISION)
+#define SIM_WHEN_COLLISION 1u
+// the sheet has air (SIM_FLAG_AIR)
+#define SIM_WHEN_AIR 2u
+// contact is on (SimUniforms::contact.x, the contact radius)
+#define SIM_WHEN_CONTACT 4u
+// the stretch limit is on (SimUniforms::limit.x)
+#define SIM_WHEN_LIMIT 8u
+// the limit shortens edges first: nothing holds the sheet (no grab, no pins)
+#define SIM_WHEN_SHORTEN 16u
+// the sheet has hinges and they crease (a yield angle)
+#define SIM_WHEN_CREASE 32u
+// contact is on with the settle's sweeps (SimUniforms::contact_check.y)
+#define SIM_WHEN_SETTLE 64u
+
 // The stages of a substep, in the order they run; each is one numbered pass, or one per colour of
-// each iteration. A tick numbers its passes substep x passesPerSubstep + the pass within the
-// substep.
-// X(name, id, repeat, condition)
-//   name       what `tender diff` and TENDER_TEST_PLANT_ULP call it; PassKind::<name> in C++
-//   id         its place in this table (0u, 1u, ...); SIM_STAGE_<name>
-//   repeat     ONCE, or COLOUR: once per colour of each iteration
-//   condition  ALWAYS, or COLLISION: only while collision is on
+// each iteration, while its condition holds (none otherwise). A tick numbers its passes substep x
+// passesPerSubstep + the pass within the substep.
+// X(name, id, repeat, when)
+//   name    what `tender diff` and TENDER_TEST_PLANT_ULP call it; PassKind::<name> in C++
+//   id      its place in this table (0u, 1u, ...); SIM_STAGE_<name>
+//   repeat  ONCE, or COLOUR: once per colour of each iteration
+//   when    SIM_WHEN_<when>: what it runs under (stageRuns)
 #define SIM_STAGES(X)                                                                                                  \
-  X(integrate, 0u, ONCE, ALWAYS)                                                                                       \
-  X(collide, 1u, ONCE, COLLISION)                                                                                      \
-  X(project, 2u, COLOUR, ALWAYS)                                                                                       \
-  X(shorten, 3u, COLOUR, ALWAYS)                                                                                       \
-  X(limit, 4u, ONCE, ALWAYS)                                                                                           \
-  X(crease, 5u, ONCE, ALWAYS)                                                                                          \
-  X(floor, 6u, ONCE, ALWAYS)                                                                                           \
-  X(settle, 7u, ONCE, ALWAYS)                                                                                          \
-  X(tear, 8u, ONCE, ALWAYS)
-#define SIM_STAGE_COUNT 9u
+  X(contact, 0u, ONCE, CONTACT)                                                                                        \
+  X(integrate, 1u, ONCE, ALWAYS)                                                                                       \
+  X(collide, 2u, ONCE, COLLISION)                                                                                      \
+  X(project, 3u, COLOUR, ALWAYS)                                                                                       \
+  X(shorten, 4u, COLOUR, SHORTEN)                                                                                      \
+  X(limit, 5u, ONCE, LIMIT)                                                                                            \
+  X(crease, 6u, ONCE, CREASE)                                                                                          \
+  X(floor, 7u, ONCE, ALWAYS)                                                                                           \
+  X(settle, 8u, ONCE, SETTLE)                                                                                          \
+  X(tear, 9u, ONCE, ALWAYS)
+#define SIM_STAGE_COUNT 10u
 
 // The dispatches of each stage, in the order the per-colour path records them (a barrier after
 // each). The fused tick and the CPU run the same bodies in the same order.
-// X(stage, kernel, elements, grid, gate, needs, category)
+// X(stage, kernel, elements, grid, when, category)
 //   stage     its row in SIM_STAGES
 //   kernel    its row in SIM_KERNELS (scan: a scan of several blocks adds scan and scan_add)
 //   elements  what it covers and its push constants: PARTICLES, COLOUR (the stage's colour),
@@ -114,77 +134,115 @@
 //             Settle (the settle's half-spaces' passes: the named queries' grid, none in a substep
 //             with no edge over the limit), Sweep (a settle sweep's, each colour's grid that of the largest:
 //             none after a sweep that moved nothing) or
-//             Compaction (the tear compaction's arguments): gpu::Grid
-//   gate      the sheets of a fleet that run it: SIM_GATE_<gate> (sim_config.h)
-//   needs     ALWAYS, AIR (the sheet has air), CREASE (the sheet has hinges and creases), LIMIT
-//             (the sheet has a stretch limit), SHORTEN (the limit shortens edges: limitShortens),
-//             CONSTRAINTS (the sheet has constraints), CONTACT (contact is on: a sheet alone,
-//             or any sheet of a fleet) or SETTLE (contact is on with the settle's
-//             sweeps: SubstepPlan::sweeps)
+//             Compaction (the tear compaction's arguments): gpu::Grid. A fleet's sheet takes an
+//             indirect pass when its own arguments would have given it workgroups (liveGate).
+//   when      SIM_WHEN_<when>: what it needs besides its stage's condition
 //   category  its timestamp category (gpu::PassCategory k<category>)
 #define SIM_DISPATCHES(X)                                                                                              \
-  X(integrate, contact_begin, ONE, Threads, CONTACT, CONTACT, Contact)                                                 \
-  X(integrate, contact_clear, CONTACT_SLOTS, Threads, CONTACT, CONTACT, Contact)                                       \
-  X(integrate, contact_arm, ONE, Threads, CONTACT, CONTACT, Contact)                                                   \
-  X(integrate, contact_grid_clear, CONTACT_BUCKETS, Contact, CONTACT_GRID, CONTACT, Contact)                           \
-  X(integrate, contact_count, CONTACT_BOXES, Contact, CONTACT_GRID, CONTACT, Contact)                                  \
-  X(integrate, scan, CONTACT_CELLS, Contact, CONTACT_GRID, CONTACT, Contact)                                           \
-  X(integrate, contact_scatter, CONTACT_BOXES, Contact, CONTACT_GRID, CONTACT, Contact)                                \
-  X(integrate, contact_cross, TRIANGLES, Cross, CONTACT_CROSS, CONTACT, Contact)                                       \
-  X(integrate, contact_near, CONTACT_QUERIES, Contact, CONTACT_GRID, CONTACT, Contact)                                 \
-  X(integrate, contact_active, CONTACT_ACTIVE, Contact, CONTACT_GRID, CONTACT, Contact)                                \
-  X(integrate, scan, CONTACT_ACTIVE_CELLS, Contact, CONTACT_GRID, CONTACT, Contact)                                    \
-  X(integrate, contact_emit, CONTACT_ACTIVE, Contact, CONTACT_GRID, CONTACT, Contact)                                  \
-  X(integrate, contact_walk, CONTACT_QUERIES, Walk, CONTACT_WALK, CONTACT, Contact)                                    \
-  X(integrate, contact_bound, PARTICLES, Threads, CONTACT, CONTACT, Contact)                                           \
-  X(integrate, air, PARTICLES, Threads, AIR, AIR, Integrate)                                                           \
-  X(integrate, integrate, PARTICLES, Threads, TICK, ALWAYS, Integrate)                                                 \
-  X(collide, candidates_check, PARTICLES, Threads, COLLISION, ALWAYS, Hash)                                            \
-  X(collide, candidates_decide, HASH_ARGS, Threads, COLLISION, ALWAYS, Hash)                                           \
-  X(collide, hash_count, PARTICLES, Hash, HASH, ALWAYS, Hash)                                                          \
-  X(collide, scan, HASH_CELLS, Hash, HASH, ALWAYS, Hash)                                                               \
-  X(collide, hash_scatter, PARTICLES, Hash, HASH, ALWAYS, Hash)                                                        \
-  X(collide, hash_sort, PARTICLES, Hash, HASH, ALWAYS, Hash)                                                           \
-  X(collide, collide, PARTICLES, Threads, COLLISION, ALWAYS, Collide)                                                  \
-  X(collide, candidates_finish, ONE, Threads, COLLISION, ALWAYS, Collide)                                              \
-  X(collide, repel, PARTICLES, Threads, COLLISION, ALWAYS, Collide)                                                    \
-  X(project, project, COLOUR, Threads, ITERATION, ALWAYS, Project)                                                     \
-  X(shorten, shorten, COLOUR, Threads, SHORTEN, SHORTEN, Project)                                                      \
-  X(limit, limit, RINGS, Threads, LIMIT, LIMIT, Project)                                                               \
-  X(crease, crease, HINGES, Threads, CREASE, CREASE, Project)                                                          \
-  X(floor, floor, PARTICLES, Threads, TICK, ALWAYS, Floor)                                                             \
-  X(floor, contact_pass, CONTACT_QUERIES, Named, CONTACT, CONTACT, Floor)                                              \
-  X(floor, contact_excess, CONTACT_QUERIES, Named, CONTACT, CONTACT, Floor)                                            \
-  X(floor, contact_share, CONTACT_QUERIES, Named, CONTACT, CONTACT, Floor)                                             \
-  X(floor, contact_step, PARTICLES, Threads, CONTACT, CONTACT, Floor)                                                  \
-  X(settle, contact_settle_check, CONSTRAINTS, Threads, SETTLE, SETTLE, Floor)                                         \
-  X(settle, contact_half_count, CONTACT_QUERIES, Settle, SETTLE, SETTLE, Floor)                                        \
-  X(settle, scan, CONTACT_HALF_CELLS, Threads, SETTLE, SETTLE, Floor)                                                  \
-  X(settle, contact_half_fill, CONTACT_QUERIES, Settle, SETTLE, SETTLE, Floor)                                         \
-  X(settle, contact_settle, SWEEPS, Sweep, SETTLE, SETTLE, Floor)                                                      \
-  X(tear, tear_mark, CONSTRAINTS, Threads, TICK, CONSTRAINTS, Tear)                                                    \
-  X(tear, tear_unsupported, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                       \
-  X(tear, tear_flags, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)                                             \
-  X(tear, scan, TEAR_SLOTS, Compaction, COMPACTION, CONSTRAINTS, Tear)                                                 \
-  X(tear, tear_compact, INDIRECT, Compaction, COMPACTION, CONSTRAINTS, Tear)
+  X(contact, contact_begin, ONE, Threads, ALWAYS, Contact)                                                             \
+  X(contact, contact_clear, CONTACT_SLOTS, Threads, ALWAYS, Contact)                                                   \
+  X(contact, contact_arm, ONE, Threads, ALWAYS, Contact)                                                               \
+  X(contact, contact_grid_clear, CONTACT_BUCKETS, Contact, ALWAYS, Contact)                                            \
+  X(contact, contact_count, CONTACT_BOXES, Contact, ALWAYS, Contact)                                                   \
+  X(contact, scan, CONTACT_CELLS, Contact, ALWAYS, Contact)                                                            \
+  X(contact, contact_scatter, CONTACT_BOXES, Contact, ALWAYS, Contact)                                                 \
+  X(contact, contact_cross, TRIANGLES, Cross, ALWAYS, Contact)                                                         \
+  X(contact, contact_near, CONTACT_QUERIES, Contact, ALWAYS, Contact)                                                  \
+  X(contact, contact_active, CONTACT_ACTIVE, Contact, ALWAYS, Contact)                                                 \
+  X(contact, scan, CONTACT_ACTIVE_CELLS, Contact, ALWAYS, Contact)                                                     \
+  X(contact, contact_emit, CONTACT_ACTIVE, Contact, ALWAYS, Contact)                                                   \
+  X(contact, contact_walk, CONTACT_QUERIES, Walk, ALWAYS, Contact)                                                     \
+  X(contact, contact_bound, PARTICLES, Threads, ALWAYS, Contact)                                                       \
+  X(integrate, air, PARTICLES, Threads, AIR, Integrate)                                                                \
+  X(integrate, integrate, PARTICLES, Threads, ALWAYS, Integrate)                                                       \
+  X(collide, candidates_check, PARTICLES, Threads, ALWAYS, Hash)                                                       \
+  X(collide, candidates_decide, HASH_ARGS, Threads, ALWAYS, Hash)                                                      \
+  X(collide, hash_count, PARTICLES, Hash, ALWAYS, Hash)                                                                \
+  X(collide, scan, HASH_CELLS, Hash, ALWAYS, Hash)                                                                     \
+  X(collide, hash_scatter, PARTICLES, Hash, ALWAYS, Hash)                                                              \
+  X(collide, hash_sort, PARTICLES, Hash, ALWAYS, Hash)                                                                 \
+  X(collide, collide, PARTICLES, Threads, ALWAYS, Collide)                                                             \
+  X(collide, candidates_finish, ONE, Threads, ALWAYS, Collide)                                                         \
+  X(collide, repel, PARTICLES, Threads, ALWAYS, Collide)                                                               \
+  X(project, project, COLOUR, Threads, ALWAYS, Project)                                                                \
+  X(shorten, shorten, COLOUR, Threads, ALWAYS, Project)                                                                \
+  X(limit, limit, RINGS, Threads, ALWAYS, Project)                                                                     \
+  X(crease, crease, HINGES, Threads, ALWAYS, Project)                                                                  \
+  X(floor, floor, PARTICLES, Threads, ALWAYS, Floor)                                                                   \
+  X(floor, contact_pass, CONTACT_QUERIES, Named, CONTACT, Floor)                                                       \
+  X(floor, contact_excess, CONTACT_QUERIES, Named, CONTACT, Floor)                                                     \
+  X(floor, contact_share, CONTACT_QUERIES, Named, CONTACT, Floor)                                                      \
+  X(floor, contact_step, PARTICLES, Threads, CONTACT, Floor)                                                           \
+  X(settle, contact_settle_check, CONSTRAINTS, Threads, ALWAYS, Floor)                                                 \
+  X(settle, contact_half_count, CONTACT_QUERIES, Settle, ALWAYS, Floor)                                                \
+  X(settle, scan, CONTACT_HALF_CELLS, Threads, ALWAYS, Floor)                                                          \
+  X(settle, contact_half_fill, CONTACT_QUERIES, Settle, ALWAYS, Floor)                                                 \
+  X(settle, contact_settle, SWEEPS, Sweep, ALWAYS, Floor)                                                              \
+  X(tear, tear_mark, CONSTRAINTS, Threads, ALWAYS, Tear)                                                               \
+  X(tear, tear_unsupported, INDIRECT, Compaction, ALWAYS, Tear)                                                        \
+  X(tear, tear_flags, INDIRECT, Compaction, ALWAYS, Tear)                                                              \
+  X(tear, scan, TEAR_SLOTS, Compaction, ALWAYS, Tear)                                                                  \
+  X(tear, tear_compact, INDIRECT, Compaction, ALWAYS, Tear)
 
-#define SIM_STAGE_ID(name, id, repeat, condition) SIM_CONST uint SIM_STAGE_##name = id;
+#define SIM_STAGE_ID(name, id, repeat, when) SIM_CONST uint SIM_STAGE_##name = id;
 SIM_STAGES(SIM_STAGE_ID)
 #undef SIM_STAGE_ID
 
-// A stage's condition and repeat as values (stagePasses)
-#define SIM_STAGE_RUNS_ALWAYS true
-#define SIM_STAGE_RUNS_COLLISION false
+/// True when the stretch limit first shortens the sheet's edges from both ends (the shorten stage)
+/// before its rings: nothing holds the sheet (no grab, no pins). The rings alone draw the sheet
+/// after their root, one-sidedly, and with no hand or pin to root them at, the free middle they
+/// root at keeps a crumpled ball moving: 1.8 to 3.5 units/s 8 s after a fast crumple
+/// (`bench/rest.py`, measured at 2bf6ebd).
+SIM_INLINE bool limitShortens(float reach, uint grab_index, uint flags) {
+  return reach > 0.0f && grab_index == SIM_NONE && (flags & SIM_FLAG_PINS) == 0u;
+}
+
+/// True when a sheet of `hinges` hinges creases at this yield (creaseReturn; 0: elastic).
+SIM_INLINE bool creasing(uint hinges, float yield0) { return hinges > 0u && yield0 > 0.0f; }
+
+/// The conditions (SIM_WHEN_* bits) a sheet's uniforms meet: its flags, the grabbed particle, its
+/// hinges and their yield angle, the stretch limit's reach, the contact radius and the settle's
+/// sweeps. What runs in a substep is decided here alone: the per-colour recorder, a fleet's gate,
+/// the fused tick, the kernels and the CPU ask stageRuns and runsWhen with these.
+SIM_INLINE uint stageConditions(uint flags, uint grab_index, uint hinges, float yield0, float reach, float contact,
+                                uint sweeps) {
+  uint when = SIM_WHEN_ALWAYS;
+  if ((flags & SIM_FLAG_COLLISION) != 0u) when |= SIM_WHEN_COLLISION;
+  if ((flags & SIM_FLAG_AIR) != 0u) when |= SIM_WHEN_AIR;
+  if (contact > 0.0f) when |= SIM_WHEN_CONTACT;
+  if (reach > 0.0f) when |= SIM_WHEN_LIMIT;
+  if (limitShortens(reach, grab_index, flags)) when |= SIM_WHEN_SHORTEN;
+  if (creasing(hinges, yield0)) when |= SIM_WHEN_CREASE;
+  if (contact > 0.0f && sweeps > 0u) when |= SIM_WHEN_SETTLE;
+  return when;
+}
+
+/// True when conditions `when` (stageConditions) meet all of `needs` (SIM_WHEN_* bits).
+SIM_INLINE bool runsWhen(uint needs, uint when) { return (when & needs) == needs; }
+
+/// What stage `stage` runs under (SIM_STAGES' when).
+SIM_INLINE uint stageNeeds(uint stage) {
+  uint needs = SIM_WHEN_ALWAYS;
+#define SIM_STAGE_NEEDS(name, id, repeat, when)                                                                        \
+  if (stage == id) needs = SIM_WHEN_##when;
+  SIM_STAGES(SIM_STAGE_NEEDS)
+#undef SIM_STAGE_NEEDS
+  return needs;
+}
+
+/// True when stage `stage` runs under conditions `when`.
+SIM_INLINE bool stageRuns(uint stage, uint when) { return runsWhen(stageNeeds(stage), when); }
+
+// A stage's repeat as a value (stagePasses)
 #define SIM_STAGE_REPEATS_ONCE false
 #define SIM_STAGE_REPEATS_COLOUR true
 
-/// Passes stage `stage` numbers in a substep of `iterations` x `colors` projections, with
-/// collision on or off (0: it does not run).
-SIM_INLINE uint stagePasses(uint stage, uint iterations, uint colors, bool collision) {
+/// Passes stage `stage` numbers in a substep of `iterations` x `colors` projections under
+/// conditions `when` (0: it does not run).
+SIM_INLINE uint stagePasses(uint stage, uint iterations, uint colors, uint when) {
   uint passes = 0u;
-#define SIM_STAGE_PASSES(name, id, repeat, condition)                                                                  \
-  if (stage == id && (SIM_STAGE_RUNS_##condition || collision))                                                        \
-    passes = SIM_STAGE_REPEATS_##repeat ? iterations * colors : 1u;
+#define SIM_STAGE_PASSES(name, id, repeat, needs)                                                                      \
+  if (stage == id && runsWhen(SIM_WHEN_##needs, when)) passes = SIM_STAGE_REPEATS_##repeat ? iterations * colors : 1u;
   SIM_STAGES(SIM_STAGE_PASSES)
 #undef SIM_STAGE_PASSES
   return passes;
@@ -192,9 +250,9 @@ SIM_INLINE uint stagePasses(uint stage, uint iterations, uint colors, bool colli
 
 /// Number within its substep of the first pass of stage `stage` (of SIM_STAGE_COUNT: the passes of
 /// a substep).
-SIM_INLINE uint stageFirstPass(uint stage, uint iterations, uint colors, bool collision) {
+SIM_INLINE uint stageFirstPass(uint stage, uint iterations, uint colors, uint when) {
   uint first = 0u;
-  for (uint k = 0u; k < stage; ++k) first += stagePasses(k, iterations, colors, collision);
+  for (uint k = 0u; k < stage; ++k) first += stagePasses(k, iterations, colors, when);
   return first;
 }
 
@@ -206,7 +264,7 @@ SIM_INLINE uvec2 groupGrid(uint groups) {
 }
 
 /// Passes one substep numbers.
-SIM_INLINE uint passesPerSubstep(uint iterations, uint colors, bool collision) {
-  return stageFirstPass(SIM_STAGE_COUNT, iterations, colors, collision);
+SIM_INLINE uint passesPerSubstep(uint iterations, uint colors, uint when) {
+  return stageFirstPass(SIM_STAGE_COUNT, iterations, colors, when);
 }
 #endif

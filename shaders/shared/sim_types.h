@@ -131,10 +131,10 @@ struct BatchArgs {
   uvec2 table;  // address (low, high 32 bits) of SIM_BATCH_ENTRIES uvec4: xy sheet 0's address, zw the stride
   uint first;   // the dispatch's sheet k (workgroup k of the fused tick, workgroup z = k of a pass) is queue[first + k]
   uint substep; // the pass's substep
-  uint gate;    // SIM_GATE_*: the sheets the pass runs for
-  uint gate_arg; // SIM_GATE_ITERATION: the iteration
+  uint when;    // the conditions its sheets meet (SIM_WHEN_* bits, stageConditions)
+  uint live;    // SIM_LIVE_*: its gate at run time
+  uint arg;     // SIM_LIVE_ITERATION: the iteration; SIM_LIVE_SWEEP: the sweep
   uint pad0;
-  uint pad1;
 };
 
 /// Push constants of the batched fused tick of a fleet (tick_batch.comp).

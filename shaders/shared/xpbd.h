@@ -279,9 +279,6 @@ SIM_INLINE uvec2 hingeTriangles(uint k, uint cols, uint rows) {
   return uvec2(2u * k, 2u * k + 1u);
 }
 
-/// True when a sheet of `hinges` hinges creases at this yield (creaseReturn; 0: elastic).
-SIM_INLINE bool creasing(uint hinges, float yield0) { return hinges > 0u && yield0 > 0.0f; }
-
 /// The signed angle of a hinge and its gradient (Bergou et al., Discrete Shells).
 struct HingeAngle {
   float angle; // radians in (-pi, pi]: 0 flat, positive when either corner moves along its triangle's normal

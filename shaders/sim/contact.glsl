@@ -1,4 +1,4 @@
-// The GPU's penetration-free contact, the contact_* passes of the integrate stage (contact.h has
+// The GPU's penetration-free contact, the contact_* passes of the contact stage (contact.h has
 // the maths and the proof). A hashed grid of the live triangles' and edges' boxes (count -> scan ->
 // scatter; cells as wide as the longest edge and the contact diameter, so a box spans two cells a
 // side at most) is built in a substep that needs it; the crossing check looks its triangles up in

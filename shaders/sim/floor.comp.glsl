@@ -12,7 +12,7 @@ void main() {
   uint i = threadIndex();
   if (i >= p.count) return;
   VerletState st = floorContact(pos[i], prev[i], u.floor_y, u.restitution, u.friction);
-  if (contactKeys().x > 0.0f) contactSlideClear(i);
+  if (runsWhen(SIM_WHEN_CONTACT, conditionsNow())) contactSlideClear(i);
   pos[i] = st.position;
   prev[i] = st.previous;
 }

@@ -85,8 +85,9 @@ void scanWorkgroup(uint mode, uint offset, uint count, uint sums) {
 // moves nothing (as contact_settle_check, contact_half_count, scan, contact_half_fill and
 // contact_settle). One loop over the five kinds of query, so that the shader holds one copy of
 // contactNear's body here, not two (NIR inlines every call, and a copy is a fifth of the kernel).
-// True when the run stops after the floor (`floor_pass`: its first pass).
-bool contactAfterFloor(uint s, uint n, uint floor_pass) {
+// The settle's part runs with `settle` (stageRuns). True when the run stops after the floor
+// (`floor_pass`: its first pass).
+bool contactAfterFloor(uint s, uint n, uint floor_pass, bool settle) {
   uint lid = gl_LocalInvocationID.x;
   uint queries = u.particle_count + contactEdgeCount();
   for (uint only = NEAR_PASS; only <= NEAR_HALF_FILL; ++only) {
@@ -101,7 +102,7 @@ bool contactAfterFloor(uint s, uint n, uint floor_pass) {
       }
       sync();
       if (stopsAfter(floor_pass)) return true;
-      if (contactChecks().y == 0u) return false;
+      if (!settle) return false;
       for (uint c = 0u; c < u.color_count; ++c) {
         uvec2 range = color_range[c];
         for (uint t = lid; t < range.y; t += kInvocations) contactSettleCheck(range.x + t, s);
@@ -168,14 +169,10 @@ void resetFrame(uint n) {
 }
 #endif
 
-// 1. Contact's bounds (with contact on), the air (as air.comp), then Verlet integration (as
-// integrate.comp)
-void integrateStage(uint s, uint n, float dt2) {
+// The air (as air.comp, with `air`), then Verlet integration (as integrate.comp)
+void integrateStage(uint s, uint n, float dt2, bool air) {
   uint lid = gl_LocalInvocationID.x;
-#ifdef SIM_FUSED_CONTACT
-  if (contactKeys().x > 0.0f) contactSubstep(s, n);
-#endif
-  if ((u.flags & SIM_FLAG_AIR) != 0u) {
+  if (air) {
     sync(); // the air reads the positions of other invocations' particles (loaded or moved)
     for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(airOnParticle(i), 0.0f);
     sync();
@@ -241,18 +238,17 @@ void collideStage(uint n) {
   }
 }
 
-// 3. Gauss-Seidel over colours (as project.comp), a barrier after each colour that projects in this
+// Gauss-Seidel over colours (as project.comp), a barrier after each colour that projects in this
 // iteration (projectsInIteration: the same for every invocation); with `shorten`, the shorten stage
-// (as shorten.comp): the colours with edges while nothing holds the sheet. True when the run stops
-// after one of the passes (numbered from `first`).
+// (as shorten.comp): the colours with edges. True when the run stops after one of the passes
+// (numbered from `first`).
 bool colourStage(bool shorten, uint first) {
   uint lid = gl_LocalInvocationID.x;
-  bool shortens = !shorten || limitShortens(u.limit.x, u.grab_index, u.flags);
   for (uint it = 0u; it < u.iterations; ++it)
     for (uint c = 0u; c < u.color_count; ++c) {
       uvec2 range = color_range[c];
       uint kind = range.y > 0u ? constraints[range.x].kind_id : 0u;
-      if (shortens && range.y > 0u && (shorten ? shortensColour(kind) : projectsInIteration(kind, it))) {
+      if (range.y > 0u && (shorten ? shortensColour(kind) : projectsInIteration(kind, it))) {
         for (uint t = lid; t < range.y; t += kInvocations) {
           if (shorten)
             shortenConstraint(constraints[range.x + t]);
@@ -266,34 +262,30 @@ bool colourStage(bool shorten, uint first) {
   return false;
 }
 
-// 5. The stretch limit (as limit.comp): ring after ring from the roots; 6. the creases (as
-// crease.comp). True when the run stops after the limit.
-bool limitAndCreaseStage(uint limit_pass) {
-  uint lid = gl_LocalInvocationID.x;
-  if (u.limit.x > 0.0f) {
-    uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
-    vec4 limit = u.limit; // read whole (limitParticle says why)
-    uint rings = uint(limit.z);
-    for (uint k = 1u; k <= rings; ++k) {
-      limitRing(roots, k, lid, kInvocations);
-      sync();
-    }
-  }
-  if (stopsAfter(limit_pass)) return true;
-  if (creasingNow()) {
-    for (uint k = lid; k < hingeKeys().y; k += kInvocations) creaseHinge(k);
+// The stretch limit (as limit.comp): ring after ring from the roots
+void limitStage() {
+  uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
+  vec4 limit = u.limit; // read whole (limitParticle says why)
+  uint rings = uint(limit.z);
+  for (uint k = 1u; k <= rings; ++k) {
+    limitRing(roots, k, gl_LocalInvocationID.x, kInvocations);
     sync();
   }
-  return false;
 }
 
-// 7. The floor (as floor.comp); with contact, the steps are then cut (contactAfterFloor)
-void floorStage(uint n) {
+// The creases (as crease.comp)
+void creaseStage() {
+  for (uint k = gl_LocalInvocationID.x; k < hingeKeys().y; k += kInvocations) creaseHinge(k);
+  sync();
+}
+
+// The floor (as floor.comp); with contact, the steps are then cut (contactAfterFloor)
+void floorStage(uint n, bool contact) {
   uint lid = gl_LocalInvocationID.x;
   for (uint i = lid; i < n; i += kInvocations) {
     VerletState st = floorContact(s_pos[i], prev[i], u.floor_y, u.restitution, u.friction);
 #ifdef SIM_FUSED_CONTACT
-    if (contactKeys().x > 0.0f) contactSlideClear(i);
+    if (contact) contactSlideClear(i);
 #endif
     s_pos[i] = st.position;
     prev[i] = st.previous;
@@ -301,7 +293,7 @@ void floorStage(uint n) {
   sync();
 }
 
-// 9. Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's live
+// Tear marking (as tear_mark.comp, which also visits the stale slots past each colour's live
 // count: those mark nothing); when something tore, the compaction (as tear_flags, scan,
 // tear_compact) in the same workgroup. A live constraint is never torn (the compaction of the
 // substep it tore in removed it), and kinds that cannot tear skip the position loads.
@@ -330,46 +322,57 @@ void tearStage() {
   sync();
 }
 
-// The stages of each substep of this dispatch, stopping where the run is cut short (stopsAfter:
-// each stage's first pass by SIM_STAGES).
+// The stages of each substep of this dispatch, those whose conditions hold (stageRuns), stopping
+// where the run is cut short (stopsAfter: each stage's first pass by SIM_STAGES).
 bool runSubsteps(uint n) {
-  bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
+  uint when = conditionsNow();
   bool tearing = tearingOn(u.tear_factor) && u.constraint_count > 0u;
   float dt2 = u.dt * u.dt;
   uint end = min(p.first_substep + p.substeps, substepCount(u.substeps));
-  uint per_substep = passesPerSubstep(u.iterations, u.color_count, collision);
-#define SIM_FIRST_PASS(stage) stageFirstPass(SIM_STAGE_##stage, u.iterations, u.color_count, collision)
+  uint per_substep = passesPerSubstep(u.iterations, u.color_count, when);
+#define SIM_RUNS(stage) stageRuns(SIM_STAGE_##stage, when)
   for (uint s = p.first_substep; s < end; ++s) {
-    uint first = s * per_substep;
-    integrateStage(s, n, dt2);
-    if (stopsAfter(first + SIM_FIRST_PASS(integrate))) return true;
+#define SIM_FIRST_PASS(stage) (s * per_substep + stageFirstPass(SIM_STAGE_##stage, u.iterations, u.color_count, when))
+#ifdef SIM_FUSED_CONTACT
+    if (SIM_RUNS(contact)) {
+      contactSubstep(s, n);
+      if (stopsAfter(SIM_FIRST_PASS(contact))) return true;
+    }
+#endif
+    integrateStage(s, n, dt2, runsWhen(SIM_WHEN_AIR, when));
+    if (stopsAfter(SIM_FIRST_PASS(integrate))) return true;
     // A new substep: no constraint torn in it yet (every invocation read the count of the last
     // substep before the barrier above).
     if (gl_LocalInvocationID.x == 0u) counters.torn_new = 0u;
-    if (collision) {
+    if (SIM_RUNS(collide)) {
       collideStage(n);
-      if (stopsAfter(first + SIM_FIRST_PASS(collide))) return true;
+      if (stopsAfter(SIM_FIRST_PASS(collide))) return true;
     }
-    if (colourStage(false, first + SIM_FIRST_PASS(project))) return true;
-    if (colourStage(true, first + SIM_FIRST_PASS(shorten))) return true;
-    if (limitAndCreaseStage(first + SIM_FIRST_PASS(limit))) return true;
-    if (stopsAfter(first + SIM_FIRST_PASS(crease))) return true;
-    floorStage(n);
+    if (colourStage(false, SIM_FIRST_PASS(project))) return true;
+    if (SIM_RUNS(shorten) && colourStage(true, SIM_FIRST_PASS(shorten))) return true;
+    if (SIM_RUNS(limit)) {
+      limitStage();
+      if (stopsAfter(SIM_FIRST_PASS(limit))) return true;
+    }
+    if (SIM_RUNS(crease)) {
+      creaseStage();
+      if (stopsAfter(SIM_FIRST_PASS(crease))) return true;
+    }
+    bool contact = runsWhen(SIM_WHEN_CONTACT, when);
+    floorStage(n, contact);
 #ifdef SIM_FUSED_CONTACT
-    // 7-8. With contact: the steps cut, and the settle stage with its sweeps on
-    if (contactKeys().x > 0.0f) {
-      if (contactAfterFloor(s, n, first + SIM_FIRST_PASS(floor))) return true;
-    } else if (stopsAfter(first + SIM_FIRST_PASS(floor))) {
-      return true;
-    }
+    // With contact: the steps cut, then the settle stage (its sweeps on) in the same loop
+    if (contact && contactAfterFloor(s, n, SIM_FIRST_PASS(floor), SIM_RUNS(settle))) return true;
+    if (!contact && stopsAfter(SIM_FIRST_PASS(floor))) return true;
 #else
-    if (stopsAfter(first + SIM_FIRST_PASS(floor))) return true;
+    if (stopsAfter(SIM_FIRST_PASS(floor))) return true;
 #endif
-    if (stopsAfter(first + SIM_FIRST_PASS(settle))) return true;
+    if (SIM_RUNS(settle) && stopsAfter(SIM_FIRST_PASS(settle))) return true;
     if (tearing) tearStage();
-    if (stopsAfter(first + SIM_FIRST_PASS(tear))) return true;
-  }
+    if (stopsAfter(SIM_FIRST_PASS(tear))) return true;
 #undef SIM_FIRST_PASS
+  }
+#undef SIM_RUNS
   return false;
 }
 

@@ -12,7 +12,7 @@
 #include "sim_elements.glsl"
 
 void main() {
-  if (!(u.limit.x > 0.0f)) return; // the same branch for the whole workgroup
+  if (!stageRuns(SIM_STAGE_limit, conditionsNow())) return; // the same branch for the whole workgroup
   uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
   vec4 limit = u.limit; // read whole (limitParticle says why)
   uint last = min(uint(limit.z), p.first + p.count - 1u);

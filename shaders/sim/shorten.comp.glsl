@@ -9,7 +9,7 @@
 #include "sim_elements.glsl"
 
 void main() {
-  if (!limitShortens(u.limit.x, u.grab_index, u.flags)) return; // the same branch for every invocation
+  if (!stageRuns(SIM_STAGE_shorten, conditionsNow())) return; // the same branch for every invocation
   uint t = threadIndex();
   uvec2 range = color_range[p.color];
   if (t >= range.y) return; // beyond the live count of this colour

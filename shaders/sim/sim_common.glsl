@@ -212,9 +212,10 @@ uvec4 contactGrid() { return u.contact_grid; }
 uvec4 hingeKeys() { return u.hinge; }
 uvec4 walkArgs() { return hash_args[SIM_CONTACT_WALK_ARGS]; }
 uvec4 crossArgs() { return hash_args[SIM_CONTACT_CROSS_ARGS]; }
-bool creasingNow() {
+// The conditions this sheet's uniforms meet (stageConditions: what runs in a substep).
+uint conditionsNow() {
   vec4 crease = u.crease;
-  return creasing(hingeKeys().y, crease.y);
+  return stageConditions(u.flags, u.grab_index, hingeKeys().y, crease.y, u.limit.x, contactKeys().x, contactChecks().y);
 }
 
 // Linear index of this invocation; grids wider than SIM_MAX_GROUPS_X spill into Y.
@@ -260,40 +261,29 @@ uint compactSlots() { return u.constraint_count + u.triangle_count + 1u; }
 
 #ifdef SIM_BATCH_PASS
 // A per-colour pass of a fleet: workgroup z works on the sheet at queue[batch.first + z], when the
-// pass's gate takes it (SIM_GATE_* in sim_config.h); the pass's own main() follows as simPassMain.
+// pass's gate takes it (BatchArgs: its conditions, SIM_LIVE_* in sim_config.h); the pass's own main()
+// follows as simPassMain.
 bool batchGateTakes() {
-  if (batch.gate == SIM_GATE_RESET) return u.reset_active != 0u;
+  if (batch.live == SIM_LIVE_RESET) return u.reset_active != 0u;
   if (u.reset_active != 0u || batch.substep >= substepCount(u.substeps)) return false;
-  bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
-  switch (batch.gate) {
-  case SIM_GATE_AIR:
-    return (u.flags & SIM_FLAG_AIR) != 0u;
-  case SIM_GATE_ITERATION:
-    return batch.gate_arg < u.iterations;
-  case SIM_GATE_COLLISION:
-    return collision;
-  case SIM_GATE_HASH:
-    return collision && collideModeNow() != SIM_COLLIDE_CANDIDATES;
-  case SIM_GATE_COMPACTION:
+  if (!runsWhen(batch.when, conditionsNow())) return false;
+  switch (batch.live) {
+  case SIM_LIVE_ITERATION:
+    return batch.arg < u.iterations;
+  case SIM_LIVE_HASH:
+    return collideModeNow() != SIM_COLLIDE_CANDIDATES;
+  case SIM_LIVE_COMPACTION:
     return counters.compact_dispatch.x != 0u;
-  case SIM_GATE_CREASE:
-    return creasingNow();
-  case SIM_GATE_LIMIT:
-    return u.limit.x > 0.0f;
-  case SIM_GATE_SHORTEN:
-    return limitShortens(u.limit.x, u.grab_index, u.flags) && batch.gate_arg < u.iterations;
-  // Contact's passes: those a sheet alone records, and of its indirect ones those its own
-  // arguments give workgroups (contact_arm set them; they stand through the substep)
-  case SIM_GATE_CONTACT:
-    return contactKeys().x > 0.0f;
-  case SIM_GATE_CONTACT_GRID:
-    return contactKeys().x > 0.0f && contact_words[SIM_CONTACT_WORD_GRID] != 0u;
-  case SIM_GATE_CONTACT_WALK:
-    return contactKeys().x > 0.0f && walkArgs().x != 0u;
-  case SIM_GATE_CONTACT_CROSS:
-    return contactKeys().x > 0.0f && crossArgs().x != 0u;
-  case SIM_GATE_SETTLE:
-    return contactKeys().x > 0.0f && batch.gate_arg < contactChecks().y;
+  // Contact's indirect passes: those its own arguments give workgroups (contact_arm set them;
+  // they stand through the substep)
+  case SIM_LIVE_CONTACT_GRID:
+    return contact_words[SIM_CONTACT_WORD_GRID] != 0u;
+  case SIM_LIVE_CONTACT_WALK:
+    return walkArgs().x != 0u;
+  case SIM_LIVE_CONTACT_CROSS:
+    return crossArgs().x != 0u;
+  case SIM_LIVE_SWEEP:
+    return batch.arg < contactChecks().y;
   default:
     return true;
   }

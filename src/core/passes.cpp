@@ -12,31 +12,29 @@ using namespace shaderio;
 
 namespace {
 
-bool collisionOn(const shaderio::SimUniforms& u) { return (u.flags & SIM_FLAG_COLLISION) != 0u; }
-
 uint32_t perSubstep(const shaderio::SimUniforms& u) {
-  return passesPerSubstep(u.iterations, u.color_count, collisionOn(u));
+  return passesPerSubstep(u.iterations, u.color_count, conditionsOf(u));
 }
 
 uint32_t stagePassesOf(const shaderio::SimUniforms& u, uint32_t stage) {
-  return stagePasses(stage, u.iterations, u.color_count, collisionOn(u));
+  return stagePasses(stage, u.iterations, u.color_count, conditionsOf(u));
 }
 
 /// The names of the stages, in SIM_STAGES order.
 constexpr const char* kStageNames[] = {
-#define TENDER_STAGE_NAME(name, id, repeat, condition) #name,
+#define TENDER_STAGE_NAME(name, id, repeat, when) #name,
     SIM_STAGES(TENDER_STAGE_NAME)
 #undef TENDER_STAGE_NAME
 };
 static_assert(std::size(kStageNames) == SIM_STAGE_COUNT);
 /// Stages numbered once per colour of each iteration (a pass of one names its iteration and colour).
 constexpr bool kPerColour[] = {
-#define TENDER_STAGE_PER_COLOUR(name, id, repeat, condition) SIM_STAGE_REPEATS_##repeat,
+#define TENDER_STAGE_PER_COLOUR(name, id, repeat, when) SIM_STAGE_REPEATS_##repeat,
     SIM_STAGES(TENDER_STAGE_PER_COLOUR)
 #undef TENDER_STAGE_PER_COLOUR
 };
 bool perColour(PassKind kind) { return kind != PassKind::reset && kPerColour[uint32_t(kind)]; }
-#define TENDER_STAGE_ORDER(name, id, repeat, condition) static_assert(std::string_view(kStageNames[id]) == #name);
+#define TENDER_STAGE_ORDER(name, id, repeat, when) static_assert(std::string_view(kStageNames[id]) == #name);
 SIM_STAGES(TENDER_STAGE_ORDER)
 #undef TENDER_STAGE_ORDER
 
@@ -58,6 +56,10 @@ std::vector<std::string> split(const std::string& s, char sep) {
 }
 
 } // namespace
+
+uint32_t conditionsOf(const shaderio::SimUniforms& u) {
+  return stageConditions(u.flags, u.grab_index, u.hinge.y, u.crease.y, u.limit.x, u.contact.x, u.contact_check.y);
+}
 
 uint32_t passesPerTick(const shaderio::SimUniforms& u) {
   return u.reset_active ? 1u : substepCount(u.substeps) * perSubstep(u);
@@ -97,7 +99,7 @@ std::optional<uint32_t> passIndex(const shaderio::SimUniforms& u, const PassPoin
     if (p.iteration >= u.iterations || p.color >= u.color_count) return std::nullopt;
     within = p.iteration * u.color_count + p.color;
   }
-  return p.substep * perSubstep(u) + stageFirstPass(stage, u.iterations, u.color_count, collisionOn(u)) + within;
+  return p.substep * perSubstep(u) + stageFirstPass(stage, u.iterations, u.color_count, conditionsOf(u)) + within;
 }
 
 std::string describePass(const PassPoint& p) {

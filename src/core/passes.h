@@ -12,7 +12,7 @@ namespace tender {
 
 /// A stage of a substep (SIM_STAGES, in its order), or the one pass of a reset frame.
 enum class PassKind : uint8_t {
-#define TENDER_PASS_KIND(name, id, repeat, condition) name = id,
+#define TENDER_PASS_KIND(name, id, repeat, when) name = id,
   SIM_STAGES(TENDER_PASS_KIND)
 #undef TENDER_PASS_KIND
       reset
@@ -26,6 +26,9 @@ struct PassPoint {
   bool operator==(const PassPoint&) const = default;
 };
 
+/// The conditions a sheet with these uniforms meets (SIM_WHEN_* bits, stageConditions in
+/// sim_passes.h): which stages and dispatches of a substep run.
+uint32_t conditionsOf(const shaderio::SimUniforms& u);
 /// Passes of a tick with these uniforms (a reset frame: its one pass).
 uint32_t passesPerTick(const shaderio::SimUniforms& u);
 /// The pass at `index` (< passesPerTick(u)) of a tick.

@@ -101,10 +101,9 @@ void CpuSolver::airPass(const SimUniforms& u) {
   });
 }
 
-void CpuSolver::integrate(const SimUniforms& u, uint32_t s) {
+void CpuSolver::integrate(const SimUniforms& u, uint32_t s, bool air) {
   const float dt2 = u.dt * u.dt;
   const vec4 wind = u.wind[s], twist = u.wind_twist[s], target = u.grab_target[s], grab_prev = u.grab_prev[s];
-  const bool air = (u.flags & SIM_FLAG_AIR) != 0u;
   if (air) airPass(u);
   // integrateParticle in two loops: with the hand's pull in it, the step's loop cost twice as much
   const float damping = substepDamping(u.damping, u.verlet, s);
@@ -185,7 +184,6 @@ const std::vector<uint32_t>& CpuSolver::countColourEdges() {
 
 void CpuSolver::shortenColors(const SimUniforms& u, uint32_t first, uint32_t count) {
   const uint32_t colors = uint32_t(colors_.size());
-  if (colors == 0 || !limitShortens(u.limit.x, u.grab_index, u.flags)) return;
   SheetElements e = elements(u);
   // The stage visits the run of structural edges at the head of each colour alone
   const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
@@ -214,7 +212,6 @@ void CpuSolver::shortenColors(const SimUniforms& u, uint32_t first, uint32_t cou
 }
 
 void CpuSolver::creasePass(const SimUniforms& u) {
-  if (!creasing(u.hinge.y, u.crease.y)) return;
   SheetElements e = elements(u);
   pool_->parallelFor(u.hinge.y, grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
     uint32_t k = begin;
@@ -226,7 +223,6 @@ void CpuSolver::creasePass(const SimUniforms& u) {
 }
 
 void CpuSolver::limitPass(const SimUniforms& u) {
-  if (!(u.limit.x > 0.0f)) return;
   SheetElements e = elements(u);
   // A particle's place depends on its parents' alone, so any order that places the parents first
   // gives the bits of the GPU's rings: row by row outwards from the root's row, each row outwards
@@ -272,8 +268,7 @@ void CpuSolver::repelPass(const SimUniforms& u) {
   });
 }
 
-void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
-  const bool contact = u.contact.x > 0.0f;
+void CpuSolver::floorPass(const SimUniforms& u, uint32_t s, bool contact) {
   const vec3 frame = contact ? contact_.frame() : vec3(0.0f);
   const uint32_t n = uint32_t(pos_.size());
   pool_->parallelFor(n, grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
@@ -303,7 +298,6 @@ void CpuSolver::floorPass(const SimUniforms& u, uint32_t s) {
 // of each colour, contact_check.y times; none when no edge is over the limit, and no more after a
 // sweep that moved nothing (the next would move nothing either: the bits are the same).
 void CpuSolver::settlePass(const SimUniforms& u, uint32_t s) {
-  if (!(u.contact.x > 0.0f) || u.contact_check.y == 0) return;
   const uint32_t colors = uint32_t(colors_.size());
   const uint32_t *ca = con_a_.data(), *cb = con_b_.data(), *kind = con_kind_.data(), *id = con_id_.data();
   const float* rest = con_rest_.data();
@@ -371,7 +365,8 @@ void CpuSolver::tick(const SimUniforms& u) {
     passes_per_tick_ = 1;
     return;
   }
-  const bool collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
+  const uint32_t when = conditionsOf(u); // the stages that run (stageConditions)
+  contact_on_ = runsWhen(SIM_WHEN_CONTACT, when);
   std::optional<uint32_t> plant_at;
   if (plant_ && plant_->tick == tick) plant_at = passIndex(u, plant_->pass);
   const uint32_t plant = plant_at.value_or(SIM_NONE);
@@ -385,16 +380,17 @@ void CpuSolver::tick(const SimUniforms& u) {
     }
     return stop == pass - 1;
   };
-  // The stages of each substep in their order (SIM_STAGES), a stage of several passes (one per
-  // colour of each iteration) in runs that end where the tick stops or a change is planted
+  // The stages of each substep in their order (SIM_STAGES), those whose conditions hold, a stage of
+  // several passes (one per colour of each iteration) in runs that end where the tick stops or a
+  // change is planted
   for (uint32_t s = 0; s < substepCount(u.substeps); ++s)
     for (uint32_t stage = 0; stage < SIM_STAGE_COUNT; ++stage) {
-      const uint32_t passes = stagePasses(stage, u.iterations, uint32_t(colors_.size()), collision);
+      const uint32_t passes = stagePasses(stage, u.iterations, uint32_t(colors_.size()), when);
       for (uint32_t done = 0; done < passes;) {
         uint32_t run = passes - done;
         for (uint32_t cut : {stop, plant})
           if (cut >= pass && cut - pass < run) run = cut - pass + 1;
-        runStage(PassKind(stage), u, s, done, run);
+        runStage(PassKind(stage), u, when, s, done, run);
         done += run;
         if (passed(run)) return;
       }
@@ -402,15 +398,15 @@ void CpuSolver::tick(const SimUniforms& u) {
   passes_per_tick_ = passesPerTick(u);
 }
 
-void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint32_t first, uint32_t count) {
+void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t when, uint32_t s, uint32_t first,
+                         uint32_t count) {
   switch (stage) {
+  case PassKind::contact: // the step bounds of the substep, from where the particles start it
+    contact_.computeBounds(pos_, prev_, triangles_, triangle_count_, u, s, bound_, push_);
+    start_ = pos_;
+    break;
   case PassKind::integrate:
-    contact_on_ = u.contact.x > 0.0f;
-    if (contact_on_) { // the step bounds of the substep, from where the particles start it
-      contact_.computeBounds(pos_, prev_, triangles_, triangle_count_, u, s, bound_, push_);
-      start_ = pos_;
-    }
-    integrate(u, s); // the air, then damped Verlet, gravity, wind; pins and the grab hold
+    integrate(u, s, runsWhen(SIM_WHEN_AIR, when)); // the air, then damped Verlet, gravity, wind; pins and the grab hold
     break;
   case PassKind::project:
     projectColors(u, first, count); // Gauss-Seidel over the colours
@@ -429,7 +425,7 @@ void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t s, uint3
     repelPass(u); // which the free particles take before the projection
     break;
   case PassKind::floor:
-    floorPass(u, s); // the ground contact; bound the steps
+    floorPass(u, s, runsWhen(SIM_WHEN_CONTACT, when)); // the ground contact; with contact, the steps cut
     break;
   case PassKind::settle:
     settlePass(u, s); // over-long edges shortened within the steps' bounds

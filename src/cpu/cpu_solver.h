@@ -77,10 +77,11 @@ public:
   // The passes of one substep, public so tests can drive them one by one.
   /// Passes [first, first + count) of stage `stage` (SIM_STAGES) of substep `substep`: what a
   /// tick runs for that stage (count > 1 only for a stage numbered once per colour).
-  void runStage(PassKind stage, const shaderio::SimUniforms& u, uint32_t substep, uint32_t first, uint32_t count);
+  void runStage(PassKind stage, const shaderio::SimUniforms& u, uint32_t when, uint32_t substep, uint32_t first,
+                uint32_t count);
   /// Verlet integration with gravity, wind, damping (and, with SIM_FLAG_AIR, the air on each
   /// particle, from airPass first); pins and the grab hold their particles.
-  void integrate(const shaderio::SimUniforms& u, uint32_t substep);
+  void integrate(const shaderio::SimUniforms& u, uint32_t substep, bool air);
   /// The air on each particle (airOnParticle in sim_elements.glsl), from the positions and previous
   /// positions of the start of the substep.
   void airPass(const shaderio::SimUniforms& u);
@@ -104,7 +105,7 @@ public:
   void repelPass(const shaderio::SimUniforms& u);
   /// The ground contact; with contact on (SimUniforms::contact),
   /// no free particle ends farther from where it started the substep than its bound (contact.h).
-  void floorPass(const shaderio::SimUniforms& u, uint32_t substep);
+  void floorPass(const shaderio::SimUniforms& u, uint32_t substep, bool contact);
   /// The settle stage, with contact and its sweeps on (SimUniforms::contact_check.y): the
   /// half-spaces listed by particle, then the sweeps over the structural edges of each colour.
   void settlePass(const shaderio::SimUniforms& u, uint32_t s);

@@ -216,9 +216,9 @@ void GpuBatch::finish() {
 }
 
 void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
-                    uint32_t substep, uint32_t gate, uint32_t gate_arg) {
+                    uint32_t substep, const PassGate& gate) {
   if (pass_sheet_ >= 0) {
-    passOfSheet(uint32_t(pass_sheet_), p, grid, count, push, push_size, gate_arg);
+    passOfSheet(uint32_t(pass_sheet_), p, grid, count, push, push_size, gate.arg);
     return;
   }
   if (push_size > sizeof(SimPush) || p.push_size != sizeof(BatchPassPush))
@@ -230,15 +230,16 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
                        grid == Grid::Sweep;
   if ((counted || grid == Grid::Walk || grid == Grid::Cross || grid == Grid::Named) && count == 0) return;
   const glm::uvec4 full = fullGrid(p, counted ? count : 1u, pass_sheets_);
-  const uint32_t hash_dispatch = hash_grids_.record(grid, full, gate_arg);
+  const uint32_t hash_dispatch = hash_grids_.record(grid, full, gate.arg);
   BatchPassPush bp{};
   if (push_size) std::memcpy(&bp.pass, push, push_size);
   const VkDeviceAddress table = table_address_;
   bp.batch.table = glm::uvec2(uint32_t(table), uint32_t(table >> 32));
   bp.batch.first = pass_first_;
   bp.batch.substep = substep;
-  bp.batch.gate = gate;
-  bp.batch.gate_arg = gate_arg;
+  bp.batch.when = gate.when;
+  bp.batch.live = gate.live;
+  bp.batch.arg = gate.arg;
   if (bound_ != p.pipeline) {
     vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
     bound_ = p.pipeline;
@@ -283,14 +284,14 @@ void GpuBatch::pass(const ComputePipeline& p, Grid grid, uint32_t count, const v
 }
 
 void GpuBatch::passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
-                           uint32_t push_size, uint32_t gate_arg) {
+                           uint32_t push_size, uint32_t arg) {
   const SheetPassTarget target{cmd_,
                                sheet_layout_,
                                buf_[SIM_BIND_HASH_ARGS].buffer,
                                sliceOffset(SIM_BIND_HASH_ARGS, i),
                                buf_[SIM_BIND_COUNTERS].buffer,
                                sliceOffset(SIM_BIND_COUNTERS, i)};
-  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size, gate_arg)) ++last_dispatches_;
+  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size, arg)) ++last_dispatches_;
 }
 
 void GpuBatch::barrier() { computeToCompute(cmd_); }

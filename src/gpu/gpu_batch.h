@@ -93,10 +93,10 @@ private:
   void recordBatchedPasses(const FlushQueue& f);
   // PassSink: a pass of the per-colour path for the sheets at queue[pass_first_, + pass_sheets_)
   void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t substep,
-            uint32_t gate, uint32_t gate_arg) override;
+            const PassGate& gate) override;
   /// PerSheet: a pass of sheet i on its descriptor set (bound), as the solver dispatches it.
   void passOfSheet(uint32_t i, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
-                   uint32_t push_size, uint32_t gate_arg);
+                   uint32_t push_size, uint32_t arg);
   void barrier() override;
   void mark(PassCategory) override {}
   /// Allocates every buffer for the batch from the first sheet's topology.

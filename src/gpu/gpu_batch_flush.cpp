@@ -141,7 +141,7 @@ void GpuBatch::recordSheetPasses(const FlushQueue& f) {
     uint32_t count = 0;
     if (u.reset_active) {
       const SimPush all{0, n, 0, 0};
-      pass(sheet_passes_.reset, Grid::Threads, n, &all, sizeof(all), 0, SIM_GATE_RESET, 0);
+      pass(sheet_passes_.reset, Grid::Threads, n, &all, sizeof(all), 0, PassGate{SIM_WHEN_ALWAYS, SIM_LIVE_RESET, 0});
       continue;
     }
     const SubstepPlan sheet_plan = substepPlan(u);
@@ -164,7 +164,7 @@ void GpuBatch::recordBatchedPasses(const FlushQueue& f) {
   const uint32_t n = topo_.particleCount();
   if (f.resets) {
     const SimPush all{0, n, 0, 0};
-    pass(passes_.reset, Grid::Threads, n, &all, sizeof(all), 0, SIM_GATE_RESET, 0);
+    pass(passes_.reset, Grid::Threads, n, &all, sizeof(all), 0, PassGate{SIM_WHEN_ALWAYS, SIM_LIVE_RESET, 0});
     barrier();
   }
   uint32_t count = 0;
@@ -207,9 +207,9 @@ void GpuBatch::flush() {
   if (!f.fused_contact.empty() && !tick_batch_contact_.pipeline)
     tick_batch_contact_ = makeComputePipeline(ctx_, "tick_batch_contact.comp", {layout_, "batch"}, float_rules_, math_,
                                               sizeof(BatchPush), 1, fused_workgroup_, true);
-  if (f.plan.contact && per_sheet_)
+  if (runsWhen(SIM_WHEN_CONTACT, f.plan.when) && per_sheet_)
     addContactPipelines(ctx_, {sheet_layout_, "sheet"}, float_rules_, math_, std::nullopt, sheet_passes_);
-  else if (f.plan.contact)
+  else if (runsWhen(SIM_WHEN_CONTACT, f.plan.when))
     addContactPipelines(ctx_, {layout_, "batch"}, float_rules_, math_, std::nullopt, passes_, true);
 
   VkCommandBufferBeginInfo bi{};

@@ -16,9 +16,9 @@ void GpuSolver::bindSet(VkCommandBuffer cmd, uint32_t uniform_index) {
 }
 
 void GpuSolver::dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
-                         uint32_t push_size, uint32_t gate_arg) {
+                         uint32_t push_size, uint32_t arg) {
   const SheetPassTarget target{cmd, layout_, buf_[SIM_BIND_HASH_ARGS].buffer, 0, buf_[SIM_BIND_COUNTERS].buffer, 0};
-  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size, gate_arg)) ++recorded_dispatches_;
+  if (recordSheetPass(target, bound_, hash_grids_, p, grid, count, push, push_size, arg)) ++recorded_dispatches_;
 }
 
 void GpuSolver::timestamp(VkCommandBuffer cmd, InFlight& flight, PassCategory c) {
@@ -31,9 +31,9 @@ void GpuSolver::timestamp(VkCommandBuffer cmd, InFlight& flight, PassCategory c)
 }
 
 void GpuSolver::pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
-                     uint32_t, uint32_t, uint32_t gate_arg) {
+                     uint32_t, const PassGate& gate) {
   // One sheet: it runs every pass recorded for it
-  dispatch(recording_->tick, p, grid, count, push, push_size, gate_arg);
+  dispatch(recording_->tick, p, grid, count, push, push_size, gate.arg);
 }
 
 void GpuSolver::barrier() { computeToCompute(recording_->tick); }
@@ -58,13 +58,13 @@ void GpuSolver::recordTick(InFlight& flight, uint32_t index, const RecordKey& ke
   if (key.fused) {
     // Small sheet: every pass of fused_substeps_ substeps (on a GPU: all) in one workgroup
     const SubstepPlan& plan = key.plan;
-    const uint32_t per = passesPerSubstep(plan.iterations, topo_.colorCount(), plan.collision);
+    const uint32_t per = passesPerSubstep(plan.iterations, topo_.colorCount(), plan.when);
     const uint32_t step = fused_substeps_;
     for (uint32_t s = 0; s < key.substeps; s += step) {
       if (s > 0) computeToCompute(cmd);
       const uint32_t count = std::min(step, key.substeps - s);
-      dispatch(cmd, plan.contact ? pipes_.tick_fused_contact : pipes_.tick_fused, Grid::Workgroup, 1,
-               FusedPush{n, s, count, plan.stop});
+      dispatch(cmd, runsWhen(SIM_WHEN_CONTACT, plan.when) ? pipes_.tick_fused_contact : pipes_.tick_fused,
+               Grid::Workgroup, 1, FusedPush{n, s, count, plan.stop});
       timestamp(cmd, flight, kFused);
       if (plan.stop != SIM_NONE && plan.stop < (s + count) * per) break;
     }

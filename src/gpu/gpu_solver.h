@@ -162,7 +162,7 @@ private:
   void recordTick(InFlight& flight, uint32_t index, const RecordKey& key);
   // PassSink: the passes of the per-colour path go to the tick being recorded (recording_)
   void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t substep,
-            uint32_t gate, uint32_t gate_arg) override;
+            const PassGate& gate) override;
   void barrier() override;
   void mark(PassCategory c) override;
   void recordReset(InFlight& flight, uint32_t index);
@@ -171,9 +171,9 @@ private:
   /// The one dispatch helper: binds the pipeline, checks and pushes the constants, and dispatches
   /// `count` elements (Threads), one workgroup (Workgroup), or the grid of an indirect argument
   /// (Compaction, Hash: the next hash dispatch's live arguments, whose full grid candidates_decide copies in;
-  /// Sweep: those of the settle sweep `gate_arg` names).
+  /// Sweep: those of the settle sweep `arg` names).
   void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const void* push,
-                uint32_t push_size, uint32_t gate_arg = 0);
+                uint32_t push_size, uint32_t arg = 0);
   template <class Push>
   void dispatch(VkCommandBuffer cmd, const ComputePipeline& p, Grid grid, uint32_t count, const Push& push) {
     dispatch(cmd, p, grid, count, &push, uint32_t(sizeof(Push)));

@@ -1,5 +1,7 @@
 #include "gpu/substep_passes.h"
 
+#include "core/passes.h"
+
 #include <algorithm>
 #include <iterator>
 #include <optional>
@@ -12,14 +14,14 @@ glm::uvec4 fullGrid(const ComputePipeline& p, uint32_t count, uint32_t sheets) {
   return glm::uvec4(groupGrid((count + p.workgroup - 1) / p.workgroup), sheets, 0u);
 }
 
-uint32_t HashGrids::record(Grid grid, glm::uvec4 full, uint32_t gate_arg) {
+uint32_t HashGrids::record(Grid grid, glm::uvec4 full, uint32_t arg) {
   if (grid == Grid::Cross || grid == Grid::Named) return 0; // own slots, amid the contact grid's passes
   if (grid == Grid::Settle) return SIM_CONTACT_SETTLE_ARGS; // armed with the named queries' grid
-  if (grid == Grid::Sweep) {                                // sweep gate_arg's slot; every sweep has the same full grid
+  if (grid == Grid::Sweep) {                                // sweep arg's slot; every sweep has the same full grid
     if (sweep_grid_ == glm::uvec4(0u)) sweep_grid_ = full;
-    if (sweep_grid_ != full || gate_arg >= SIM_SETTLE_MAX_SWEEPS)
+    if (sweep_grid_ != full || arg >= SIM_SETTLE_MAX_SWEEPS)
       vkCheckFailed(VK_ERROR_UNKNOWN, "settle grid", __FILE__, __LINE__);
-    return SIM_CONTACT_SETTLE_ARGS + 1 + gate_arg;
+    return SIM_CONTACT_SETTLE_ARGS + 1 + arg;
   }
   if (grid != Grid::Hash && grid != Grid::Contact) {
     next_ = next_contact_ = 0;
@@ -36,11 +38,11 @@ uint32_t HashGrids::record(Grid grid, glm::uvec4 full, uint32_t gate_arg) {
 }
 
 bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& hash_grids, const ComputePipeline& p,
-                     Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t gate_arg) {
+                     Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t arg) {
   if (push_size != p.push_size) vkCheckFailed(VK_ERROR_UNKNOWN, "push constant size", __FILE__, __LINE__);
   if (grid != Grid::Workgroup && grid != Grid::Compaction && grid != Grid::Hash && count == 0) return false;
   const glm::uvec4 full = fullGrid(p, count);
-  const uint32_t hash_dispatch = hash_grids.record(grid, full, gate_arg);
+  const uint32_t hash_dispatch = hash_grids.record(grid, full, arg);
   if (bound != p.pipeline) {
     vkCmdBindPipeline(t.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
     bound = p.pipeline;
@@ -105,8 +107,12 @@ enum class Elements : uint8_t {
   CONTACT_HALF_CELLS,
   SWEEPS
 };
-/// When a sheet records a dispatch (SIM_DISPATCHES' needs column).
-enum class Needs : uint8_t { ALWAYS, AIR, CREASE, LIMIT, SHORTEN, CONSTRAINTS, CONTACT, SETTLE };
+/// What each stage runs under (SIM_STAGES' when column).
+constexpr uint32_t kStageNeeds[] = {
+#define TENDER_STAGE_NEEDS(name, id, repeat, when) SIM_WHEN_##when,
+    SIM_STAGES(TENDER_STAGE_NEEDS)
+#undef TENDER_STAGE_NEEDS
+};
 
 /// One row of SIM_DISPATCHES.
 struct Dispatch {
@@ -114,18 +120,43 @@ struct Dispatch {
   ComputePipeline SimPipelines::*kernel;
   Elements elements;
   Grid grid;
-  uint32_t gate;
-  Needs needs;
+  uint32_t when; ///< SIM_WHEN_* bits: its stage's and its own
   PassCategory category;
 };
 
 constexpr Dispatch kDispatches[] = {
-#define TENDER_DISPATCH(stage, kernel, elements, grid, gate, needs, category)                                          \
-  {SIM_STAGE_##stage, &SimPipelines::kernel, Elements::elements, Grid::grid,                                           \
-   SIM_GATE_##gate,   Needs::needs,          k##category},
+#define TENDER_DISPATCH(stage, kernel, elements, grid, when, category)                                                 \
+  {SIM_STAGE_##stage,                                                                                                  \
+   &SimPipelines::kernel,                                                                                              \
+   Elements::elements,                                                                                                 \
+   Grid::grid,                                                                                                         \
+   kStageNeeds[SIM_STAGE_##stage] | SIM_WHEN_##when,                                                                   \
+   k##category},
     SIM_DISPATCHES(TENDER_DISPATCH)
 #undef TENDER_DISPATCH
 };
+
+/// The run-time gate of a row's pass in a fleet: the grids armed at run time take a sheet whose
+/// own arguments would have given it workgroups; a colour's pass, a sheet with its iteration; a
+/// sweep's, a sheet with that sweep.
+constexpr uint32_t liveGate(const Dispatch& d) {
+  switch (d.grid) {
+  case Grid::Hash:
+    return SIM_LIVE_HASH;
+  case Grid::Compaction:
+    return SIM_LIVE_COMPACTION;
+  case Grid::Contact:
+    return SIM_LIVE_CONTACT_GRID;
+  case Grid::Walk:
+    return SIM_LIVE_CONTACT_WALK;
+  case Grid::Cross:
+    return SIM_LIVE_CONTACT_CROSS;
+  case Grid::Sweep:
+    return SIM_LIVE_SWEEP;
+  default:
+    return d.elements == Elements::COLOUR ? SIM_LIVE_ITERATION : SIM_LIVE_NONE;
+  }
+}
 static_assert(std::is_sorted(std::begin(kDispatches), std::end(kDispatches),
                              [](const Dispatch& a, const Dispatch& b) { return a.stage < b.stage; }),
               "SIM_DISPATCHES lists the stages in SIM_STAGES order");
@@ -138,13 +169,13 @@ constexpr bool closesCategory(size_t row) {
 
 template <class Push>
 void record(PassSink& sink, const ComputePipeline& p, Grid grid, uint32_t count, const Push& push, uint32_t s,
-            uint32_t gate, uint32_t gate_arg = 0) {
-  sink.pass(p, grid, count, &push, uint32_t(sizeof(Push)), s, gate, gate_arg);
+            const PassGate& gate) {
+  sink.pass(p, grid, count, &push, uint32_t(sizeof(Push)), s, gate);
 }
 
 /// Exclusive scan: block scans, then (several blocks) scan the block sums and add them back.
 void recordScan(PassSink& sink, const SimPipelines& pipes, uint32_t mode, uint32_t offset, uint32_t count,
-                uint32_t sums, Grid grid, uint32_t s, uint32_t gate) {
+                uint32_t sums, Grid grid, uint32_t s, const PassGate& gate) {
   const uint32_t blocks = (count + SIM_SCAN_BLOCK - 1) / SIM_SCAN_BLOCK;
   const ScanPush push{mode, offset, count, sums};
   record(sink, pipes.scan, grid, count, push, s, gate);
@@ -208,13 +239,14 @@ std::optional<ScanRange> scanRange(Elements e, const SheetTopology& topo, const 
 /// or one that does not project in this iteration (projectsInIteration), records nothing; nor, in
 /// the shorten stage, does a colour with no edge (shortensColour). True when it recorded.
 bool recordColour(PassSink& sink, const ComputePipeline& p, const SheetTopology& topo, const Dispatch& d, uint32_t s,
-                  uint32_t k) {
+                  uint32_t k, PassGate gate) {
   const uint32_t c = k % topo.colorCount(), iteration = k / topo.colorCount();
   const ColorRange& range = topo.colors[c];
   if (range.count == 0) return false;
   const uint32_t kind = topo.constraints[range.first].kind_id;
   if (d.stage == SIM_STAGE_shorten ? !shortensColour(kind) : !projectsInIteration(kind, iteration)) return false;
-  record(sink, p, d.grid, range.count, SimPush{iteration, range.count, s, c}, s, d.gate, iteration);
+  gate.arg = iteration;
+  record(sink, p, d.grid, range.count, SimPush{iteration, range.count, s, c}, s, gate);
   return true;
 }
 
@@ -223,41 +255,42 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
                     const Dispatch& d, uint32_t s, uint32_t k, uint32_t sweeps = 0) {
   const ComputePipeline& p = pipes.*d.kernel;
   const uint32_t n = topo.particleCount();
+  PassGate gate{d.when, liveGate(d), 0};
   if (const std::optional<uint32_t> count = wholeCount(d.elements, topo, sizes)) {
-    record(sink, p, d.grid, *count, SimPush{0, *count, s, 0}, s, d.gate);
+    record(sink, p, d.grid, *count, SimPush{0, *count, s, 0}, s, gate);
     sink.barrier();
     return;
   }
   if (const std::optional<ScanRange> scan = scanRange(d.elements, topo, sizes)) {
-    recordScan(sink, pipes, scan->mode, scan->offset, scan->count, scan->sums, d.grid, s, d.gate);
+    recordScan(sink, pipes, scan->mode, scan->offset, scan->count, scan->sums, d.grid, s, gate);
     return;
   }
   switch (d.elements) {
   case Elements::COLOUR:
-    if (!recordColour(sink, p, topo, d, s, k)) return;
+    if (!recordColour(sink, p, topo, d, s, k, gate)) return;
     break;
   case Elements::ONE:
-    record(sink, p, d.grid, 1, SimPush{0, n, s, 0}, s, d.gate);
+    record(sink, p, d.grid, 1, SimPush{0, n, s, 0}, s, gate);
     break;
   case Elements::RINGS: {
     // One workgroup walks each run of rings, a barrier after it
     const uint32_t per = limitRingsPerDispatch(topo.cols, topo.rows, p.workgroup),
                    most = limitMostRings(topo.cols, topo.rows);
     for (uint32_t first = 1; first <= most; first += per) {
-      record(sink, p, d.grid, 1, SimPush{first, per, s, 0}, s, d.gate);
+      record(sink, p, d.grid, 1, SimPush{first, per, s, 0}, s, gate);
       if (first + per <= most) sink.barrier();
     }
     break;
   }
   case Elements::HASH_ARGS:
-    record(sink, p, d.grid, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0}, s, d.gate);
+    record(sink, p, d.grid, 1, SimPush{0, SIM_HASH_DISPATCHES, s, 0}, s, gate);
     break;
   case Elements::INDIRECT:
-    sink.pass(p, d.grid, 0, nullptr, 0, s, d.gate, 0);
+    sink.pass(p, d.grid, 0, nullptr, 0, s, gate);
     break;
   case Elements::CONTACT_ACTIVE: {
     const uint32_t flags = n + sizes.contact_edges + 1;
-    record(sink, p, d.grid, flags, SimPush{sizes.contact_active, flags, s, 0}, s, d.gate);
+    record(sink, p, d.grid, flags, SimPush{sizes.contact_active, flags, s, 0}, s, gate);
     break;
   }
   case Elements::SWEEPS: {
@@ -272,7 +305,8 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
     for (uint32_t sweep = 0; sweep < sweeps; ++sweep)
       for (uint32_t c = 0; c < topo.colorCount(); ++c) {
         if (edges(c) == 0) continue;
-        record(sink, p, d.grid, largest, SimPush{sweep, edges(c), s, c}, s, d.gate, sweep);
+        gate.arg = sweep;
+        record(sink, p, d.grid, largest, SimPush{sweep, edges(c), s, c}, s, gate);
         sink.barrier();
       }
     return;
@@ -286,28 +320,17 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
 } // namespace
 
 SubstepPlan substepPlan(const shaderio::SimUniforms& u, uint32_t stop) {
-  const bool contact = u.contact.x > 0.0f;
   SubstepPlan plan;
   plan.iterations = u.iterations;
-  plan.collision = (u.flags & SIM_FLAG_COLLISION) != 0u;
-  plan.air = (u.flags & SIM_FLAG_AIR) != 0u;
+  plan.when = conditionsOf(u);
   plan.stop = stop;
-  plan.crease = creasing(u.hinge.y, u.crease.y);
-  plan.contact = contact;
-  plan.limit = u.limit.x > 0.0f;
-  plan.shorten = limitShortens(u.limit.x, u.grab_index, u.flags);
-  plan.sweeps = contact ? u.contact_check.y : 0u;
+  plan.sweeps = runsWhen(SIM_WHEN_SETTLE, plan.when) ? u.contact_check.y : 0u;
   return plan;
 }
 
 void SubstepPlan::add(const SubstepPlan& other) {
   iterations = std::max(iterations, other.iterations);
-  collision = collision || other.collision;
-  air = air || other.air;
-  crease = crease || other.crease;
-  contact = contact || other.contact;
-  limit = limit || other.limit;
-  shorten = shorten || other.shorten;
+  when |= other.when;
   sweeps = std::max(sweeps, other.sweeps);
 }
 
@@ -319,22 +342,16 @@ uint32_t marksPerSubstep() {
 
 bool recordSubstep(PassSink& sink, const SimPipelines& pipes, const SheetTopology& topo, const SheetLayout& sizes,
                    const SubstepPlan& plan, uint32_t s, uint32_t& pass) {
-  const bool has_constraints = topo.constraintCount() > 0;
   // The stages in their order, each pass of a stage its dispatches in theirs (SIM_STAGES,
-  // SIM_DISPATCHES); the last pass of a stage closes its timestamp categories
+  // SIM_DISPATCHES), those whose conditions the plan meets; the last pass of a stage closes its
+  // timestamp categories
   for (uint32_t stage = 0; stage < SIM_STAGE_COUNT; ++stage) {
-    const uint32_t passes = stagePasses(stage, plan.iterations, topo.colorCount(), plan.collision);
+    const uint32_t passes = stagePasses(stage, plan.iterations, topo.colorCount(), plan.when);
     for (uint32_t k = 0; k < passes; ++k) {
       for (size_t row = 0; row < std::size(kDispatches); ++row) {
         const Dispatch& d = kDispatches[row];
         if (d.stage != stage) continue;
-        const bool needed = d.needs == Needs::ALWAYS || (d.needs == Needs::AIR && plan.air) ||
-                            (d.needs == Needs::CREASE && plan.crease && topo.hingeCount() > 0) ||
-                            (d.needs == Needs::LIMIT && plan.limit) || (d.needs == Needs::SHORTEN && plan.shorten) ||
-                            (d.needs == Needs::CONSTRAINTS && has_constraints) ||
-                            (d.needs == Needs::CONTACT && plan.contact) ||
-                            (d.needs == Needs::SETTLE && plan.contact && plan.sweeps > 0);
-        if (needed) recordDispatch(sink, pipes, topo, sizes, d, s, k, plan.sweeps);
+        if (runsWhen(d.when, plan.when)) recordDispatch(sink, pipes, topo, sizes, d, s, k, plan.sweeps);
         if (k + 1 == passes && closesCategory(row)) sink.mark(d.category);
       }
       if (pass++ == plan.stop) return true;

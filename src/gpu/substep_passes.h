@@ -1,8 +1,8 @@
 #pragma once
 /// The passes of one substep of the per-colour path, as the pass table says (SIM_STAGES and
 /// SIM_DISPATCHES, shaders/shared/sim_passes.h), recorded into a PassSink: the GPU solver dispatches them for its
-/// sheet; a fleet dispatches each for every sheet of a batch, and its gate (SIM_GATE_* in sim_config.h) picks the
-/// sheets that run it, those that would run it alone.
+/// sheet; a fleet dispatches each for every sheet of a batch, and its gate (PassGate) picks the sheets that run it,
+/// those that would run it alone.
 #include <cstdint>
 #include <vector>
 
@@ -49,9 +49,9 @@ public:
   /// A pass of grid `grid` is recorded. A hash (or contact grid) pass of full grid `full` is the
   /// next dispatch of its kind and returns the slot of its live argument in SIM_BIND_HASH_ARGS
   /// (its grid checked against earlier substeps'); a settle pass returns its slot there (for
-  /// Grid::Sweep the sweep `gate_arg` names, as for a fleet's gate); any other pass makes the next
+  /// Grid::Sweep the sweep `arg` names, as for a fleet's gate); any other pass makes the next
   /// of each kind the first.
-  uint32_t record(Grid grid, glm::uvec4 full, uint32_t gate_arg = 0);
+  uint32_t record(Grid grid, glm::uvec4 full, uint32_t arg = 0);
   /// The hash passes' full grids (from slot SIM_HASH_DISPATCHES)
   const std::vector<glm::uvec4>& grids() const { return grids_; }
   /// Contact's grid passes' full grids (from slot SIM_CONTACT_GRID_ARGS + SIM_CONTACT_GRID_DISPATCHES)
@@ -85,19 +85,26 @@ struct SheetPassTarget {
 /// Records a pass of one sheet on its descriptor set, as the solver dispatches it: `count`
 /// elements (Grid::Threads; none: nothing recorded), one workgroup, the compaction's indirect
 /// arguments, or the next hash dispatch's live arguments (Grid::Sweep: those of the settle sweep
-/// `gate_arg` names). `bound` is the pipeline bound on `t.cmd`. Returns false when nothing was
+/// `arg` names). `bound` is the pipeline bound on `t.cmd`. Returns false when nothing was
 /// recorded.
 bool recordSheetPass(const SheetPassTarget& t, VkPipeline& bound, HashGrids& hash_grids, const ComputePipeline& p,
-                     Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t gate_arg = 0);
+                     Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t arg = 0);
+
+/// Which sheets of a batch run a pass (BatchArgs): those that meet its conditions, of those the ones
+/// its run-time gate takes.
+struct PassGate {
+  uint32_t when = SIM_WHEN_ALWAYS; ///< SIM_WHEN_* bits, its stage's and its own (stageConditions)
+  uint32_t live = SIM_LIVE_NONE;   ///< SIM_LIVE_*
+  uint32_t arg = 0;                ///< SIM_LIVE_ITERATION: the iteration; SIM_LIVE_SWEEP: the sweep
+};
 
 /// Where the passes of a substep go.
 class PassSink {
 public:
   /// A pass of substep `substep`: `count` elements of `p` (Grid::Threads) or the grid `grid` names,
-  /// with `push_size` bytes of push constants; `gate` and `gate_arg` say which sheets of a batch
-  /// run it.
+  /// with `push_size` bytes of push constants; `gate` says which sheets of a batch run it.
   virtual void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size,
-                    uint32_t substep, uint32_t gate, uint32_t gate_arg) = 0;
+                    uint32_t substep, const PassGate& gate) = 0;
   /// What the passes recorded so far wrote is seen by the next.
   virtual void barrier() = 0;
   /// The passes recorded since the last mark belong to category `c` (timestamps).
@@ -111,14 +118,9 @@ protected:
 /// union of its sheets' (add): the most iterations and sweeps, and each pass any sheet runs.
 struct SubstepPlan {
   uint32_t iterations = 0;
-  bool collision = false;
-  bool air = false;
-  uint32_t stop = SIM_NONE; ///< last pass to record (SIM_STAGES numbering; Solver::stopNextTickAfter)
-  bool crease = false;      ///< the crease pass runs (creasing in xpbd.h)
-  bool contact = false;     ///< the contact passes run (SimUniforms::contact)
-  bool limit = false;       ///< the stretch limit runs (SimUniforms::limit)
-  bool shorten = false;     ///< the limit shortens edges first (limitShortens)
-  uint32_t sweeps = 0;      ///< the settle stage's sweeps (SimUniforms::contact_check.y; 0: it does not run)
+  uint32_t when = SIM_WHEN_ALWAYS; ///< the conditions met (SIM_WHEN_* bits, stageConditions)
+  uint32_t stop = SIM_NONE;        ///< last pass to record (SIM_STAGES numbering; Solver::stopNextTickAfter)
+  uint32_t sweeps = 0;             ///< the settle stage's sweeps (SimUniforms::contact_check.y)
 
   /// Widens this plan to cover `other`'s passes as well (its stop is kept).
   void add(const SubstepPlan& other);

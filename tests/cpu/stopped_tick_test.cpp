@@ -30,7 +30,8 @@ TEST(StoppedTick, RunsThePassesUpToTheStopInOrder) {
     const shaderio::SimUniforms u = sa.makeUniforms();
     a.stopNextTickAfter(stop);
     a.tick(u);
-    b.integrate(u, 0);
+    ASSERT_EQ(passAt(u, 0).kind, PassKind::integrate);
+    b.integrate(u, 0, shaderio::runsWhen(SIM_WHEN_AIR, conditionsOf(u)));
     if (stop > 0) b.collide(u), b.repelPass(u);
     if (stop > 1) b.projectColors(u, 0, stop - 1);
     EXPECT_TRUE(sameBytes(a.positions(), b.positions())) << "stop after pass " << stop;

@@ -18,7 +18,7 @@ namespace {
 
 struct Recorded {
   std::string kernel;
-  uint32_t gate = 0, gate_arg = 0;
+  PassGate gate;
 };
 
 /// Writes down each pass (by kernel name), barrier and mark.
@@ -29,10 +29,9 @@ public:
     SIM_KERNELS(NAME_OF)
 #undef NAME_OF
   }
-  void pass(const ComputePipeline& p, Grid, uint32_t, const void*, uint32_t, uint32_t, uint32_t gate,
-            uint32_t gate_arg) override {
+  void pass(const ComputePipeline& p, Grid, uint32_t, const void*, uint32_t, uint32_t, const PassGate& gate) override {
     for (const auto& [pipeline, name] : names_)
-      if (pipeline == p.pipeline) passes.push_back({name, gate, gate_arg});
+      if (pipeline == p.pipeline) passes.push_back({name, gate});
     ++barriers_due;
   }
   void barrier() override { barriers_due = 0; }
@@ -85,9 +84,11 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   const SimPipelines pipes = fakePipelines();
   RecordingSink sink(pipes);
   uint32_t pass = 0;
-  const SubstepPlan plan{2, true, true, SIM_NONE, true, true, true, true, 2};
+  constexpr uint32_t all = SIM_WHEN_COLLISION | SIM_WHEN_AIR | SIM_WHEN_CONTACT | SIM_WHEN_LIMIT | SIM_WHEN_SHORTEN |
+                           SIM_WHEN_CREASE | SIM_WHEN_SETTLE;
+  const SubstepPlan plan{2, all, SIM_NONE, 2};
   EXPECT_FALSE(recordSubstep(sink, pipes, topo, sizes, plan, 0, pass));
-  EXPECT_EQ(pass, shaderio::passesPerSubstep(2, topo.colorCount(), true));
+  EXPECT_EQ(pass, shaderio::passesPerSubstep(2, topo.colorCount(), all));
   EXPECT_EQ(sink.barriers_due, 0u); // every pass is followed by a barrier
 
   // The contact's grid (its buckets' scan one block here), then the integration
@@ -138,11 +139,15 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   EXPECT_EQ(kernels(sink.passes), expected);
   for (size_t k = 0, project = 0, shorten = 0; k < sink.passes.size(); ++k)
     if (sink.passes[k].kernel == "project") {
-      EXPECT_EQ(sink.passes[k].gate, SIM_GATE_ITERATION);
-      EXPECT_EQ(sink.passes[k].gate_arg, iterations[project++]);
+      EXPECT_EQ(sink.passes[k].gate.when, SIM_WHEN_ALWAYS);
+      EXPECT_EQ(sink.passes[k].gate.live, SIM_LIVE_ITERATION);
+      EXPECT_EQ(sink.passes[k].gate.arg, iterations[project++]);
     } else if (sink.passes[k].kernel == "shorten") {
-      EXPECT_EQ(sink.passes[k].gate, SIM_GATE_SHORTEN);
-      EXPECT_EQ(sink.passes[k].gate_arg, shorten_iterations[shorten++]);
+      EXPECT_EQ(sink.passes[k].gate.when, SIM_WHEN_SHORTEN);
+      EXPECT_EQ(sink.passes[k].gate.live, SIM_LIVE_ITERATION);
+      EXPECT_EQ(sink.passes[k].gate.arg, shorten_iterations[shorten++]);
+    } else if (sink.passes[k].kernel == "contact_step") {
+      EXPECT_EQ(sink.passes[k].gate.when, SIM_WHEN_CONTACT); // the floor's, with contact
     }
   EXPECT_EQ(sink.marks, (std::vector<PassCategory>{kContact, kIntegrate, kHash, kCollide, kProject, kProject, kProject,
                                                    kProject, kFloor, kFloor, kTear}));
@@ -159,6 +164,11 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
   u.iterations = 1;
   u.color_count = topo.colorCount();
   u.flags = SIM_FLAG_COLLISION;
+  u.grab_index = SIM_NONE; // nothing holds the sheet: the limit shortens edges first
+  u.limit.x = 1.0f;
+  u.hinge.y = topo.hingeCount();
+  u.crease.y = 0.2f;
+  ASSERT_GT(u.hinge.y, 0u);
   // The last kernel each stage records
   const auto lastOf = [](PassKind kind) -> std::string {
     switch (kind) {
@@ -175,10 +185,11 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
     case PassKind::collide:
       return "repel";
     case PassKind::floor:
-    case PassKind::settle: // without contact the settle records nothing
       return "floor";
     case PassKind::tear:
       return "tear_compact";
+    case PassKind::contact: // without contact neither records anything
+    case PassKind::settle:
     case PassKind::reset:
       break;
     }
@@ -187,9 +198,7 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
   for (uint32_t stop = 0; stop < passesPerTick(u); ++stop) {
     RecordingSink sink(pipes);
     uint32_t pass = 0;
-    EXPECT_TRUE(
-        recordSubstep(sink, pipes, topo, sizes, SubstepPlan{1, true, false, stop, true, false, true, true}, 0, pass))
-        << stop;
+    EXPECT_TRUE(recordSubstep(sink, pipes, topo, sizes, substepPlan(u, stop), 0, pass)) << stop;
     EXPECT_EQ(pass, stop + 1);
     const PassPoint at = passAt(u, stop);
     ASSERT_FALSE(sink.passes.empty());
