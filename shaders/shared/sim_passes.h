@@ -96,16 +96,17 @@
 //   when    SIM_WHEN_<when>: what it runs under (stageRuns)
 #define SIM_STAGES(X)                                                                                                  \
   X(contact, 0u, ONCE, CONTACT)                                                                                        \
-  X(integrate, 1u, ONCE, ALWAYS)                                                                                       \
-  X(collide, 2u, ONCE, COLLISION)                                                                                      \
-  X(project, 3u, COLOUR, ALWAYS)                                                                                       \
-  X(shorten, 4u, COLOUR, SHORTEN)                                                                                      \
-  X(limit, 5u, ONCE, LIMIT)                                                                                            \
-  X(crease, 6u, ONCE, CREASE)                                                                                          \
-  X(floor, 7u, ONCE, ALWAYS)                                                                                           \
-  X(settle, 8u, ONCE, SETTLE)                                                                                          \
-  X(tear, 9u, ONCE, ALWAYS)
-#define SIM_STAGE_COUNT 10u
+  X(air, 1u, ONCE, AIR)                                                                                                \
+  X(integrate, 2u, ONCE, ALWAYS)                                                                                       \
+  X(collide, 3u, ONCE, COLLISION)                                                                                      \
+  X(project, 4u, COLOUR, ALWAYS)                                                                                       \
+  X(shorten, 5u, COLOUR, SHORTEN)                                                                                      \
+  X(limit, 6u, ONCE, LIMIT)                                                                                            \
+  X(crease, 7u, ONCE, CREASE)                                                                                          \
+  X(floor, 8u, ONCE, ALWAYS)                                                                                           \
+  X(settle, 9u, ONCE, SETTLE)                                                                                          \
+  X(tear, 10u, ONCE, ALWAYS)
+#define SIM_STAGE_COUNT 11u
 
 // The dispatches of each stage, in the order the per-colour path records them (a barrier after
 // each). The fused tick and the CPU run the same bodies in the same order.
@@ -153,7 +154,7 @@
   X(contact, contact_emit, CONTACT_ACTIVE, Contact, ALWAYS, Contact)                                                   \
   X(contact, contact_walk, CONTACT_QUERIES, Walk, ALWAYS, Contact)                                                     \
   X(contact, contact_bound, PARTICLES, Threads, ALWAYS, Contact)                                                       \
-  X(integrate, air, PARTICLES, Threads, AIR, Integrate)                                                                \
+  X(air, air, PARTICLES, Threads, ALWAYS, Integrate)                                                                   \
   X(integrate, integrate, PARTICLES, Threads, ALWAYS, Integrate)                                                       \
   X(collide, candidates_check, PARTICLES, Threads, ALWAYS, Hash)                                                       \
   X(collide, candidates_decide, HASH_ARGS, Threads, ALWAYS, Hash)                                                      \

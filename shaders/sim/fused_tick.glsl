@@ -169,14 +169,16 @@ void resetFrame(uint n) {
 }
 #endif
 
-// The air (as air.comp, with `air`), then Verlet integration (as integrate.comp)
-void integrateStage(uint s, uint n, float dt2, bool air) {
+// The air on each particle (as air.comp), which the integration reads
+void airStage(uint n) {
+  sync(); // the air reads the positions of other invocations' particles (loaded or moved)
+  for (uint i = gl_LocalInvocationID.x; i < n; i += kInvocations) delta[i] = vec4(airOnParticle(i), 0.0f);
+  sync();
+}
+
+// Verlet integration (as integrate.comp)
+void integrateStage(uint s, uint n, float dt2) {
   uint lid = gl_LocalInvocationID.x;
-  if (air) {
-    sync(); // the air reads the positions of other invocations' particles (loaded or moved)
-    for (uint i = lid; i < n; i += kInvocations) delta[i] = vec4(airOnParticle(i), 0.0f);
-    sync();
-  }
   for (uint i = lid; i < n; i += kInvocations) {
     VerletState st = integrateParticle(i, s_pos[i], prev[i], rest_pos[i], uv[i].x, i == u.grab_index, u.grab_target[s],
                                        u.grab_prev[s], u.hand, u.hand_motion, u.flags, u.gravity,
@@ -188,7 +190,7 @@ void integrateStage(uint s, uint n, float dt2, bool air) {
   sync();
 }
 
-// 2. Collision (as candidates_check, hash_*, collide and candidates_finish). From the candidate lists
+// Collision (as candidates_check, hash_*, collide and candidates_finish). From the candidate lists
 // while they hold every pair that can touch (no particle has travelled SIM_CANDIDATE_TRAVEL x skin
 // since they were built); otherwise from the spatial hash (count, scan, scatter, order within
 // bucket) and a search of the 27 cells around each particle, which rebuilds the lists as it
@@ -339,7 +341,11 @@ bool runSubsteps(uint n) {
       if (stopsAfter(SIM_FIRST_PASS(contact))) return true;
     }
 #endif
-    integrateStage(s, n, dt2, runsWhen(SIM_WHEN_AIR, when));
+    if (SIM_RUNS(air)) {
+      airStage(n);
+      if (stopsAfter(SIM_FIRST_PASS(air))) return true;
+    }
+    integrateStage(s, n, dt2);
     if (stopsAfter(SIM_FIRST_PASS(integrate))) return true;
     // A new substep: no constraint torn in it yet (every invocation read the count of the last
     // substep before the barrier above).

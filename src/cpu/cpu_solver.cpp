@@ -104,7 +104,6 @@ void CpuSolver::airPass(const SimUniforms& u) {
 void CpuSolver::integrate(const SimUniforms& u, uint32_t s, bool air) {
   const float dt2 = u.dt * u.dt;
   const vec4 wind = u.wind[s], twist = u.wind_twist[s], target = u.grab_target[s], grab_prev = u.grab_prev[s];
-  if (air) airPass(u);
   // integrateParticle in two loops: with the hand's pull in it, the step's loop cost twice as much
   const float damping = substepDamping(u.damping, u.verlet, s);
   pool_->parallelFor(uint32_t(pos_.size()), grain_(kGrainParticles), [&](uint32_t begin, uint32_t end) {
@@ -405,8 +404,11 @@ void CpuSolver::runStage(PassKind stage, const SimUniforms& u, uint32_t when, ui
     contact_.computeBounds(pos_, prev_, triangles_, triangle_count_, u, s, bound_, push_);
     start_ = pos_;
     break;
+  case PassKind::air:
+    airPass(u); // the air on each particle, which the integration reads
+    break;
   case PassKind::integrate:
-    integrate(u, s, runsWhen(SIM_WHEN_AIR, when)); // the air, then damped Verlet, gravity, wind; pins and the grab hold
+    integrate(u, s, runsWhen(SIM_WHEN_AIR, when)); // damped Verlet, gravity, wind; pins and the grab hold
     break;
   case PassKind::project:
     projectColors(u, first, count); // Gauss-Seidel over the colours

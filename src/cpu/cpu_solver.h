@@ -79,8 +79,8 @@ public:
   /// tick runs for that stage (count > 1 only for a stage numbered once per colour).
   void runStage(PassKind stage, const shaderio::SimUniforms& u, uint32_t when, uint32_t substep, uint32_t first,
                 uint32_t count);
-  /// Verlet integration with gravity, wind, damping (and, with SIM_FLAG_AIR, the air on each
-  /// particle, from airPass first); pins and the grab hold their particles.
+  /// Verlet integration with gravity, wind, damping (and with `air` the air on each particle,
+  /// from airPass); pins and the grab hold their particles.
   void integrate(const shaderio::SimUniforms& u, uint32_t substep, bool air);
   /// The air on each particle (airOnParticle in sim_elements.glsl), from the positions and previous
   /// positions of the start of the substep.

@@ -59,7 +59,8 @@ TEST(Passes, AStageIsNumberedOnlyWhileItsConditionHolds) {
   // Nothing on: the integration, the projection, the floor and the tear (the grab holds particle 0)
   shaderio::SimUniforms u = uniforms(2, 2, 3, false);
   EXPECT_EQ(passesPerTick(u), 2u * (1u + 6u + 1u + 1u));
-  for (PassKind kind : {PassKind::contact, PassKind::collide, PassKind::limit, PassKind::crease, PassKind::settle})
+  for (PassKind kind :
+       {PassKind::contact, PassKind::air, PassKind::collide, PassKind::limit, PassKind::crease, PassKind::settle})
     EXPECT_FALSE(passIndex(u, PassPoint{0, kind})) << describePass(PassPoint{0, kind});
   EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::shorten, 0, 0}));
   // Each condition adds its stage's passes, the shorten stage's once per colour of each iteration
@@ -80,7 +81,10 @@ TEST(Passes, AStageIsNumberedOnlyWhileItsConditionHolds) {
   EXPECT_EQ(passesPerTick(u), base + 2u * 3u);
   u.crease.y = 0.1f;
   EXPECT_EQ(passesPerTick(u), base + 2u * 4u);
-  EXPECT_EQ(conditionsOf(u), SIM_WHEN_CONTACT | SIM_WHEN_LIMIT | SIM_WHEN_CREASE | SIM_WHEN_SETTLE);
+  u.flags |= SIM_FLAG_AIR;
+  EXPECT_EQ(passesPerTick(u), base + 2u * 5u);
+  EXPECT_EQ(passIndex(u, PassPoint{0, PassKind::air}), 1u); // after contact's
+  EXPECT_EQ(conditionsOf(u), SIM_WHEN_AIR | SIM_WHEN_CONTACT | SIM_WHEN_LIMIT | SIM_WHEN_CREASE | SIM_WHEN_SETTLE);
 }
 
 TEST(Passes, IndexIsTheInverseOfPassAt) {

@@ -149,8 +149,8 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
     } else if (sink.passes[k].kernel == "contact_step") {
       EXPECT_EQ(sink.passes[k].gate.when, SIM_WHEN_CONTACT); // the floor's, with contact
     }
-  EXPECT_EQ(sink.marks, (std::vector<PassCategory>{kContact, kIntegrate, kHash, kCollide, kProject, kProject, kProject,
-                                                   kProject, kFloor, kFloor, kTear}));
+  EXPECT_EQ(sink.marks, (std::vector<PassCategory>{kContact, kIntegrate, kIntegrate, kHash, kCollide, kProject,
+                                                   kProject, kProject, kProject, kFloor, kFloor, kTear}));
   EXPECT_EQ(marksPerSubstep(), sink.marks.size());
 }
 
@@ -172,6 +172,8 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
   // The last kernel each stage records
   const auto lastOf = [](PassKind kind) -> std::string {
     switch (kind) {
+    case PassKind::air:
+      return "air";
     case PassKind::integrate:
       return "integrate";
     case PassKind::project:
