@@ -137,9 +137,11 @@ SIM_INLINE vec3 contactFrame(vec3 lo, vec3 hi, float lowest, float scale) {
   return dot3(t, t) < 1e30f ? t : vec3(0.0f);
 }
 
-/// contactFrame's scale in substep s: the first substep's velocity rescale (SimUniforms::verlet.y,
+/// contactFrame's scale in substep s: the first substep's velocity rescale (SimUniforms::verlet.rescale,
 /// this substep's length over the last tick's, 0 when they are the same), else 1.
-SIM_INLINE float contactFrameScale(vec4 verlet, uint s) { return s == 0u && verlet.y > 0.0f ? verlet.y : 1.0f; }
+SIM_INLINE float contactFrameScale(VerletKeys verlet, uint s) {
+  return s == 0u && verlet.rescale > 0.0f ? verlet.rescale : 1.0f;
+}
 
 /// Where a particle that moved from x0 to x this substep ends when its step may not exceed
 /// `bound`: x, or the point `bound` from x0 towards x.
@@ -363,7 +365,7 @@ SIM_INLINE vec3 untanglePush(vec3 a0, vec3 a1, vec3 a2, vec3 b0, vec3 b1, vec3 b
          untangleEdge(b1, b2, a0, a1, a2, gap, 4u, 5u, 0u, k) + untangleEdge(b2, b0, a0, a1, a2, gap, 5u, 3u, 0u, k);
 }
 
-/// A pair's push on one particle in fixed point (`scale`: SimUniforms::contact.w units per unit of
+/// A pair's push on one particle in fixed point (`scale`: SimUniforms::contact.fixed_units units per unit of
 /// length), clamped to +-SIM_CONTACT_FIXED_MAX: integers sum to the same bits in any order, so a
 /// particle's pushes need no fixed order (atomic adds on the GPU).
 SIM_INLINE ivec3 contactFixed(vec3 push, float scale) {

@@ -78,7 +78,7 @@ SIM_INLINE uint limitStepsAt(uint x, uint y, uvec4 rx, uvec4 ry, uint count) {
 /// and rise after it, so their least is highest at the row's ends or where one root's rising steps
 /// meet another's falling ones, at (rx_i + rx_j + dy_j - dy_i) / 2 (dy: the rows to the root):
 /// those columns of each row are all it weighs. Rows x (2 + 4 x pairs of roots) places, for the
-/// host (SimUniforms::limit.z).
+/// host (SimUniforms::limit.last_ring).
 SIM_INLINE uint limitLastRing(uvec4 roots, uint cols, uint rows) {
   uvec4 rx = roots % cols, ry = roots / cols;
   uint count = roots.w, last = 0u;

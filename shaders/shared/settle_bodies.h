@@ -43,7 +43,7 @@ SIM_INLINE bool settleOver(Constraint c, uint s) {
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b);
   if (shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return false;
   vec3 d = vec3(pb) - vec3(pa);
-  return dot3(d, d) > u.limit.x * u.limit.x && (settleFree(c.a, s) || settleFree(c.b, s));
+  return dot3(d, d) > u.limit.reach * u.limit.reach && (settleFree(c.a, s) || settleFree(c.b, s));
 }
 
 /// Moves particle i by up to `want` along the unit `dir`, as far as its ball and half-spaces let
@@ -76,15 +76,15 @@ SIM_INLINE float settleBack(uint i, vec3 dir, float want) {
 /// moved): a sweep in which every edge is left alone is the last that moves anything.
 SIM_INLINE bool settleConstraint(Constraint c, uint s) {
   if ((c.kind_id & SIM_KIND_MASK) != SIM_KIND_STRUCTURAL) return false;
-  vec4 limit = u.limit;
+  LimitKeys limit = u.limit;
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b);
   if (shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return false;
   vec3 d = vec3(pb) - vec3(pa);
   float len2 = dot3(d, d);
-  if (!(len2 > limit.x * limit.x)) return false;
+  if (!(len2 > limit.reach * limit.reach)) return false;
   bool ma = settleMovable(c.a, s), mb = settleMovable(c.b, s);
   if (!ma && !mb) return false;
-  float len = simSqrt(len2), over = len - limit.x;
+  float len = simSqrt(len2), over = len - limit.reach;
   vec3 e = d * simDiv(1.0f, len);
   float got_a = ma ? settleMove(c.a, e, mb ? 0.5f * over : over) : 0.0f;
   float got_b = mb ? settleMove(c.b, -e, over - got_a) : 0.0f;

@@ -45,6 +45,12 @@ static_assert(sizeof(SimPush) == 16);
 static_assert(sizeof(Counters) == 80);
 static_assert(sizeof(FusedPush) == 16);
 static_assert(sizeof(BatchArgs) == 32);
+static_assert(sizeof(AirKeys) == 16 && sizeof(HingeRange) == 16 && sizeof(CreaseKeys) == 16 && sizeof(HandKeys) == 16 &&
+              sizeof(HandMotion) == 16 && sizeof(ContactKeys) == 16 && sizeof(ContactChecks) == 16 &&
+              sizeof(ContactGrid) == 16 && sizeof(LimitKeys) == 16 && sizeof(VerletKeys) == 16);
+static_assert(offsetof(SimUniforms, air) % 16 == 0 && offsetof(SimUniforms, hinge) % 16 == 0 &&
+              offsetof(SimUniforms, hand_motion) % 16 == 0 && offsetof(SimUniforms, limit) % 16 == 0 &&
+              offsetof(SimUniforms, verlet) % 16 == 0 && offsetof(SimUniforms, wind) % 16 == 0);
 static_assert(sizeof(BatchPush) == 48 && offsetof(BatchPush, batch) == 16);
 static_assert(sizeof(BatchPassPush) == 48 && offsetof(BatchPassPush, batch) == 16 &&
               sizeof(ScanPush) == sizeof(SimPush));

@@ -19,8 +19,8 @@
 SIM_INLINE void projectHinge(uint k) {
   uvec4 q = gridHinge(k, u.cols, u.rows);
   vec4 pu = SIM_POSITION(q.x), pv = SIM_POSITION(q.y), pa = SIM_POSITION(q.z), pb = SIM_POSITION(q.w);
-  vec4 crease = u.crease; // uniform vectors whole (SpirvRules: a fleet's kernels read them by address)
-  float alpha = hingeIsDiagonal(k, u.cols, u.rows) ? 0.5f * crease.x : crease.x;
+  CreaseKeys crease = u.crease; // uniform vectors whole (SpirvRules: a fleet's kernels read them by address)
+  float alpha = hingeIsDiagonal(k, u.cols, u.rows) ? 0.5f * crease.compliance : crease.compliance;
   HingeDelta d = solveHinge(pu, pv, pa, pb, hinges[k].x, alpha, 0.0f);
   SIM_POSITION(q.x) = pu + vec4(d.du, 0.0f);
   SIM_POSITION(q.y) = pv + vec4(d.dv, 0.0f);
@@ -34,8 +34,8 @@ SIM_INLINE void projectHinge(uint k) {
 SIM_INLINE void projectConstraint(Constraint c, uint iteration) {
   if (!projectsInIteration(c.kind_id, iteration)) return;
   if ((c.kind_id & SIM_KIND_MASK) == SIM_KIND_HINGE) {
-    uvec4 hinge = u.hinge;
-    projectHinge((c.kind_id >> SIM_KIND_BITS) - hinge.x);
+    HingeRange hinge = u.hinge;
+    projectHinge((c.kind_id >> SIM_KIND_BITS) - hinge.first);
     return;
   }
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b); // a != b: each end is read once
@@ -47,13 +47,13 @@ SIM_INLINE void projectConstraint(Constraint c, uint iteration) {
 /// The crease of hinge k after the substep's projection (creaseReturn), unless it is torn or
 /// degenerate.
 SIM_INLINE void creaseHinge(uint k) {
-  uvec4 hinge = u.hinge;
-  if (torn[hinge.x + k] != 0u) return;
+  HingeRange hinge = u.hinge;
+  if (torn[hinge.first + k] != 0u) return;
   uvec4 q = gridHinge(k, u.cols, u.rows);
   HingeAngle h = hingeAngle(vec3(SIM_POSITION(q.x)), vec3(SIM_POSITION(q.y)), vec3(SIM_POSITION(q.z)),
                             vec3(SIM_POSITION(q.w)), false);
-  vec4 crease = u.crease;
-  if (h.valid) hinges[k] = creaseReturn(hinges[k], h.angle, crease.y, crease.z);
+  CreaseKeys crease = u.crease;
+  if (h.valid) hinges[k] = creaseReturn(hinges[k], h.angle, crease.yield_angle, crease.hardening);
 }
 
 /// True when triangle t (original id) has lost an edge.
@@ -102,16 +102,16 @@ SIM_INLINE bool edgeCut(uint a, uint b) {
 /// Runs only while limitShortens.
 SIM_INLINE void shortenConstraint(Constraint c) {
   if ((c.kind_id & SIM_KIND_MASK) != SIM_KIND_STRUCTURAL) return;
-  vec4 limit = u.limit;
+  LimitKeys limit = u.limit;
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b);
   if (shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return;
-  PairDelta d = shortenEdge(pa, pb, limit.x);
+  PairDelta d = shortenEdge(pa, pb, limit.reach);
   SIM_POSITION(c.a) = pa + vec4(d.da, 0.0f);
   SIM_POSITION(c.b) = pb + vec4(d.db, 0.0f);
 }
 
 /// The stretch limit on particle i, in its ring of the limit from `root` (after the projection,
-/// ring after ring, so its parents have their places): a free particle farther than u.limit.x from
+/// ring after ring, so its parents have their places): a free particle farther than u.limit.reach from
 /// a parent it is still joined to moves to the nearest point within that reach of its parents
 /// (intoBothReaches). An edge stretched to its tear length (shouldTear) is left to tear. The move
 /// is a placement, not a step: the previous position moves with it, so the particle keeps its
@@ -124,16 +124,16 @@ SIM_INLINE void limitParticle(uint i, uint root) {
   vec4 q = SIM_POSITION(i);
   if (!(q.w > 0.0f)) return;
   uvec2 parent = limitParents(i, root, u.cols);
-  vec4 limit = u.limit;
-  float reach = limit.x;
+  LimitKeys limit = u.limit;
+  float reach = limit.reach;
   vec4 px = parent.x != SIM_NONE ? SIM_POSITION(parent.x) : q, py = parent.y != SIM_NONE ? SIM_POSITION(parent.y) : q;
   bool far_x = !withinReach(vec3(q), vec3(px), reach), far_y = !withinReach(vec3(q), vec3(py), reach);
   if (!far_x && !far_y) return;
   // The parents it is joined to by an edge that holds
   bool use_x = parent.x != SIM_NONE && !edgeCut(min(i, parent.x), max(i, parent.x)) &&
-               !shouldTear(q, px, limit.y, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds);
+               !shouldTear(q, px, limit.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds);
   bool use_y = parent.y != SIM_NONE && !edgeCut(min(i, parent.y), max(i, parent.y)) &&
-               !shouldTear(q, py, limit.y, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds);
+               !shouldTear(q, py, limit.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds);
   if (!(far_x && use_x) && !(far_y && use_y)) return;
   vec3 to = use_x && use_y ? intoBothReaches(vec3(q), vec3(px), vec3(py), reach)
                            : intoReach(vec3(q), vec3(use_x ? px : py), reach);
@@ -158,8 +158,8 @@ SIM_INLINE void markUnsupported(Constraint c) {
     uint mid = (c.a + c.b) / 2u; // a bend spans two structural edges of a row or a column
     cut = edgeCut(c.a, mid) || edgeCut(mid, c.b);
   } else {
-    uvec4 hinge = u.hinge;
-    uvec2 t = kind == SIM_KIND_HINGE ? hingeTriangles(id - hinge.x, u.cols, u.rows)
+    HingeRange hinge = u.hinge;
+    uvec2 t = kind == SIM_KIND_HINGE ? hingeTriangles(id - hinge.first, u.cols, u.rows)
                                      : supportTriangles(c.a, c.b, kind, u.cols);
     cut = unsupported(c.a, c.b, kind, u.cols, triangleGone(t.x), triangleGone(t.y));
   }

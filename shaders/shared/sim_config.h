@@ -276,7 +276,7 @@
 // magnitude of one pair's push on one particle in those units: 2^11 such pushes sum within an int
 #define SIM_CONTACT_FIXED 262144.0f
 #define SIM_CONTACT_FIXED_MAX 1048576.0f
-// SimUniforms::contact_check.x: every triangle is checked for crossing the sheet in the first substep
+// SimUniforms::contact_check.mode: every triangle is checked for crossing the sheet in the first substep
 #define SIM_CONTACT_CHECK_ALL 1u
 // Ticks between two checks of every triangle for crossing the sheet (and the first tick with contact on)
 #define SIM_CONTACT_AUDIT_TICKS 60u

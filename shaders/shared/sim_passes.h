@@ -75,15 +75,15 @@
 #define SIM_WHEN_COLLISION 1u
 // the sheet has air (SIM_FLAG_AIR)
 #define SIM_WHEN_AIR 2u
-// contact is on (SimUniforms::contact.x, the contact radius)
+// contact is on (SimUniforms::contact.radius, the contact radius)
 #define SIM_WHEN_CONTACT 4u
-// the stretch limit is on (SimUniforms::limit.x)
+// the stretch limit is on (SimUniforms::limit.reach)
 #define SIM_WHEN_LIMIT 8u
 // the limit shortens edges first: nothing holds the sheet (no grab, no pins)
 #define SIM_WHEN_SHORTEN 16u
 // the sheet has hinges and they crease (a yield angle)
 #define SIM_WHEN_CREASE 32u
-// contact is on with the settle's sweeps (SimUniforms::contact_check.y)
+// contact is on with the settle's sweeps (SimUniforms::contact_check.sweeps)
 #define SIM_WHEN_SETTLE 64u
 
 // The stages of a substep, in the order they run; each is one numbered pass, or one per colour of

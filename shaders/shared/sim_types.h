@@ -14,6 +14,95 @@ struct Constraint {
   uint kind_id;
 };
 
+// The keys of SimUniforms, one struct a topic: 16 bytes each, at offsets that are multiples of 16,
+// so std140, std430 and C++ lay them out alike (shaderio.h checks). A fleet's kernels read one
+// whole where they read two of its fields (SpirvRules).
+
+/// The air on each triangle (SIM_FLAG_AIR, airOnTriangle in xpbd.h).
+struct AirKeys {
+  float pressure;      // SimParams::airPressureFactor's pressure
+  float friction;      // its friction factor
+  float third_over_dt; // 1 / (3 dt)
+  float unused;
+};
+
+/// The sheet's hinges (SIM_KIND_HINGE): constraints first .. first + count - 1.
+struct HingeRange {
+  uint first; // original id of the first hinge (hinge k is constraint first + k)
+  uint count; // hinges
+  uint unused0;
+  uint unused1;
+};
+
+/// The hinges' bending and creases (solveHinge, creaseReturn in xpbd.h).
+struct CreaseKeys {
+  float compliance;  // the XPBD compliance of an edge hinge over dt^2 (a diagonal's is half)
+  float yield_angle; // radians (0: elastic, no creases)
+  float hardening;
+  float unused;
+};
+
+/// The hand closing around the grab (handPull in xpbd.h), zero while it is open.
+struct HandKeys {
+  float fist;  // the fist's radius
+  float reach; // how far around the grab it draws the sheet in (0: open)
+  float draw;  // the part of a particle's way into the fist it is drawn per substep
+  float grip;  // the part of its velocity relative to the hand the grip takes per substep
+};
+
+/// The hand's motion.
+struct HandMotion {
+  vec3 per_substep; // its displacement per substep
+  float lowest;     // the lowest the fist's centre goes (floor + HandKeys::fist)
+};
+
+/// Penetration-free contact (contact.h).
+struct ContactKeys {
+  float radius;      // the contact radius (0: off)
+  float fraction;    // the part of its distance to the nearest primitive a particle may move in a substep (below 1/2)
+  float thickness;   // closer pairs are pushed apart
+  float fixed_units; // the fixed-point units of a push per unit of length (contactFixed)
+};
+
+/// Contact's checks and the GPU's places for its scratch.
+struct ContactChecks {
+  uint mode;          // which triangles are checked for crossing the sheet (SIM_CONTACT_CHECK_*: crossingChecked)
+  uint sweeps;        // the settle stage's sweeps (contact_settle; 0 without the stretch limit)
+  uint half_offset;   // the GPU's scratch offset of the settle's half-space counts, then starts (particles + 1),
+                      // their fills (particles) and their scan's sums (the solver fills it in)
+  uint list_capacity; // the GPU's pairs a contact query keeps in its list (at most SIM_CONTACT_LIST_CAPACITY)
+};
+
+/// The GPU's contact grid (the solver fills it in): the triangles' buckets are the first mask + 1,
+/// the edges' the next mask + 1.
+struct ContactGrid {
+  uint mask;   // the hash mask of each half
+  uint counts; // the scratch offset of its bucket counts (then starts)
+  uint fills;  // the scratch offset of its bucket fills
+  uint edges;  // the sheet's edges (SIM_BIND_CONTACT_LISTS)
+};
+
+/// The stretch limit (limitParticle in sim_bodies.h).
+struct LimitKeys {
+  float reach;     // the longest a structural edge may be after the projection (stretch_limit x spacing; 0: off)
+  float rest;      // its rest length (the spacing)
+  float last_ring; // the last ring from limitRootSet's roots (limitLastRing, a whole number)
+  float unused;
+};
+
+/// The Verlet step of the first substep.
+struct VerletKeys {
+  // the damping of the first substep, which also rescales the velocity its previous position carries
+  // from the last tick's substeps to this tick's (damping x dt / the last tick's dt, when the substeps
+  // key changed between them or the hand's pace asks for more, Simulation::tickParams)
+  float first_damping;
+  // that rescale alone (dt / the last tick's dt; 0 when they are the same), which the contact's
+  // frame takes too (contactFrameScale)
+  float rescale;
+  float unused0;
+  float unused1;
+};
+
 /// Per-tick inputs of the simulation (one uniform buffer, std140 == C++ layout).
 struct SimUniforms {
   uint particle_count; // N
@@ -48,45 +137,21 @@ struct SimUniforms {
   float reset_alpha; // reset interpolation factor of this frame, 0..1
   uint iterations;   // constraint iterations per substep
 
-  vec4 air; // SIM_FLAG_AIR: x pressure, y friction factor (SimParams::airPressureFactor), z 1 / (3 dt)
+  AirKeys air; // SIM_FLAG_AIR
 
-  uvec4 hinge; // x original id of the first hinge (hinge k is constraint x + k), y hinges (SIM_KIND_HINGE)
-  // Hinges: x the XPBD compliance of an edge hinge over dt^2 (a diagonal's is half), y the yield
-  // angle in radians (0: elastic, no creases), z the hardening
-  vec4 crease;
-  // The hand closing around the grab (handPull in xpbd.h), zero while it is open: x the fist's
-  // radius, y its reach (0: open), z the part of a particle's way into the fist it is drawn per
-  // substep, w the part of its velocity relative to the hand the grip takes per substep
-  vec4 hand;
-  vec4 hand_motion; // xyz the hand's displacement per substep, w the lowest the fist's centre goes (floor + x)
-  // Penetration-free contact (contact.h): x the contact radius (0: off), y the part of its distance
-  // to the nearest primitive a particle may move in a substep (below 1/2), z the thickness (closer
-  // pairs are pushed apart), w the fixed-point units of a push per unit of length (contactFixed)
-  vec4 contact;
-  // Which triangles are checked for crossing the sheet (crossingChecked): x SIM_CONTACT_CHECK_*; y
-  // the settle stage's sweeps (contact_settle; 0 without the stretch limit); z the GPU's scratch
-  // offset of the settle's half-space counts, then starts (particles + 1), their fills (particles)
-  // and their scan's sums (the solver fills it in); w the GPU's pairs a contact query keeps in its
-  // list (at most SIM_CONTACT_LIST_CAPACITY)
-  uvec4 contact_check;
-  // The GPU's contact grid (the solver fills it in): x the hash mask of each half, y the scratch offset of its
-  // bucket counts (then starts), z of its bucket fills, w the sheet's edges (SIM_BIND_CONTACT_LISTS);
-  // the triangles' buckets are the first x + 1, the edges' the next x + 1
-  uvec4 contact_grid;
+  HingeRange hinge;
+  CreaseKeys crease;
+  HandKeys hand;
+  HandMotion hand_motion;
+  ContactKeys contact;
+  ContactChecks contact_check;
+  ContactGrid contact_grid;
 
-  // The stretch limit (limitParticle in sim_bodies.h): x the longest a structural edge may be after
-  // the projection (stretch_limit x spacing; 0: off), y its rest length (the spacing), z the last
-  // ring from limitRootSet's roots (limitLastRing, a whole number)
-  vec4 limit;
+  LimitKeys limit;
   // The roots its rings run from (limitRootSet in xpbd.h): xyz the particles (SIM_NONE past the
   // last), w how many (0: the grabbed particle, else the sheet's middle)
   uvec4 limit_roots;
-  // The Verlet step: x the damping of the first substep, which also rescales the velocity its
-  // previous position carries from the last tick's substeps to this tick's (damping x dt / the
-  // last tick's dt, when the substeps key changed between them or the hand's pace asks for more,
-  // Simulation::tickParams); y that rescale alone (dt / the last tick's dt; 0 when they are the
-  // same), which the contact's frame takes too (contactFrameScale); zw unused
-  vec4 verlet;
+  VerletKeys verlet;
 
   vec4 wind[SIM_MAX_SUBSTEPS];        // uniform wind acceleration at each substep
   vec4 wind_twist[SIM_MAX_SUBSTEPS];  // wind acceleration scaled by (u - 0.5) across the sheet

@@ -64,24 +64,24 @@ SIM_INLINE vec3 handFinger(uint i) {
   return k * 0.00048828125f - vec3(0.25f); // k / 2048 - 1/4, exact
 }
 
-/// The hand closing around the grab (hand.y > 0, see SimUniforms::hand) on free particle i that
-/// the Verlet step took from `previous` to `position`: within the hand's reach of its centre (the
-/// grab target) the grip takes hand.w of the particle's velocity relative to the hand's motion,
-/// then the particle is drawn hand.z of its way toward the fist (a ball of radius hand.x around the
-/// centre, moved by handFinger(i) x hand.x). The fist rests on the floor: its centre is never
-/// lower than motion.w (the floor plus the fist's radius), so a hand closing or pressing down near
-/// the floor forms its ball above it, with the grab at the ball's foot, instead of drawing the sheet
-/// into the floor. Returns the particle's new position.
-SIM_INLINE vec4 handPull(vec4 position, vec4 previous, uint i, vec3 centre, vec4 hand, vec4 motion) {
-  if (!(hand.y > 0.0f) || !(position.w > 0.0f)) return position; // an open hand: nothing to do
+/// The hand closing around the grab (hand.reach > 0, see SimUniforms::hand) on free particle i
+/// that the Verlet step took from `previous` to `position`: within the hand's reach of its centre
+/// (the grab target) the grip takes hand.grip of the particle's velocity relative to the hand's
+/// motion, then the particle is drawn hand.draw of its way toward the fist (a ball of radius
+/// hand.fist around the centre, moved by handFinger(i) x hand.fist). The fist rests on the floor:
+/// its centre is never lower than motion.lowest (the floor plus the fist's radius), so a hand
+/// closing or pressing down near the floor forms its ball above it, with the grab at the ball's
+/// foot, instead of drawing the sheet into the floor. Returns the particle's new position.
+SIM_INLINE vec4 handPull(vec4 position, vec4 previous, uint i, vec3 centre, HandKeys hand, HandMotion motion) {
+  if (!(hand.reach > 0.0f) || !(position.w > 0.0f)) return position; // an open hand: nothing to do
   vec3 p = vec3(position);
   vec3 d = p - centre;
-  if (dot3(d, d) < hand.y * hand.y) {
-    p = p - (p - vec3(previous) - vec3(motion)) * hand.w;
-    vec3 fist = vec3(centre.x, max(centre.y, motion.w), centre.z);
-    d = p - (fist + handFinger(i) * hand.x);
+  if (dot3(d, d) < hand.reach * hand.reach) {
+    p = p - (p - vec3(previous) - motion.per_substep) * hand.grip;
+    vec3 fist = vec3(centre.x, max(centre.y, motion.lowest), centre.z);
+    d = p - (fist + handFinger(i) * hand.fist);
     float dist = simSqrt(dot3(d, d));
-    if (dist > hand.x) p = p - d * (simDiv(dist - hand.x, dist) * hand.z);
+    if (dist > hand.fist) p = p - d * (simDiv(dist - hand.fist, dist) * hand.draw);
   }
   return vec4(p, position.w);
 }
@@ -113,8 +113,9 @@ SIM_INLINE VerletState integrateOpenHand(vec4 pos, vec4 prev, vec4 rest, float u
 /// Particle i's integration at a substep: integrateOpenHand, then, while a grab is held, the hand's
 /// pull on every particle it did not place (handPull, which moves nothing while the hand is open).
 SIM_INLINE VerletState integrateParticle(uint i, vec4 pos, vec4 prev, vec4 rest, float u, bool is_grabbed,
-                                         vec4 grab_target, vec4 grab_prev, vec4 hand, vec4 hand_motion, uint flags,
-                                         float gravity, vec4 wind, vec4 wind_twist, float damping, float dt2) {
+                                         vec4 grab_target, vec4 grab_prev, HandKeys hand, HandMotion hand_motion,
+                                         uint flags, float gravity, vec4 wind, vec4 wind_twist, float damping,
+                                         float dt2) {
   VerletState s = integrateOpenHand(pos, prev, rest, u, is_grabbed, grab_target, grab_prev, flags, gravity, wind,
                                     wind_twist, damping, dt2);
   if (!placedByGrab(is_grabbed, grab_target))
@@ -385,10 +386,9 @@ SIM_INLINE uint particleTriangle(uint i, uint k, uint cols, uint rows) {
 
 /// The air on a triangle now at pa, pb, pc and a substep ago at qa, qb, qc, per unit mass of its
 /// paper: the pressure of quadratic drag along its normal (which lifts a tilted sheet as it
-/// slows it) and skin friction along its plane, both growing with its area. air: x the pressure,
-/// y the friction factor (SimParams::airPressureFactor), z 1 / (3 dt).
-SIM_INLINE vec3 airOnTriangle(vec3 pa, vec3 pb, vec3 pc, vec3 qa, vec3 qb, vec3 qc, vec4 air) {
-  vec3 v = ((pa - qa) + (pb - qb) + (pc - qc)) * air.z;
+/// slows it) and skin friction along its plane, both growing with its area (AirKeys).
+SIM_INLINE vec3 airOnTriangle(vec3 pa, vec3 pb, vec3 pc, vec3 qa, vec3 qb, vec3 qc, AirKeys air) {
+  vec3 v = ((pa - qa) + (pb - qb) + (pc - qc)) * air.third_over_dt;
   vec3 n = cross3(pb - pa, pc - pa);
   float n2 = dot3(n, n), v2 = dot3(v, v);
   if (!(n2 > 1e-30f) || !(v2 > 0.0f)) return vec3(0.0f);
@@ -396,7 +396,7 @@ SIM_INLINE vec3 airOnTriangle(vec3 pa, vec3 pb, vec3 pc, vec3 qa, vec3 qb, vec3 
   float k = simSqrt(v2) * simSqrt(n2);
   vec3 vn = n * simDiv(dot3(v, n), n2);
   vec3 vt = v - vn;
-  return vn * (-air.x * k) + vt * (-air.y * k);
+  return vn * (-air.pressure * k) + vt * (-air.friction * k);
 }
 
 /// The air on a particle: the mean over the live triangles around it (sum of airOnTriangle over
@@ -409,7 +409,9 @@ SIM_INLINE vec3 meanAir(vec3 sum, uint count) {
 
 /// The Verlet damping of substep s (SimUniforms::damping and verlet): the first substep's rescales
 /// the velocity the last tick left to this tick's substep as well.
-SIM_INLINE float substepDamping(float damping, vec4 verlet, uint s) { return s == 0u ? verlet.x : damping; }
+SIM_INLINE float substepDamping(float damping, VerletKeys verlet, uint s) {
+  return s == 0u ? verlet.first_damping : damping;
+}
 
 /// The wind a particle integrates with: the substep's, plus the air on it (from the air pass) when
 /// SIM_FLAG_AIR is set.

@@ -5,7 +5,7 @@
 // it. Each particle and each edge (a query) keeps a list of the primitives within contactReach of
 // it, as the CPU's lists do: built from the grid when the particles' travel since the last build
 // outgrew them (listsOutgrown; or the triangles, the radius or the audit say so), in the query's own slots, in
-// the order of the grid; a query with more than its slots (u.contact_check.w) looks the grid up
+// the order of the grid; a query with more than its slots (u.contact_check.list_capacity) looks the grid up
 // every substep. The grid's passes dispatch indirectly (contact_arm: no workgroups in a substep
 // that does not build it), and between builds contact_walk runs over the queries with pairs alone
 // (named in order at each build). A pair counts when its primitives are closer than the contact
@@ -25,7 +25,7 @@ void contactCross(uint t, uint s) {
   if (!gridBuilt()) return;
   uvec4 tri = triangles[t];
   uint was = contact_particles[tri.x].state.y | contact_particles[tri.y].state.y | contact_particles[tri.z].state.y;
-  bool all = s == 0u && (contactChecks().x & SIM_CONTACT_CHECK_ALL) != 0u;
+  bool all = s == 0u && (contactChecks().mode & SIM_CONTACT_CHECK_ALL) != 0u;
   if (!crossingChecked(all, (was & 2u) != 0u)) return;
   loadBox(t, lo, hi);
   float inv = contactInvCell();
@@ -66,11 +66,11 @@ void contactCross(uint t, uint s) {
 vec4 nearPosition(uint j, uint only) { return only >= NEAR_PASS ? contact_particles[j].start : SIM_POSITION(j); }
 
 // The settle stage's half-spaces listed by particle (settle_bodies.h), in scratch from
-// u.contact_check.z: particle i's count, then (their exclusive scan) where its list starts
+// u.contact_check.half_offset: particle i's count, then (their exclusive scan) where its list starts
 // (particles + 1 words), then its fill (particles words); the lists themselves (SlideHalf: five
 // words each, SIM_CONTACT_HALF_CAPACITY a particle) after the queries' pair lists
-uint halfStarts() { return contactChecks().z; }
-uint halfFills() { return contactChecks().z + u.particle_count + 1u; }
+uint halfStarts() { return contactChecks().half_offset; }
+uint halfFills() { return contactChecks().half_offset + u.particle_count + 1u; }
 uint halfEntries() { return listOf(u.particle_count + contactEdgeCount()); }
 uint halfFirst(uint i) { return scratch[halfStarts() + i]; }
 uint halfEnd(uint i) { return scratch[halfStarts() + i + 1u]; }
@@ -102,7 +102,7 @@ void listHalf(uint i, SlideHalf h, uint only) {
 uint pairParticle(uvec4 q, uint j) { return j == 0u ? q.x : (j == 1u ? q.y : (j == 2u ? q.z : q.w)); }
 
 // The mean of what particle i is passed (contactPassed), summed by contact_pass
-vec3 passedMean(uint i) { return contactAverage(ivec4(contact_particles[i].passed), contactKeys().w); }
+vec3 passedMean(uint i) { return contactAverage(ivec4(contact_particles[i].passed), contactKeys().fixed_units); }
 
 // The half-spaces pair q sets its particles' steps in (slideConstraint; `edge`: two edges; x0..x3
 // where they started the substep, c their nearest points): each step's excess beyond them passed
@@ -113,7 +113,7 @@ vec3 passedMean(uint i) { return contactAverage(ivec4(contact_particles[i].passe
 void slidePair(uvec4 q, vec3 x0, vec3 x1, vec3 x2, vec3 x3, NearestPoints c, bool edge, uint only) {
   vec3 frame = contactFrameNow();
   for (uint j = 0u; j < 4u; ++j) {
-    SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, contactKeys().x, contactKeys().y, j);
+    SlideHalf h = slideConstraint(x0, x1, x2, x3, c, edge, contactKeys().radius, contactKeys().fraction, j);
     if (h.h.w < 0.0f) continue;
     uint i = pairParticle(q, j);
     if (only >= NEAR_HALF_COUNT) {
@@ -137,7 +137,7 @@ void slidePair(uvec4 q, vec3 x0, vec3 x1, vec3 x2, vec3 x3, NearestPoints c, boo
       vec3 e = slideExcess(h, step);
       if (e != vec3(0.0f)) addPush(i, e);
     } else {
-      float share = slideShare(h, step + contactAverage(ivec4(contact_particles[i].sum), contactKeys().w));
+      float share = slideShare(h, step + contactAverage(ivec4(contact_particles[i].sum), contactKeys().fixed_units));
       if (share < 1.0f) atomicMin(contact_particles[i].state.z, floatBitsToUint(share));
     }
   }
@@ -187,7 +187,7 @@ void contactNearOf(uint k, uint only, bool particle) {
   bool build = only < NEAR_WALK && listsRebuilt();
   uint count = build ? 0u : contact_lists[list];
   // Through its list (which holds only live primitives: a tear builds the lists again)
-  bool walk = only == NEAR_WALK || (!build && count <= contactChecks().w);
+  bool walk = only == NEAR_WALK || (!build && count <= contactChecks().list_capacity);
   if (walk && count == 0u) return;
   if (only == NEAR_SEARCH && walk) return;
   if (particle && !build && contactFree(k)) return;
@@ -214,7 +214,7 @@ void contactNearOf(uint k, uint only, bool particle) {
       contact_lists[w + 2u] = floatBitsToUint(lo.z);
     }
   }
-  float reach = build ? 1.01f * contactReach(contactKeys().x) : 1.01f * contactKeys().x;
+  float reach = build ? 1.01f * contactReach(contactKeys().radius) : 1.01f * contactKeys().radius;
   lo -= vec3(reach);
   hi += vec3(reach);
   float inv = contactInvCell();
@@ -268,7 +268,7 @@ uint activeWord() { return contactBoxWord(u.triangle_count + contactEdgeCount())
 bool contactActive(uint k) { return contact_lists[listOf(k)] > 0u; }
 // True when query k has pairs in its list, all in its slots (contact_walk walks it until the next
 // build; one whose list overflowed searches the grid every substep, contact_near)
-bool contactWalks(uint k) { return contact_lists[listOf(k)] <= contactChecks().w; }
+bool contactWalks(uint k) { return contact_lists[listOf(k)] <= contactChecks().list_capacity; }
 
 // contact_active: query k's flag, 1 when it has pairs in its list (the end, k = queries: 0), at
 // scratch offset `flags` (scanned in place next)
@@ -311,7 +311,7 @@ void contactWalk(uint j) {
 // contact_bound: particle i's step bound (stepBound; unbounded when free) and push
 // (contactAverage); the particles in contact counted; the substep's frame (contactFrame)
 void contactBound(uint i, uint s) {
-  float r = contactKeys().x;
+  float r = contactKeys().radius;
   if (i == 0u && listsRebuilt()) {
     // The lists stand for these triangles and this radius (none when the positions went wrong)
     contact_lists[listHeader() + LIST_KEY] = contactGoneWrong() ? 0u : counters.triangle_count + 1u;
@@ -332,11 +332,13 @@ void contactBound(uint i, uint s) {
   uvec4 state = contact_particles[i].state;
   uint nearest = contactGoneWrong() ? 0u : state.x;
   if (nearest < floatBitsToUint(r * r)) atomicAdd(contact_words[CONTACT_COUNT], 1u);
-  contact_particles[i].start.w =
-      contactFreeState(state) ? uintBitsToFloat(0x7F800000u) : slideBound(uintBitsToFloat(nearest), r, contactKeys().y);
-  contact_particles[i].push = vec4(
-      contactPushWithin(contactAverage(ivec4(contact_particles[i].sum), contactKeys().w), uintBitsToFloat(nearest), r),
-      0.0f);
+  contact_particles[i].start.w = contactFreeState(state)
+                                     ? uintBitsToFloat(0x7F800000u)
+                                     : slideBound(uintBitsToFloat(nearest), r, contactKeys().fraction);
+  contact_particles[i].push =
+      vec4(contactPushWithin(contactAverage(ivec4(contact_particles[i].sum), contactKeys().fixed_units),
+                             uintBitsToFloat(nearest), r),
+           0.0f);
 }
 
 // The floor's step with contact (after floor.comp, contact_pass, contact_excess and contact_share):
@@ -352,7 +354,7 @@ VerletState contactSlideStep(uint i, VerletState st, uint s) {
   vec4 start = contact_particles[i].start;
   st = passedState(st, passedMean(i), u.floor_y);
   return slideStep(st, vec3(start), vec3(contact_particles[i].push),
-                   contactAverage(ivec4(contact_particles[i].sum), contactKeys().w),
+                   contactAverage(ivec4(contact_particles[i].sum), contactKeys().fixed_units),
                    uintBitsToFloat(contact_particles[i].state.z), start.w, contactFrameNow());
 }
 
@@ -363,7 +365,7 @@ void contactSlideClear(uint i) {
   contact_particles[i].sum = uvec4(0u);
   contact_particles[i].passed = uvec4(0u);
   contact_particles[i].state.z = floatBitsToUint(1.0f);
-  if (contactChecks().y == 0u) return;
+  if (contactChecks().sweeps == 0u) return;
   scratch[halfStarts() + i] = 0u;
   scratch[halfFills() + i] = 0u;
   if (i == 0u) scratch[halfStarts() + u.particle_count] = 0u;
@@ -384,7 +386,7 @@ vec3 settleFrame() { return contactFrameNow(); }
 // its colour's live count may say so too: that only runs a stage that moves nothing); true for the
 // one that starts the stage (the first of the substep found over)
 bool contactSettleCheck(uint k, uint s) {
-  return contactChecks().y > 0u && settleOver(constraints[k], s) &&
+  return contactChecks().sweeps > 0u && settleOver(constraints[k], s) &&
          atomicOr(contact_words[CONTACT_SETTLE_OVER], 1u) == 0u;
 }
 // True when an edge is over the limit as the stage starts: else it lists nothing and moves nothing

@@ -43,9 +43,9 @@
 // The entries of the grid, after the header: an entry k is live triangle slot k
 // (k < u.triangle_count) or edge k - u.triangle_count
 uint contactEntries() { return SIM_CONTACT_HEADER; }
-uint contactCounts() { return contactGrid().y; }
-uint contactFill() { return contactGrid().z; }
-uint contactEdgeCount() { return contactGrid().w; }
+uint contactCounts() { return contactGrid().counts; }
+uint contactFill() { return contactGrid().fills; }
+uint contactEdgeCount() { return contactGrid().edges; }
 
 // True when triangle id `id` is live (its two edge constraints stand, as the compaction keeps it)
 bool contactTriangleLive(uint id) {
@@ -90,7 +90,7 @@ bool gridBuilt() { return contact_words[CONTACT_GRID] != 0u; }
 // contact diameter, whichever is longer
 float contactInvCell() {
   float longest = simSqrt(uintBitsToFloat(contact_words[CONTACT_LONGEST]));
-  return simDiv(1.0f, SIM_CONTACT_CELL_ROOM * max(longest, 2.0f * contactKeys().x));
+  return simDiv(1.0f, SIM_CONTACT_CELL_ROOM * max(longest, 2.0f * contactKeys().radius));
 }
 
 // True when grid entry k is a live triangle slot or a live edge
@@ -148,7 +148,7 @@ bool boxesMeet(vec3 lo, vec3 hi, vec3 elo, vec3 ehi) {
 // The bucket of a cell: the triangles' in the first half of the table, the edges' in the second, so
 // that a look-up reads only the kind it looks for
 uint contactBucket(ivec3 cell, bool edge) {
-  return hashCell(cell, contactGrid().x) + (edge ? contactGrid().x + 1u : 0u);
+  return hashCell(cell, contactGrid().mask) + (edge ? contactGrid().mask + 1u : 0u);
 }
 
 // The buckets of the cells a box of grid entry k spans, each once (two cells of a box may share a
@@ -193,7 +193,7 @@ bool contactFree(uint i) { return contactFreeState(contact_particles[i].state); 
 // thickness pushes them apart (contactPush, in fixed point)
 // Adds a push to particle i's sum in fixed point (contactFixed) and counts it
 void addPush(uint i, vec3 push) {
-  ivec3 f = contactFixed(push, contactKeys().w);
+  ivec3 f = contactFixed(push, contactKeys().fixed_units);
   // Two's complement: unsigned sums have the bits of the signed ones
   atomicAdd(contact_particles[i].sum.x, uint(f.x));
   atomicAdd(contact_particles[i].sum.y, uint(f.y));
@@ -202,7 +202,7 @@ void addPush(uint i, vec3 push) {
 }
 // Adds what particle i is passed (contactPassed) to its passed sum in fixed point and counts it
 void addPassed(uint i, vec3 passed) {
-  ivec3 f = contactFixed(passed, contactKeys().w);
+  ivec3 f = contactFixed(passed, contactKeys().fixed_units);
   atomicAdd(contact_particles[i].passed.x, uint(f.x));
   atomicAdd(contact_particles[i].passed.y, uint(f.y));
   atomicAdd(contact_particles[i].passed.z, uint(f.z));
@@ -210,7 +210,7 @@ void addPassed(uint i, vec3 passed) {
 }
 
 void contactPair(uvec4 q, NearestPoints c) {
-  float r = contactKeys().x, thickness = contactKeys().z;
+  float r = contactKeys().radius, thickness = contactKeys().thickness;
   if (!(c.d2 < r * r)) return;
   lowerNearest(q.x, c.d2);
   lowerNearest(q.y, c.d2);
@@ -225,14 +225,14 @@ void contactPair(uvec4 q, NearestPoints c) {
 }
 
 // A pair of query `list` found by a build: kept when within contactReach (in the first
-// u.contact_check.w of its slots; the count goes on past them)
+// u.contact_check.list_capacity of its slots; the count goes on past them)
 void listPair(uint list, float d2, uint other) {
-  float reach = contactReach(contactKeys().x);
+  float reach = contactReach(contactKeys().radius);
   if (!(d2 < reach * reach)) return;
   uint c = contact_lists[list];
-  if (c < contactChecks().w)
+  if (c < contactChecks().list_capacity)
     contact_lists[list + 1u + c] = other;
-  else if (c == contactChecks().w)
+  else if (c == contactChecks().list_capacity)
     contact_words[CONTACT_OVERFLOW] = 1u;
   contact_lists[list] = c + 1u;
 }
@@ -250,7 +250,7 @@ void visitCrossing(uint t, uint o) {
   for (uint k = 0u; k < 6u; ++k) {
     uint i = k < 3u ? a[k] : b[k - 3u];
     atomicOr(contact_particles[i].state.y, 1u);
-    vec3 push = untanglePush(x[0], x[1], x[2], x[3], x[4], x[5], contactKeys().z, k);
+    vec3 push = untanglePush(x[0], x[1], x[2], x[3], x[4], x[5], contactKeys().thickness, k);
     if (push != vec3(0.0f)) addPush(i, push);
   }
   atomicOr(contact_words[CONTACT_TANGLED], 1u);
@@ -287,9 +287,9 @@ void contactBegin(uint s, bool passes) {
     contact_words[CONTACT_TRAVEL_LO + c] = 0xFFFFFFFFu;
   }
   contact_words[CONTACT_LOWEST] = 0x7F800000u;
-  bool audit = s == 0u && (contactChecks().x & SIM_CONTACT_CHECK_ALL) != 0u;
+  bool audit = s == 0u && (contactChecks().mode & SIM_CONTACT_CHECK_ALL) != 0u;
   bool stand = contact_lists[listHeader() + LIST_KEY] == counters.triangle_count + 1u &&
-               contact_lists[listHeader() + LIST_RADIUS] == floatBitsToUint(contactKeys().x) && !audit;
+               contact_lists[listHeader() + LIST_RADIUS] == floatBitsToUint(contactKeys().radius) && !audit;
   // The passes walk the queries contact_emit named: lists the fused tick built are built again
   if (passes) stand = stand && contact_lists[listHeader() + LIST_NAMED] == contact_lists[listHeader() + LIST_BUILDS];
   if (!stand) contact_words[CONTACT_REBUILD] = 1u;
@@ -305,7 +305,7 @@ vec3 gatheredCorner(uint w0) {
 // One invocation after contact_clear: the lists (and the grid) are built in this substep when the
 // particles' travel since the last build outgrew them (listsOutgrown)
 void contactTravelled() {
-  if (listsOutgrown(gatheredCorner(CONTACT_TRAVEL_LO), gatheredCorner(CONTACT_TRAVEL_HI), contactKeys().x)) {
+  if (listsOutgrown(gatheredCorner(CONTACT_TRAVEL_LO), gatheredCorner(CONTACT_TRAVEL_HI), contactKeys().radius)) {
     contact_words[CONTACT_REBUILD] = 1u;
     contact_words[CONTACT_GRID] = 1u;
   }
@@ -321,14 +321,14 @@ vec3 contactFrameNow() {
 // Elements contact_clear covers: the particles, the edges
 uint contactSlots() { return max(u.particle_count, contactEdgeCount()); }
 // Elements contact_grid_clear covers: the buckets and their end
-uint contactBucketSlots() { return 2u * (contactGrid().x + 1u) + 1u; }
+uint contactBucketSlots() { return 2u * (contactGrid().mask + 1u) + 1u; }
 
 // contact_clear: particle k's start of the substep, its travel since the lists were built into the
 // box contactTravelled looks at, and its last step and height above the floor into the frame's
 // inputs; edge k's squared length raises the longest
 void contactClear(uint k) {
   if (k < u.particle_count) {
-    float r = contactKeys().x;
+    float r = contactKeys().radius;
     vec4 x = SIM_POSITION(k);
     vec3 step = vec3(x) - vec3(prev[k]);
     for (uint c = 0u; c < 3u; ++c) {
@@ -387,7 +387,7 @@ void contactArm() {
 // contact_grid_clear: bucket k cleared when the grid is built (dispatched only then: contact_arm)
 void contactGridClear(uint k) {
   if (!gridBuilt()) return;
-  uint buckets = 2u * (contactGrid().x + 1u); // the triangles' and the edges'
+  uint buckets = 2u * (contactGrid().mask + 1u); // the triangles' and the edges'
   if (k <= buckets) scratch[contactCounts() + k] = 0u;
   if (k < buckets) scratch[contactFill() + k] = 0u;
 }

@@ -9,5 +9,5 @@
 
 void main() {
   uint k = namedQuery(threadIndex()); // the queries with pairs (armed as Grid::Named's)
-  if (k != SIM_NONE && contactChecks().y > 0u && settleStarts()) contactNear(k, NEAR_HALF_COUNT);
+  if (k != SIM_NONE && contactChecks().sweeps > 0u && settleStarts()) contactNear(k, NEAR_HALF_COUNT);
 }

@@ -114,7 +114,7 @@ bool contactAfterFloor(uint s, uint n, uint floor_pass, bool settle) {
     for (uint k = lid; k < queries; k += kInvocations) contactNear(k, only);
     sync();
   }
-  for (uint sweep = 0u; sweep < contactChecks().y; ++sweep) {
+  for (uint sweep = 0u; sweep < contactChecks().sweeps; ++sweep) {
     for (uint c = 0u; c < u.color_count; ++c) {
       uvec2 range = color_range[c];
       if (range.y == 0u || !shortensColour(constraints[range.x].kind_id)) continue;
@@ -142,7 +142,7 @@ void contactSubstep(uint s, uint n) {
   sync();
   for (uint k = lid; k < boxes; k += kInvocations) contactInsert(k, false);
   sync();
-  scanWorkgroup(SIM_SCAN_SCRATCH, contactCounts(), 2u * (contactGrid().x + 1u) + 1u, compactSlots());
+  scanWorkgroup(SIM_SCAN_SCRATCH, contactCounts(), 2u * (contactGrid().mask + 1u) + 1u, compactSlots());
   for (uint k = lid; k < boxes; k += kInvocations) contactInsert(k, true);
   sync();
   for (uint t = lid; t < u.triangle_count; t += kInvocations) contactCross(t, s);
@@ -267,8 +267,8 @@ bool colourStage(bool shorten, uint first) {
 // The stretch limit (as limit.comp): ring after ring from the roots
 void limitStage() {
   uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
-  vec4 limit = u.limit; // read whole (limitParticle says why)
-  uint rings = uint(limit.z);
+  LimitKeys limit = u.limit; // read whole (limitParticle says why)
+  uint rings = uint(limit.last_ring);
   for (uint k = 1u; k <= rings; ++k) {
     limitRing(roots, k, gl_LocalInvocationID.x, kInvocations);
     sync();
@@ -277,7 +277,7 @@ void limitStage() {
 
 // The creases (as crease.comp)
 void creaseStage() {
-  for (uint k = gl_LocalInvocationID.x; k < hingeKeys().y; k += kInvocations) creaseHinge(k);
+  for (uint k = gl_LocalInvocationID.x; k < hingeKeys().count; k += kInvocations) creaseHinge(k);
   sync();
 }
 

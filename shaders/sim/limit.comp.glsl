@@ -14,8 +14,8 @@
 void main() {
   if (!stageRuns(SIM_STAGE_limit, conditionsNow())) return; // the same branch for the whole workgroup
   uvec4 roots = limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
-  vec4 limit = u.limit; // read whole (limitParticle says why)
-  uint last = min(uint(limit.z), p.first + p.count - 1u);
+  LimitKeys limit = u.limit; // read whole (limitParticle says why)
+  uint last = min(uint(limit.last_ring), p.first + p.count - 1u);
   for (uint k = p.first; k <= last; ++k) {
     limitRing(roots, k, gl_LocalInvocationID.x, gl_WorkGroupSize.x);
     memoryBarrierBuffer();

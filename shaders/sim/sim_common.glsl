@@ -206,16 +206,17 @@ layout(std430, set = 0, binding = SIM_BIND_CONTACT_GRID) SIM_COHERENT buffer Con
 // crossing checks' arguments, each read whole: a fleet's lavapipe build (device addresses, Mesa
 // 22.3) misreads components of one vector loaded apart
 // (SpirvRules.NoSimShaderLoadsTwoComponentsOfAVectorApartByDeviceAddress)
-vec4 contactKeys() { return u.contact; }
-uvec4 contactChecks() { return u.contact_check; }
-uvec4 contactGrid() { return u.contact_grid; }
-uvec4 hingeKeys() { return u.hinge; }
+ContactKeys contactKeys() { return u.contact; }
+ContactChecks contactChecks() { return u.contact_check; }
+ContactGrid contactGrid() { return u.contact_grid; }
+HingeRange hingeKeys() { return u.hinge; }
 uvec4 walkArgs() { return hash_args[SIM_CONTACT_WALK_ARGS]; }
 uvec4 crossArgs() { return hash_args[SIM_CONTACT_CROSS_ARGS]; }
 // The conditions this sheet's uniforms meet (stageConditions: what runs in a substep).
 uint conditionsNow() {
-  vec4 crease = u.crease;
-  return stageConditions(u.flags, u.grab_index, hingeKeys().y, crease.y, u.limit.x, contactKeys().x, contactChecks().y);
+  CreaseKeys crease = u.crease;
+  return stageConditions(u.flags, u.grab_index, hingeKeys().count, crease.yield_angle, u.limit.reach,
+                         contactKeys().radius, contactChecks().sweeps);
 }
 
 // Linear index of this invocation; grids wider than SIM_MAX_GROUPS_X spill into Y.
@@ -283,7 +284,7 @@ bool batchGateTakes() {
   case SIM_LIVE_CONTACT_CROSS:
     return crossArgs().x != 0u;
   case SIM_LIVE_SWEEP:
-    return batch.arg < contactChecks().y;
+    return batch.arg < contactChecks().sweeps;
   default:
     return true;
   }

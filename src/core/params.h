@@ -98,7 +98,7 @@ struct SimParams {
   /// and friction, rho C / (2 sigma spacing^2).
   float airPressureFactor() const;
   float airFrictionFactor() const;
-  /// The XPBD compliance over dt^2 of a hinge across a grid edge (SimUniforms::crease.x): the
+  /// The XPBD compliance over dt^2 of a hinge across a grid edge (SimUniforms::crease.compliance): the
   /// discrete-shell stiffness 3 D |e|^2 / (A1 + A2) = 3 D of a grid hinge, per particle mass
   /// (paper_weight x spacing^2: the solver's masses are 1).
   float hingeCompliance() const;

@@ -58,7 +58,8 @@ std::vector<std::string> split(const std::string& s, char sep) {
 } // namespace
 
 uint32_t conditionsOf(const shaderio::SimUniforms& u) {
-  return stageConditions(u.flags, u.grab_index, u.hinge.y, u.crease.y, u.limit.x, u.contact.x, u.contact_check.y);
+  return stageConditions(u.flags, u.grab_index, u.hinge.count, u.crease.yield_angle, u.limit.reach, u.contact.radius,
+                         u.contact_check.sweeps);
 }
 
 uint32_t passesPerTick(const shaderio::SimUniforms& u) {

@@ -214,8 +214,8 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   // substeps key changed between them, or the hand's pace asks for more: tickParams)
   const float last_dt = last_uniforms_.dt;
   const bool rescaled = last_dt > 0.0f && last_dt != u.dt;
-  u.verlet = glm::vec4(rescaled ? float(double(p.damping) * double(u.dt) / double(last_dt)) : p.damping,
-                       rescaled ? float(double(u.dt) / double(last_dt)) : 0.0f, 0.0f, 0.0f);
+  u.verlet = {rescaled ? float(double(p.damping) * double(u.dt) / double(last_dt)) : p.damping,
+              rescaled ? float(double(u.dt) / double(last_dt)) : 0.0f, 0.0f, 0.0f};
   u.gravity = p.gravity;
   u.floor_y = p.floor_y;
   u.restitution = p.restitution;
@@ -227,17 +227,17 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   u.tear_kinds = (p.tear_structural ? 1u << SIM_KIND_STRUCTURAL : 0u) | (p.tear_shear ? 1u << SIM_KIND_SHEAR : 0u) |
                  (p.tear_bend ? (1u << SIM_KIND_BEND) | (1u << SIM_KIND_TRIBEND) : 0u);
   u.flags = (p.collision ? SIM_FLAG_COLLISION : 0u) | (pins_ ? SIM_FLAG_PINS : 0u) | (p.air ? SIM_FLAG_AIR : 0u);
-  if (p.air) u.air = glm::vec4(p.airPressureFactor(), p.airFrictionFactor(), 1.0f / (3.0f * u.dt), 0.0f);
+  if (p.air) u.air = {p.airPressureFactor(), p.airFrictionFactor(), 1.0f / (3.0f * u.dt), 0.0f};
   u.stiffness = glm::vec4(p.stiffness, p.stiffness, p.bend_stiffness, p.bend_stiffness);
-  u.hinge = glm::uvec4(topo_.hinge_first, topo_.hingeCount(), 0u, 0u);
-  u.crease = glm::vec4(p.hingeCompliance(), float(double(p.crease_yield) * (3.14159265358979323846 / 180.0)),
-                       p.crease_hardening, 0.0f);
+  u.hinge = {topo_.hinge_first, topo_.hingeCount(), 0u, 0u};
+  u.crease = {p.hingeCompliance(), float(double(p.crease_yield) * (3.14159265358979323846 / 180.0)), p.crease_hardening,
+              0.0f};
   u.reset_active = reset_frame_ > 0 ? 1u : 0u;
   u.reset_alpha = reset_frame_ > 0 ? float(SIM_RESET_FRAMES - reset_frame_ + 1) / float(SIM_RESET_FRAMES) : 0.0f;
   u.iterations = p.iterations;
   if (p.contactRadius() > 0.0f) {
     const float thickness = p.contactRadius() * SIM_CONTACT_THICKNESS;
-    u.contact = glm::vec4(p.contactRadius(), SIM_CONTACT_FRACTION, thickness, SIM_CONTACT_FIXED / thickness);
+    u.contact = {p.contactRadius(), SIM_CONTACT_FRACTION, thickness, SIM_CONTACT_FIXED / thickness};
   }
 
   u.grab_index = grab_index_ != SIM_NONE ? grab_index_ : release_index_;
@@ -245,9 +245,9 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   if (grab_index_ != SIM_NONE && closure_ > 0.0f && p.hand_reach > 0.0f) {
     const double dt = double(u.dt);
     const float ball = std::min(p.handBallRadius(), p.hand_reach);
-    u.hand = glm::vec4(p.hand_reach - (p.hand_reach - ball) * closure_, p.hand_reach,
-                       float(-std::expm1(-dt / kHandPullSeconds)), float(-std::expm1(-dt / kHandGripSeconds)));
-    u.hand_motion = glm::vec4((grab_to_ - grab_from_) / float(p.substeps), p.floor_y + u.hand.x);
+    u.hand = {p.hand_reach - (p.hand_reach - ball) * closure_, p.hand_reach, float(-std::expm1(-dt / kHandPullSeconds)),
+              float(-std::expm1(-dt / kHandGripSeconds))};
+    u.hand_motion = {(grab_to_ - grab_from_) / float(p.substeps), p.floor_y + u.hand.fist};
   }
   setSubstepInputs(p, u);
   // Every triangle is checked for crossing the sheet in the first substep of a tick when contact
@@ -255,8 +255,8 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
   // otherwise those already crossing (crossingChecked in contact.h)
   const bool audit = !contact_on_last_ || physics_ticks_ % SIM_CONTACT_AUDIT_TICKS == 0;
   // The settle's sweeps, with the stretch limit on
-  if (u.contact.x > 0.0f)
-    u.contact_check = glm::uvec4(audit ? SIM_CONTACT_CHECK_ALL : 0u, u.limit.x > 0.0f ? p.contact_settle : 0u, 0u, 0u);
+  if (u.contact.radius > 0.0f)
+    u.contact_check = {audit ? SIM_CONTACT_CHECK_ALL : 0u, u.limit.reach > 0.0f ? p.contact_settle : 0u, 0u, 0u};
   return u;
 }
 
@@ -264,16 +264,16 @@ shaderio::SimUniforms Simulation::makeUniforms() const {
 // roots (the grab, else the pins that hold the sheet: limitRootSet) and its last ring
 void Simulation::setLimitUniforms(const SimParams& p, shaderio::SimUniforms& u) const {
   if (!(p.stretch_limit > 0.0f)) return;
-  u.limit = glm::vec4(p.stretch_limit * p.spacing, p.spacing, 0.0f, 0.0f);
+  u.limit = {p.stretch_limit * p.spacing, p.spacing, 0.0f, 0.0f};
   const std::vector<uint32_t> pins = pins_ ? pinIndices(p.pins, p.cols, p.rows) : std::vector<uint32_t>{};
   if (grab_index_ == SIM_NONE && release_index_ == SIM_NONE && !pins.empty()) {
     u.limit_roots = glm::uvec4(SIM_NONE, SIM_NONE, SIM_NONE, 0u);
     for (const uint32_t pin : pins)
       if (u.limit_roots.w < SIM_LIMIT_ROOTS) u.limit_roots[int(u.limit_roots.w++)] = pin;
   }
-  if (u.limit.x > 0.0f) {
+  if (u.limit.reach > 0.0f) {
     const glm::uvec4 roots = shaderio::limitRootSet(u.limit_roots, u.grab_index, u.cols, u.rows);
-    u.limit.z = float(shaderio::limitLastRing(roots, u.cols, u.rows));
+    u.limit.last_ring = float(shaderio::limitLastRing(roots, u.cols, u.rows));
   }
 }
 
@@ -307,7 +307,7 @@ void Simulation::runPhysicsTick() {
   last_uniforms_ = makeUniforms();
   solver_.tick(last_uniforms_);
   ++physics_ticks_;
-  contact_on_last_ = last_uniforms_.contact.x > 0.0f;
+  contact_on_last_ = last_uniforms_.contact.radius > 0.0f;
   release_index_ = SIM_NONE;
   if (grab_index_ != SIM_NONE) {
     grab_from_ = grab_to_;

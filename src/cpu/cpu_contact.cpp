@@ -40,20 +40,21 @@ void CpuContact::computeBounds(const std::vector<glm::vec4>& pos, const std::vec
                                const std::vector<uvec4>& triangles, uint32_t count, const SimUniforms& u, uint32_t s,
                                std::vector<float>& bound, std::vector<glm::vec4>& push) {
   const uint32_t n = uint32_t(pos.size());
-  const float radius = u.contact.x, thickness = u.contact.z, scale = u.contact.w;
+  const float radius = u.contact.radius, thickness = u.contact.thickness, scale = u.contact.fixed_units;
   bound.resize(n);
   push.resize(n);
   const auto [travel_lo, travel_hi] = gatherFrame(pos, prev, u, s);
   if (edges_key_ != count) listEdges(triangles, count);
   keepLists(pos, triangles, count, radius, travel_lo, travel_hi);
   sums_.assign(n, glm::ivec4(0));
-  findCrossings(pos, triangles, count, s == 0 && (u.contact_check.x & SIM_CONTACT_CHECK_ALL) != 0u, thickness, scale);
-  lowerNearest(pos, radius, thickness, scale, u.contact.y);
+  findCrossings(pos, triangles, count, s == 0 && (u.contact_check.mode & SIM_CONTACT_CHECK_ALL) != 0u, thickness,
+                scale);
+  lowerNearest(pos, radius, thickness, scale, u.contact.fraction);
   const uint32_t none = std::bit_cast<uint32_t>(radius * radius);
   uint64_t contacts = 0;
   for (uint32_t i = 0; i < n; ++i) {
     contacts += nearest2_[i] < none ? 1u : 0u;
-    bound[i] = free_[i] ? INFINITY : slideBound(std::bit_cast<float>(nearest2_[i]), radius, u.contact.y);
+    bound[i] = free_[i] ? INFINITY : slideBound(std::bit_cast<float>(nearest2_[i]), radius, u.contact.fraction);
     push[i] =
         glm::vec4(contactPushWithin(contactAverage(sums_[i], scale), std::bit_cast<float>(nearest2_[i]), radius), 0.0f);
   }
@@ -200,7 +201,7 @@ void CpuContact::visitHalfSpaces(Visit&& visit) {
 void CpuContact::slide(const std::vector<glm::vec4>& start, const std::vector<glm::vec4>& pos, const SimUniforms& u,
                        std::vector<glm::vec4>& passed, std::vector<glm::vec4>& excess, std::vector<float>& share) {
   const uint32_t n = uint32_t(pos.size());
-  const float scale = u.contact.w;
+  const float scale = u.contact.fixed_units;
   passed.assign(n, glm::vec4(0.0f));
   excess.assign(n, glm::vec4(0.0f));
   share.assign(n, 1.0f);

@@ -115,7 +115,7 @@ void CpuSolver::integrate(const SimUniforms& u, uint32_t s, bool air) {
       pos[i] = st.position;
       prev[i] = st.previous;
     }
-    for (uint32_t i = begin; u.hand.y > 0.0f && i < end; ++i) // the hand closed: its pull
+    for (uint32_t i = begin; u.hand.reach > 0.0f && i < end; ++i) // the hand closed: its pull
       if (!placedByGrab(i == u.grab_index, target))
         pos[i] = handPull(pos[i], prev[i], i, vec3(target), u.hand, u.hand_motion);
   });
@@ -135,7 +135,7 @@ void CpuSolver::projectRange(SheetElements& e, const float stiffness[4], uint32_
   if (simd_ && hinges) {
     k = simd::projectHinges(reinterpret_cast<float*>(pos_.data()), reinterpret_cast<float*>(hinges_.data()),
                             hinge_corners_.data(), con_hinge_.data(), firstDiagonalHinge(topo_->cols, topo_->rows),
-                            e.u.crease.x, begin, end);
+                            e.u.crease.compliance, begin, end);
   }
   for (; k < end; ++k)
     e.projectConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]}, iteration);
@@ -204,19 +204,20 @@ void CpuSolver::shortenColors(const SimUniforms& u, uint32_t first, uint32_t cou
       const uint32_t end = start + WorkerPool::chunkBound(edges[c], chunks, chunk + 1);
       uint32_t k = start + WorkerPool::chunkBound(edges[c], chunks, chunk);
       if (simd_)
-        k = simd::shorten(reinterpret_cast<float*>(pos_.data()), ca, cb, rest, kind, u.limit.x, u.tear_factor, tears, k,
-                          end);
+        k = simd::shorten(reinterpret_cast<float*>(pos_.data()), ca, cb, rest, kind, u.limit.reach, u.tear_factor,
+                          tears, k, end);
       for (; k < end; ++k) e.shortenConstraint(Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]});
     });
 }
 
 void CpuSolver::creasePass(const SimUniforms& u) {
   SheetElements e = elements(u);
-  pool_->parallelFor(u.hinge.y, grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
+  pool_->parallelFor(u.hinge.count, grain_(kGrainConstraints), [&](uint32_t begin, uint32_t end) {
     uint32_t k = begin;
     if (simd_)
       k = simd::creaseHinges(reinterpret_cast<float*>(pos_.data()), reinterpret_cast<float*>(hinges_.data()),
-                             hinge_corners_.data(), torn_.data() + u.hinge.x, u.crease.y, u.crease.z, begin, end);
+                             hinge_corners_.data(), torn_.data() + u.hinge.first, u.crease.yield_angle,
+                             u.crease.hardening, begin, end);
     for (; k < end; ++k) e.creaseHinge(k);
   });
 }
@@ -294,7 +295,7 @@ void CpuSolver::floorPass(const SimUniforms& u, uint32_t s, bool contact) {
 }
 
 // The settle sweeps, after the contact's cut and push (settle_bodies.h): over the structural edges
-// of each colour, contact_check.y times; none when no edge is over the limit, and no more after a
+// of each colour, contact_check.sweeps times; none when no edge is over the limit, and no more after a
 // sweep that moved nothing (the next would move nothing either: the bits are the same).
 void CpuSolver::settlePass(const SimUniforms& u, uint32_t s) {
   const uint32_t colors = uint32_t(colors_.size());
@@ -329,7 +330,7 @@ void CpuSolver::settlePass(const SimUniforms& u, uint32_t s) {
   e.half_start = contact_.halfStart().data();
   e.half_spaces = contact_.halfSpaces().data();
   e.half_slack = contact_.halfSlack().data();
-  for (uint32_t k = 0; k < u.contact_check.y; ++k)
+  for (uint32_t k = 0; k < u.contact_check.sweeps; ++k)
     if (!sweep([&](Constraint c) { return e.settleConstraint(c, s); })) break;
 }
 

@@ -106,7 +106,7 @@ public:
   /// The ground contact; with contact on (SimUniforms::contact),
   /// no free particle ends farther from where it started the substep than its bound (contact.h).
   void floorPass(const shaderio::SimUniforms& u, uint32_t substep, bool contact);
-  /// The settle stage, with contact and its sweeps on (SimUniforms::contact_check.y): the
+  /// The settle stage, with contact and its sweeps on (SimUniforms::contact_check.sweeps): the
   /// half-spaces listed by particle, then the sweeps over the structural edges of each colour.
   void settlePass(const shaderio::SimUniforms& u, uint32_t s);
   /// How many structural edges each colour holds at its head (the shorten and settle stages visit those).

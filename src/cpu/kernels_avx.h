@@ -17,7 +17,7 @@ uint32_t projectColor(float* pos, const uint32_t* a, const uint32_t* b, const fl
 
 /// The stretch limit as the shorten stage reads it (shortenConstraint).
 struct ShortenLimit {
-  float reach;       ///< the longest an edge may be (SimUniforms::limit.x)
+  float reach;       ///< the longest an edge may be (SimUniforms::limit.reach)
   float tear_factor; ///< SimUniforms::tear_factor
   bool tears;        ///< structural edges tear (tearingOn and SimUniforms::tear_kinds)
 };
@@ -33,7 +33,7 @@ struct HingeSlots {
   const uint32_t* corners; ///< 4 per hinge: the edge's ends and its opposite corners (gridHinge)
   const uint32_t* hinge;   ///< per slot: the hinge (its HingeState)
   uint32_t first_diagonal; ///< hinges from here on are diagonals (half the compliance)
-  float alpha;             ///< compliance over dt^2 of an edge hinge (SimUniforms::crease.x)
+  float alpha;             ///< compliance over dt^2 of an edge hinge (SimUniforms::crease.compliance)
 };
 
 /// Projects the hinges of slots [begin, end) of one colour, eight at a time, with the exact

@@ -33,24 +33,24 @@ GpuBatch::FlushQueue GpuBatch::takeQueued() {
     if (!q) continue;
     SimUniforms u = *q;
     q.reset();
-    if (u.contact.x > 0.0f) {
+    if (u.contact.radius > 0.0f) {
       // The fleet sized its contact buffers when a sheet was made with contact on
       if (!sizes_.contact)
         throw std::runtime_error("contact_factor was turned on in a fleet made without it: a fleet on the GPU "
                                  "needs it set when its sheets are made");
-      u.contact_grid =
-          glm::uvec4(sizes_.contact_buckets / 2 - 1, sizes_.contact_counts, sizes_.contact_fill, sizes_.contact_edges);
-      u.contact_check.z = sizes_.contact_half;
-      u.contact_check.w = SIM_CONTACT_LIST_CAPACITY;
+      u.contact_grid = {sizes_.contact_buckets / 2 - 1, sizes_.contact_counts, sizes_.contact_fill,
+                        sizes_.contact_edges};
+      u.contact_check.half_offset = sizes_.contact_half;
+      u.contact_check.list_capacity = SIM_CONTACT_LIST_CAPACITY;
     }
     ticked_ = true;
-    contact_on_[i] = u.contact.x > 0.0f;
+    contact_on_[i] = u.contact.radius > 0.0f;
     if (keepsCandidateLists(sizes_, candidates_allowed_)) u.flags |= SIM_FLAG_CANDIDATES; // as the solver does
     std::memcpy(inputs + f.uniforms_at + stride_[SIM_BIND_UNIFORMS] * i, &u, sizeof(u));
     const uint32_t substeps = u.reset_active ? 0u : substepCount(u.substeps);
     // A sheet with contact takes the fused tick with contact's bodies where the device's shape runs
     // them in the workgroup (FusedShape::contact), the per-colour passes elsewhere
-    const bool contact = u.contact.x > 0.0f;
+    const bool contact = u.contact.radius > 0.0f;
     if (fits_fused && fusedTickTakes(u, spacing_, fused_max_cell_spacings_, fused_contact_)) {
       f.fused_substeps = std::max(f.fused_substeps, std::max(substeps, 1u));
       (contact ? f.fused_contact : f.fused).push_back(i);

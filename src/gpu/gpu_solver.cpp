@@ -130,7 +130,7 @@ void GpuSolver::collectTimes(const InFlight& flight) const {
 }
 
 void GpuSolver::tick(const SimUniforms& u) {
-  const bool contact = u.contact.x > 0.0f;
+  const bool contact = u.contact.radius > 0.0f;
   if (contact) {
     // The contact's buffers and pipelines, the first time contact is on
     if (!layout_sizes_.contact) sizeContact();
@@ -148,10 +148,10 @@ void GpuSolver::tick(const SimUniforms& u) {
   SimUniforms gpu_u = u;
   if (usesCandidateLists()) gpu_u.flags |= SIM_FLAG_CANDIDATES;
   if (contact) {
-    gpu_u.contact_grid = glm::uvec4(layout_sizes_.contact_buckets / 2 - 1, layout_sizes_.contact_counts,
-                                    layout_sizes_.contact_fill, layout_sizes_.contact_edges);
-    gpu_u.contact_check.z = layout_sizes_.contact_half;
-    gpu_u.contact_check.w = contact_list_capacity_;
+    gpu_u.contact_grid = {layout_sizes_.contact_buckets / 2 - 1, layout_sizes_.contact_counts,
+                          layout_sizes_.contact_fill, layout_sizes_.contact_edges};
+    gpu_u.contact_check.half_offset = layout_sizes_.contact_half;
+    gpu_u.contact_check.list_capacity = contact_list_capacity_;
   }
   std::memcpy(static_cast<char*>(buf_[SIM_BIND_UNIFORMS].mapped) + index * uniform_stride_, &gpu_u, sizeof(gpu_u));
   if (u.reset_active) {
@@ -312,7 +312,7 @@ bool fusedTickFits(const SheetTopology& topo, uint32_t capacity) {
 }
 
 bool fusedTickTakes(const SimUniforms& u, float spacing, float max_cell_spacings, bool contact_in_workgroup) {
-  if (u.contact.x > 0.0f && !contact_in_workgroup) return false;
+  if (u.contact.radius > 0.0f && !contact_in_workgroup) return false;
   if ((u.flags & SIM_FLAG_COLLISION) == 0u || max_cell_spacings < 0.0f) return true;
   return u.inv_cell * max_cell_spacings * spacing >= 1.0f;
 }

@@ -324,7 +324,7 @@ SubstepPlan substepPlan(const shaderio::SimUniforms& u, uint32_t stop) {
   plan.iterations = u.iterations;
   plan.when = conditionsOf(u);
   plan.stop = stop;
-  plan.sweeps = runsWhen(SIM_WHEN_SETTLE, plan.when) ? u.contact_check.y : 0u;
+  plan.sweeps = runsWhen(SIM_WHEN_SETTLE, plan.when) ? u.contact_check.sweeps : 0u;
   return plan;
 }
 

@@ -120,7 +120,7 @@ struct SubstepPlan {
   uint32_t iterations = 0;
   uint32_t when = SIM_WHEN_ALWAYS; ///< the conditions met (SIM_WHEN_* bits, stageConditions)
   uint32_t stop = SIM_NONE;        ///< last pass to record (SIM_STAGES numbering; Solver::stopNextTickAfter)
-  uint32_t sweeps = 0;             ///< the settle stage's sweeps (SimUniforms::contact_check.y)
+  uint32_t sweeps = 0;             ///< the settle stage's sweeps (SimUniforms::contact_check.sweeps)
 
   /// Widens this plan to cover `other`'s passes as well (its stop is kept).
   void add(const SubstepPlan& other);

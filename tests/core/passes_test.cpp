@@ -21,11 +21,11 @@ shaderio::SimUniforms uniforms(uint32_t substeps, uint32_t iterations, uint32_t 
 shaderio::SimUniforms everyStage(uint32_t substeps, uint32_t iterations, uint32_t colors) {
   shaderio::SimUniforms u = uniforms(substeps, iterations, colors, true);
   u.grab_index = SIM_NONE;
-  u.limit.x = 1.0f;
-  u.hinge.y = 4;
-  u.crease.y = 0.2f;
-  u.contact.x = 0.1f;
-  u.contact_check.y = 2;
+  u.limit.reach = 1.0f;
+  u.hinge.count = 4;
+  u.crease.yield_angle = 0.2f;
+  u.contact.radius = 0.1f;
+  u.contact_check.sweeps = 2;
   return u;
 }
 
@@ -65,21 +65,21 @@ TEST(Passes, AStageIsNumberedOnlyWhileItsConditionHolds) {
   EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::shorten, 0, 0}));
   // Each condition adds its stage's passes, the shorten stage's once per colour of each iteration
   const uint32_t base = passesPerTick(u);
-  u.limit.x = 1.0f;
+  u.limit.reach = 1.0f;
   EXPECT_EQ(passesPerTick(u), base + 2u);
   EXPECT_EQ(passIndex(u, PassPoint{0, PassKind::limit}), 7u);
   u.grab_index = SIM_NONE;
   EXPECT_EQ(passesPerTick(u), base + 2u * (1u + 6u));
   u.flags |= SIM_FLAG_PINS; // pins hold the sheet: no shortening
   EXPECT_EQ(passesPerTick(u), base + 2u);
-  u.contact.x = 0.1f;
+  u.contact.radius = 0.1f;
   EXPECT_EQ(passIndex(u, PassPoint{0, PassKind::contact}), 0u);
   EXPECT_FALSE(passIndex(u, PassPoint{0, PassKind::settle}));
-  u.contact_check.y = 4;
+  u.contact_check.sweeps = 4;
   EXPECT_EQ(passesPerTick(u), base + 2u * 3u);
-  u.hinge.y = 3;
+  u.hinge.count = 3;
   EXPECT_EQ(passesPerTick(u), base + 2u * 3u);
-  u.crease.y = 0.1f;
+  u.crease.yield_angle = 0.1f;
   EXPECT_EQ(passesPerTick(u), base + 2u * 4u);
   u.flags |= SIM_FLAG_AIR;
   EXPECT_EQ(passesPerTick(u), base + 2u * 5u);

@@ -55,7 +55,7 @@ Layers stackedLayers(uint32_t side, uint32_t layers, float gap, glm::vec2 shift)
 shaderio::SimUniforms contactUniforms(float radius) {
   shaderio::SimUniforms u{};
   const float thickness = radius * SIM_CONTACT_THICKNESS;
-  u.contact = glm::vec4(radius, SIM_CONTACT_FRACTION, thickness, SIM_CONTACT_FIXED / thickness);
+  u.contact = {radius, SIM_CONTACT_FRACTION, thickness, SIM_CONTACT_FIXED / thickness};
   u.floor_y = -10.0f;
   return u;
 }
@@ -78,7 +78,7 @@ struct KeptAgainstRebuilt {
     kept.computeBounds(pos, prev, triangles, uint32_t(triangles.size()), u, 1, bound_b, push_b);
     moved.resize(pos.size());
     for (size_t i = 0; i < pos.size(); ++i)
-      moved[i] = pos[i] + glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.3f * u.contact.x;
+      moved[i] = pos[i] + glm::vec4(unit(rng), unit(rng), unit(rng), 0.0f) * 0.3f * u.contact.radius;
     rebuilt.slide(pos, moved, u, passed_a, excess_a, share_a);
     kept.slide(pos, moved, u, passed_b, excess_b, share_b);
     if (!sameBytes(bound_a, bound_b)) return testing::AssertionFailure() << "the bounds differ";
@@ -227,7 +227,7 @@ struct BruteBounds {
 BruteBounds bruteForceBounds(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles,
                              const std::vector<glm::uvec2>& edges, const shaderio::SimUniforms& u) {
   const uint32_t n = uint32_t(pos.size());
-  const float radius = u.contact.x, thickness = radius * SIM_CONTACT_THICKNESS, r2 = radius * radius;
+  const float radius = u.contact.radius, thickness = radius * SIM_CONTACT_THICKNESS, r2 = radius * radius;
   auto at = [&](uint32_t i) { return vec3(pos[i]); };
   std::vector<float> nearest2(n, r2);
   std::vector<glm::ivec4> sums(n, glm::ivec4(0));
@@ -236,14 +236,14 @@ BruteBounds bruteForceBounds(const std::vector<glm::vec4>& pos, const std::vecto
     if (!(c.d2 < r2)) return;
     for (uint32_t j = 0; j < 4; ++j) {
       const shaderio::SlideHalf h =
-          shaderio::slideConstraint(at(q.x), at(q.y), at(q.z), at(q.w), c, edge, radius, u.contact.y, j);
+          shaderio::slideConstraint(at(q.x), at(q.y), at(q.z), at(q.w), c, edge, radius, u.contact.fraction, j);
       if (h.h.w >= 0.0f) want.halves.push_back(Half{q, c, edge, j, h});
     }
     for (uint32_t i : {q.x, q.y, q.z, q.w}) nearest2[i] = std::min(nearest2[i], c.d2);
     if (!(c.d2 < thickness * thickness)) return;
     for (uint32_t j = 0; j < 4; ++j) {
       const glm::ivec3 f = shaderio::contactFixed(
-          shaderio::contactPush(pos[q.x], pos[q.y], pos[q.z], pos[q.w], c, thickness, j), u.contact.w);
+          shaderio::contactPush(pos[q.x], pos[q.y], pos[q.z], pos[q.w], c, thickness, j), u.contact.fixed_units);
       sums[q[j]] += glm::ivec4(f, 1);
     }
   };
@@ -260,9 +260,10 @@ BruteBounds bruteForceBounds(const std::vector<glm::vec4>& pos, const std::vecto
   want.bound.resize(n);
   want.push.resize(n);
   for (uint32_t i = 0; i < n; ++i) {
-    want.bound[i] = shaderio::slideBound(nearest2[i], radius, u.contact.y);
+    want.bound[i] = shaderio::slideBound(nearest2[i], radius, u.contact.fraction);
     want.push[i] = glm::vec4(
-        shaderio::contactPushWithin(shaderio::contactAverage(sums[i], u.contact.w), nearest2[i], radius), 0.0f);
+        shaderio::contactPushWithin(shaderio::contactAverage(sums[i], u.contact.fixed_units), nearest2[i], radius),
+        0.0f);
     want.pushed += sums[i].w > 0 ? 1u : 0u;
   }
   return want;
@@ -292,12 +293,13 @@ BruteSlide bruteForceSlide(const std::vector<Half>& halves, const std::vector<gl
       const bool other = a.edge ? (k < 2) != (a.j < 2) : (k == 0) != (a.j == 0);
       if (!other || !(moved[a.q[k]].w > 0.0f)) continue;
       const float wk = std::abs(a.c.w[int(k)]);
-      passed_sums[a.q[k]] += glm::ivec4(shaderio::contactFixed(e * (-SIM_CONTACT_PASS_FRACTION * wk), u.contact.w), 1);
+      passed_sums[a.q[k]] +=
+          glm::ivec4(shaderio::contactFixed(e * (-SIM_CONTACT_PASS_FRACTION * wk), u.contact.fixed_units), 1);
     }
   }
   want.passed.resize(n);
   for (uint32_t i = 0; i < n; ++i)
-    want.passed[i] = glm::vec4(shaderio::contactAverage(passed_sums[i], u.contact.w), 0.0f);
+    want.passed[i] = glm::vec4(shaderio::contactAverage(passed_sums[i], u.contact.fixed_units), 0.0f);
   auto step = [&](uint32_t i) {
     glm::vec3 x = vec3(moved[i]) + vec3(want.passed[i]);
     x.y = std::max(x.y, std::min(moved[i].y, u.floor_y));
@@ -307,12 +309,12 @@ BruteSlide bruteForceSlide(const std::vector<Half>& halves, const std::vector<gl
   for (const Half& a : halves) {
     const uint32_t i = a.q[a.j];
     const vec3 e = shaderio::slideExcess(a.h, step(i));
-    if (e != vec3(0.0f)) excess_sums[i] += glm::ivec4(shaderio::contactFixed(e, u.contact.w), 1);
+    if (e != vec3(0.0f)) excess_sums[i] += glm::ivec4(shaderio::contactFixed(e, u.contact.fixed_units), 1);
   }
   want.excess.resize(n);
   want.share.assign(n, 1.0f);
   for (uint32_t i = 0; i < n; ++i)
-    want.excess[i] = glm::vec4(shaderio::contactAverage(excess_sums[i], u.contact.w), 0.0f);
+    want.excess[i] = glm::vec4(shaderio::contactAverage(excess_sums[i], u.contact.fixed_units), 0.0f);
   for (const Half& a : halves) {
     const uint32_t i = a.q[a.j];
     want.share[i] = std::min(want.share[i], shaderio::slideShare(a.h, step(i) + vec3(want.excess[i])));

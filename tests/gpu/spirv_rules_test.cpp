@@ -185,10 +185,11 @@ TEST(SpirvRules, NoSimShaderLoadsAVectorAndOneOfItsComponentsByDeviceAddress) {
 
 // Lavapipe's load vectoriser (Mesa 22.3) merges components of one vector loaded apart by device
 // address into one load that it can read wrongly: the fleet's fused contact kernel, reading
-// `u.contact_grid.y` and `u.contact_grid.z` apart, cleared the wrong buckets of its grid (counts of
-// billions, then a scatter far out of bounds). So a kernel loads a vector it reaches by device address
-// whole, at most once per chain, or one component of it alone: never two components apart. Loads
-// through a pointer held in a variable (a fleet's `u`, loaded again at each use) count as one chain.
+// `u.contact_grid.y` and `.z` apart (now ContactGrid's counts and fills), cleared the wrong buckets of its grid (counts
+// of billions, then a scatter far out of bounds). So a kernel loads a vector it reaches by device address whole, at
+// most once per chain, or one component of it alone: never two components apart; and so for the fields of the uniforms'
+// topics (SimUniforms' 16-byte structs). Loads through a pointer held in a variable (a fleet's `u`, loaded again at
+// each use) count as one chain.
 namespace {
 
 // The components of each vector a shader loads through a chain from a device address (a
@@ -256,20 +257,19 @@ VectorLoads deviceAddressVectorLoads(const std::vector<Instruction>& code) {
     const uint32_t root = root_type[c[0]];
     uint32_t t = type.count(root) && type[root]->op == 32 ? type[root]->words[3] : 0;
     std::string path = "%"; // (appended to, not "%" + ...: see nameOf in spirv_rules.cpp)
-    if (name.count(c[0]))
-      path = name[c[0]];
-    else if (name.count(t))
-      path = name[t];
-    else
-      path += std::to_string(c[0]);
+    path = name.count(c[0]) ? name[c[0]] : name.count(t) ? name[t] : path + std::to_string(c[0]);
+    uint32_t parent = 0;
     for (size_t k = 1; k + 1 < c.size() && t; ++k) {
       if (type.count(t) && type[t]->op == 30 && constant.count(c[k]))
         path += "." + member_name[{t, constant[c[k]]}];
       else
         path += "[]";
+      parent = t;
       t = member(t, c[k]);
     }
-    if (!t || !type.count(t) || type[t]->op != 23 /*Vector*/ || !constant.count(c.back())) continue;
+    // A vector, or a topic of the uniforms (SimUniforms' 16-byte structs), whose fields it merges alike
+    const bool topic = t && type.count(t) && type[t]->op == 30 && name.count(parent) && name[parent] == "SimUniforms";
+    if (!t || !type.count(t) || (type[t]->op != 23 /*Vector*/ && !topic) || !constant.count(c.back())) continue;
     const std::vector<uint32_t> vector(c.begin(), c.end() - 1);
     loads.components[vector].insert(constant[c.back()]);
     loads.paths[vector] = path;
@@ -280,6 +280,7 @@ VectorLoads deviceAddressVectorLoads(const std::vector<Instruction>& code) {
 } // namespace
 
 TEST(SpirvRules, NoSimShaderLoadsTwoComponentsOfAVectorApartByDeviceAddress) {
+  // (nor two fields of one of the uniforms' topics)
   uint32_t vectors = 0;
   for (std::string_view key : simShaderKeys()) {
     const VectorLoads loads = deviceAddressVectorLoads(instructions(simShader(key)));

@@ -109,7 +109,7 @@ TEST_F(StoppedTick, EveryShortenPassMatchesTheCpuFusedAndPerColour) {
   for (uint64_t t = 0; t <= tick; ++t) sim.tick();
   const shaderio::SimUniforms u = sim.lastUniforms();
   ASSERT_EQ(u.grab_index, SIM_NONE);
-  ASSERT_TRUE(shaderio::limitShortens(u.limit.x, u.grab_index, u.flags));
+  ASSERT_TRUE(shaderio::limitShortens(u.limit.reach, u.grab_index, u.flags));
   gpu::GpuSolver fused(ctx()), percolor(ctx());
   percolor.setFusedPath(false);
   CpuSolver cpu;

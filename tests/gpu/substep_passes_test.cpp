@@ -165,10 +165,10 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
   u.color_count = topo.colorCount();
   u.flags = SIM_FLAG_COLLISION;
   u.grab_index = SIM_NONE; // nothing holds the sheet: the limit shortens edges first
-  u.limit.x = 1.0f;
-  u.hinge.y = topo.hingeCount();
-  u.crease.y = 0.2f;
-  ASSERT_GT(u.hinge.y, 0u);
+  u.limit.reach = 1.0f;
+  u.hinge.count = topo.hingeCount();
+  u.crease.yield_angle = 0.2f;
+  ASSERT_GT(u.hinge.count, 0u);
   // The last kernel each stage records
   const auto lastOf = [](PassKind kind) -> std::string {
     switch (kind) {
