@@ -68,34 +68,57 @@ inline SimParams cloth(std::initializer_list<const char*> sets = {}) {
 
 /// SimParams' defaults with the space-separated `keys` and then `sets` over them (which must be
 /// valid): a test scene that names every key it depends on, so that no preset file changes it.
-inline SimParams keyed(const std::string& keys, std::initializer_list<const char*> sets) {
+inline SimParams keyed(const std::string& keys, const std::vector<std::string>& sets) {
   std::vector<std::string> all;
   std::istringstream words(keys);
   for (std::string key; words >> key;) all.push_back(key);
   all.insert(all.end(), sets.begin(), sets.end());
   return withSets(SimParams{}, all);
 }
+inline SimParams keyed(const std::string& keys, std::initializer_list<const char*> sets) {
+  return keyed(keys, std::vector<std::string>(sets.begin(), sets.end()));
+}
+
+/// Contact as every preset has it (contact_factor) and the settle's sweeps of the paper's presets.
+inline constexpr const char* kContactKeys = "contact_factor=0.5";
+inline constexpr const char* kSettleKeys = "contact_factor=0.5 contact_settle=16";
+
+/// The seeds' cloth with contact (the `tender` preset's scene, every key named), with `sets` over it.
+inline SimParams clothWithContact(std::initializer_list<const char*> sets = {}) { return keyed(kContactKeys, sets); }
 
 /// A 40 x 60 sheet of paper hanging from its corners, without contact, with `sets` over it: hinges
 /// that crease and the stretch limit at the scale of the hand's scenes (the `crumple` preset's
 /// paper).
-inline SimParams paperSheet(std::initializer_list<const char*> sets = {}) {
-  return keyed("cols=40 rows=60 spacing=0.15 pins=corners bend=off dihedral=on tick_hz=60 substeps=8 iterations=4 "
-               "gravity=0.5 damping=0.995 wind=off wind_kind=noise wind_scale=0.15 bending_rigidity=0.02 "
-               "crease_yield=11.5 crease_hardening=0.5 stretch_limit=1.01 cell_size=0.375 floor_y=-10 "
-               "restitution=0.3 friction=0.3 release=drag",
-               sets);
+inline constexpr const char* kPaperKeys =
+    "cols=40 rows=60 spacing=0.15 pins=corners bend=off dihedral=on tick_hz=60 substeps=8 iterations=4 "
+    "gravity=0.5 damping=0.995 wind=off wind_kind=noise wind_scale=0.15 bending_rigidity=0.02 "
+    "crease_yield=11.5 crease_hardening=0.5 stretch_limit=1.01 cell_size=0.375 floor_y=-10 "
+    "restitution=0.3 friction=0.3 release=drag";
+inline SimParams paperSheet(std::initializer_list<const char*> sets = {}) { return keyed(kPaperKeys, sets); }
+
+/// The paper of the hand's scenes with contact and the settle's sweeps (the `crumple` preset's
+/// scene, every key named), with `sets` over it.
+inline SimParams crumpleSheet(std::initializer_list<const char*> sets = {}) {
+  return keyed(std::string(kPaperKeys) + " " + kSettleKeys, sets);
 }
 
 /// A receipt in SI units without contact, with `sets` over it: 80 mm x 300 mm of 55 g/m^2 paper in
 /// still air, its lowest point 1 m above the floor, leaning 5 degrees from flat (the `paper`
 /// preset's sheet).
-inline SimParams receiptSheet(std::initializer_list<const char*> sets = {}) {
-  return keyed("cols=17 rows=61 spacing=0.005 pins=none tilt=85 view_scale=0.1 bend=off dihedral=on damping=1 "
-               "wind=off air=on paper_weight=55 bending_rigidity=7.9e-05 crease_yield=11.5 crease_hardening=0.5 "
-               "stretch_limit=1.01 cell_size=0.012499999 floor_y=0 restitution=0.05 friction=0.6 release=drag "
-               "grab_radius=0.02 hand_reach=0.16",
-               sets);
+inline constexpr const char* kReceiptKeys =
+    "cols=17 rows=61 spacing=0.005 pins=none tilt=85 view_scale=0.1 bend=off dihedral=on damping=1 "
+    "wind=off air=on paper_weight=55 bending_rigidity=7.9e-05 crease_yield=11.5 crease_hardening=0.5 "
+    "stretch_limit=1.01 cell_size=0.012499999 floor_y=0 restitution=0.05 friction=0.6 release=drag "
+    "grab_radius=0.02 hand_reach=0.16";
+inline SimParams receiptSheet(std::initializer_list<const char*> sets = {}) { return keyed(kReceiptKeys, sets); }
+
+/// The receipt with contact and the settle's sweeps (the `paper` preset's scene, every key named),
+/// with `sets` over it.
+inline SimParams receiptWithContact(const std::vector<std::string>& sets) {
+  return keyed(std::string(kReceiptKeys) + " " + kSettleKeys, sets);
+}
+inline SimParams receiptWithContact(std::initializer_list<const char*> sets = {}) {
+  return receiptWithContact(std::vector<std::string>(sets.begin(), sets.end()));
 }
 
 /// Parses an input script (which must be valid).

@@ -119,7 +119,7 @@ TYPED_TEST_P(SolverCase, ZeroTearFactorNeverTears) {
 
 TYPED_TEST_P(SolverCase, YankTearsAndCompactsCleanly) {
   auto solver = this->make();
-  Simulation sim(preset("crumple", {"cols=12", "rows=16", "wind=on"}), *solver);
+  Simulation sim(crumpleSheet({"cols=12", "rows=16", "wind=on"}), *solver);
   sim.setScript(script("0 grab particle 191\n1 move 6 -5 6\n20 release\n"));
   SimState s = run(sim, 40);
   SheetStats st = computeStats(s, sim.params().substepDt());
@@ -152,7 +152,7 @@ TYPED_TEST_P(SolverCase, YankTearsAndCompactsCleanly) {
 
 TYPED_TEST_P(SolverCase, NoNaNUnderWindAndCollision) {
   auto solver = this->make();
-  Simulation sim(preset("crumple", {"cols=10", "rows=14", "wind=on", "pins=none"}), *solver);
+  Simulation sim(crumpleSheet({"cols=10", "rows=14", "wind=on", "pins=none"}), *solver);
   SimState s = run(sim, 120);
   SheetStats st = computeStats(s, sim.params().substepDt());
   EXPECT_EQ(st.nan_count, 0u);
@@ -220,7 +220,7 @@ TYPED_TEST_P(SolverCase, DragReleaseKeepsMomentum) {
   for (ReleaseMode mode : {ReleaseMode::ZeroVelocity, ReleaseMode::DragVelocity}) {
     auto solver = this->make();
     // A single particle: nothing but the release decides how it moves on.
-    SimParams p = preset("crumple", {"pins=none", "gravity=0", "wind=off", "cols=1", "rows=1"});
+    SimParams p = crumpleSheet({"pins=none", "gravity=0", "wind=off", "cols=1", "rows=1"});
     p.release = mode;
     Simulation sim(p, *solver);
     sim.grabParticle(0);

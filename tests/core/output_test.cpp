@@ -9,10 +9,12 @@
 
 #include <unistd.h>
 
+#include "common/sim_helpers.h"
 #include "core/output.h"
 #include "core/simulation.h"
 
 using namespace tender;
+using namespace tender::test;
 namespace fs = std::filesystem;
 
 namespace {
@@ -126,7 +128,7 @@ TEST(Simulation, GrabTargetsStayWithinTheCoordinateLimit) {
   private:
     const SheetTopology* topo_ = nullptr;
   } still;
-  SimParams p = *presetParams("tender");
+  SimParams p = clothWithContact();
   Simulation sim(p, still);
   sim.grabParticle(5);
   sim.moveGrab(glm::vec3(1e30f, -INFINITY, NAN));

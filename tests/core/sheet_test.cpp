@@ -2,12 +2,14 @@
 
 #include <set>
 
+#include "common/sim_helpers.h"
 #include "core/sheet.h"
 
 using namespace tender;
+using namespace tender::test;
 
 TEST(Sheet, CountsMatchTheSpecFor32x48) {
-  SheetTopology t = buildSheet(*presetParams("tender"));
+  SheetTopology t = buildSheet(clothWithContact());
   EXPECT_EQ(t.particleCount(), 1536u);
   EXPECT_EQ(t.kind_counts[SIM_KIND_STRUCTURAL], 2992u);
   EXPECT_EQ(t.kind_counts[SIM_KIND_SHEAR], 2914u);
@@ -18,7 +20,7 @@ TEST(Sheet, CountsMatchTheSpecFor32x48) {
 }
 
 TEST(Sheet, CrumpleHasHinges) {
-  SheetTopology t = buildSheet(*presetParams("crumple"));
+  SheetTopology t = buildSheet(crumpleSheet());
   EXPECT_EQ(t.particleCount(), 2400u);
   EXPECT_EQ(t.kind_counts[SIM_KIND_BEND], 0u);
   EXPECT_EQ(t.kind_counts[SIM_KIND_TRIBEND], 0u);
@@ -27,7 +29,7 @@ TEST(Sheet, CrumpleHasHinges) {
   EXPECT_EQ(t.kind_counts[SIM_KIND_HINGE], 39u * 58u + 38u * 59u + 39u * 59u);
   EXPECT_EQ(t.kind_counts[SIM_KIND_SHEAR], 39u * 59u);
   EXPECT_EQ(t.hinge_first + t.hingeCount(), t.constraintCount());
-  EXPECT_EQ(sheetCounts(*presetParams("crumple")).constraints, t.constraintCount());
+  EXPECT_EQ(sheetCounts(crumpleSheet()).constraints, t.constraintCount());
   // Each hinge's two triangles are the two of gridTriangle that hold its edge and its corners
   for (uint32_t k = 0; k < t.hingeCount(); ++k) {
     const glm::uvec4 q = shaderio::gridHinge(k, t.cols, t.rows);
@@ -95,11 +97,11 @@ TEST(Coloring, AColourHoldsItsEdgesFirst) {
 
 TEST(Coloring, GridNeedsTwelveColours) {
   // An interior particle has 12 constraints, so 12 colours is optimal; greedy reaches it.
-  EXPECT_EQ(buildSheet(*presetParams("tender")).colorCount(), 12u);
+  EXPECT_EQ(buildSheet(clothWithContact()).colorCount(), 12u);
 }
 
 TEST(Sheet, AdjacencyIsSymmetricAndFromConstraints) {
-  SimParams p = *presetParams("tender");
+  SimParams p = clothWithContact();
   p.cols = 7;
   p.rows = 9;
   SheetTopology t = buildSheet(p);
@@ -111,7 +113,7 @@ TEST(Sheet, AdjacencyIsSymmetricAndFromConstraints) {
 }
 
 TEST(Sheet, TrianglesAreCounterClockwiseFromFront) {
-  SheetTopology t = buildSheet(*presetParams("tender"));
+  SheetTopology t = buildSheet(clothWithContact());
   for (auto& tri : t.triangles) {
     glm::vec3 a(t.rest_pos[tri.x]), b(t.rest_pos[tri.y]), c(t.rest_pos[tri.z]);
     EXPECT_GT(glm::cross(b - a, c - a).z, 0.0f);
@@ -119,7 +121,7 @@ TEST(Sheet, TrianglesAreCounterClockwiseFromFront) {
 }
 
 TEST(Sheet, PinsAndPlacement) {
-  SimParams p = *presetParams("tender");
+  SimParams p = clothWithContact();
   SheetTopology t = buildSheet(p);
   std::vector<uint32_t> pins;
   for (uint32_t i = 0; i < t.particleCount(); ++i)
@@ -128,5 +130,5 @@ TEST(Sheet, PinsAndPlacement) {
   float lowest = 1e9f;
   for (auto& r : t.rest_pos) lowest = std::min(lowest, r.y);
   EXPECT_GT(lowest, p.floor_y + 1.0f);
-  EXPECT_TRUE(buildSheet(*presetParams("crumple")).rest_pos[39].w > 0.5f);
+  EXPECT_TRUE(buildSheet(crumpleSheet()).rest_pos[39].w > 0.5f);
 }

@@ -120,8 +120,8 @@ struct Toss {
   uint64_t pairs = 0;
 };
 Toss toss(const char* contact_factor) {
-  const SimParams p = preset("crumple", {"cols=20", "rows=30", "tilt=90", "pins=none", "wind=off", "floor_y=-3",
-                                         "top_y=-2.925", "tear_factor=0", "stretch_limit=0", contact_factor});
+  const SimParams p = crumpleSheet({"cols=20", "rows=30", "tilt=90", "pins=none", "wind=off", "floor_y=-3",
+                                    "top_y=-2.925", "tear_factor=0", "stretch_limit=0", contact_factor});
   CpuSolver solver;
   Simulation sim(p, solver);
   const uint32_t middle = (p.rows / 2) * p.cols + p.cols / 2;
@@ -288,12 +288,12 @@ TEST(Contact, ASheetAtRestStaysAtRestAtEveryAcceptedRadius) {
   // particles that lie still (a radius past sqrt 2 spacings does: 2.9 units/s hanging at 2)
   const ParamInfo info = *paramInfo("contact_factor");
   ASSERT_GT(info.least_on, 0.0);
-  for (const float factor : {float(info.least_on), presetParams("crumple")->contact_factor, float(info.hi)})
+  for (const float factor : {float(info.least_on), crumpleSheet().contact_factor, float(info.hi)})
     for (const bool flat : {false, true}) {
       const std::string radius = "contact_factor=" + std::to_string(factor);
-      const SimParams p = flat ? preset("crumple", {"cols=8", "rows=8", "wind=off", "tilt=90", "pins=none",
-                                                    "floor_y=-3", "top_y=-3", radius.c_str()})
-                               : preset("crumple", {"cols=8", "rows=8", "wind=off", radius.c_str()});
+      const SimParams p = flat ? crumpleSheet({"cols=8", "rows=8", "wind=off", "tilt=90", "pins=none", "floor_y=-3",
+                                               "top_y=-3", radius.c_str()})
+                               : crumpleSheet({"cols=8", "rows=8", "wind=off", radius.c_str()});
       CpuSolver solver;
       Simulation sim(p, solver);
       const SimState first = run(sim, 30);
@@ -314,7 +314,7 @@ TEST(Contact, ASheetFallingAsAWholeIsNotHeldBack) {
   // as no pair's distance changes, the lists of pairs stand from the first build to the last
   uint32_t builds = 0;
   auto fall = [&](const char* contact) {
-    const SimParams p = preset("paper", {"air=off", "tilt=90", "floor_y=-100", contact});
+    const SimParams p = receiptWithContact({"air=off", "tilt=90", "floor_y=-100", contact});
     CpuSolver solver;
     Simulation sim(p, solver);
     const SimState s = run(sim, int(0.5f * p.tick_hz));
@@ -322,7 +322,7 @@ TEST(Contact, ASheetFallingAsAWholeIsNotHeldBack) {
     return s;
   };
   const SimState free = fall("contact_factor=0"), bounded = fall("contact_factor=0.5");
-  const SimParams p = preset("paper", {"contact_factor=0.5"});
+  const SimParams p = receiptWithContact();
   const float speed = computeStats(bounded, p.substepDt()).max_speed;
   const float cap = SIM_CONTACT_FRACTION * p.contactRadius() * p.tick_hz * float(p.substeps);
   std::printf("falling receipt with contact: %.3f m/s after 0.5 s (the bound's cap: %.3f m/s); the lists built %u "
@@ -340,7 +340,7 @@ TEST(Contact, AStripHeldUnderAFoldIsPulledFree) {
   // that only cut each step in its own half-spaces took all of the pull out and held the edge at
   // 9.08 times its length from tick 60 on; passed on in part (contactPassed), the pull moves the
   // layer, and the strip shortens to its length by tick 120 without the layers crossing
-  const SimParams p = preset("tender", {"cols=8", "rows=12", "tear_factor=50"});
+  const SimParams p = clothWithContact({"cols=8", "rows=12", "tear_factor=50"});
   CpuSolver solver;
   Simulation sim(p, solver);
   sim.setScript(script("0 grab particle 95\n1 move 6 -5 6\n30 release\n"));

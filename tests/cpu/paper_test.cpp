@@ -32,7 +32,7 @@ Extent extentOf(Solver& solver, float dt) {
 
 TEST(Paper, AReceiptLetGoOneMetreUpGlidesAndLandsNearlyFlat) {
   TENDER_ONE_THREAD_TEST();
-  const SimParams p = preset("paper");
+  const SimParams p = receiptWithContact();
   CpuSolver solver;
   Simulation sim(p, solver);
   const Extent start = extentOf(solver, p.substepDt());
@@ -77,7 +77,7 @@ TEST(Paper, AFlatSheetFallsAtTheTerminalSpeedOfQuadraticDrag) {
   TENDER_ONE_THREAD_TEST();
   // Flat and level, it falls straight down; drag rho C v^2 / 2 per area balances its weight
   // sigma g at v = sqrt(2 sigma g / (rho C)).
-  const SimParams p = preset("paper", {"tilt=90", "floor_y=-100", "collision=off", "skin_friction=0"});
+  const SimParams p = receiptWithContact({"tilt=90", "floor_y=-100", "collision=off", "skin_friction=0"});
   CpuSolver solver;
   Simulation sim(p, solver);
   for (int t = 0; t < int(2.0f * p.tick_hz); ++t) sim.tick();
@@ -91,7 +91,7 @@ TEST(Paper, AFlatSheetFallsAtTheTerminalSpeedOfQuadraticDrag) {
 }
 
 TEST(Paper, WithoutAirTheSheetFallsFreely) {
-  const SimParams p = preset("paper", {"air=off", "tilt=90", "floor_y=-100", "collision=off"});
+  const SimParams p = receiptWithContact({"air=off", "tilt=90", "floor_y=-100", "collision=off"});
   CpuSolver solver;
   Simulation sim(p, solver);
   const int ticks = int(0.5f * p.tick_hz);

@@ -56,7 +56,7 @@ TEST(Verlet, ChangingTheSubstepsKeepsTheVelocity) {
     for (const char* contact : {"contact_factor=0", "contact_factor=0.5"}) {
       const std::vector<std::string> keys = {"air=off", "tilt=90", "floor_y=-1000", "damping=1", "substeps=8", contact};
       CpuSolver kept_solver, changed_solver;
-      Simulation kept(preset("paper", keys), kept_solver), changed(preset("paper", keys), changed_solver);
+      Simulation kept(receiptWithContact(keys), kept_solver), changed(receiptWithContact(keys), changed_solver);
       changed.setScript(script(change));
       run(kept, 31);
       run(changed, 31);

@@ -46,8 +46,8 @@ TEST(CpuThreads, TearingYankIsIdenticalOnOneAndTwoThreads) {
 
 TEST(CpuThreads, CrumpleTossAndAwkwardSizeAreIdentical) {
   const std::string toss = "0 grab particle 100\n1 move 1 2 3\n10 release\n";
-  expectIdentical(run(preset("crumple", {"cols=13", "rows=19"}), toss, 40, kOne),
-                  run(preset("crumple", {"cols=13", "rows=19"}), toss, 40, kThree));
+  expectIdentical(run(crumpleSheet({"cols=13", "rows=19"}), toss, 40, kOne),
+                  run(crumpleSheet({"cols=13", "rows=19"}), toss, 40, kThree));
 }
 
 TEST(CpuThreads, TunedChunkingIsIdenticalOnALargerSheet) {
@@ -80,7 +80,7 @@ TEST(CpuThreads, ZeroMeansOnePerHardwareThread) {
 }
 
 TEST(CpuThreads, MemoryIsReported) {
-  SimParams p = *presetParams("tender");
+  SimParams p = clothWithContact();
   CpuSolver solver;
   Simulation sim(p, solver);
   // At least pos, prev, rest, normal (16 bytes each) per particle, and the constraints.
@@ -112,8 +112,8 @@ TEST(CpuCandidateLists, DragTossAndCrowdsAreIdenticalWithoutLists) {
   EXPECT_GT(tornCount(a), 0u);
   expectIdentical(a, run(cloth({"wind=on"}), drag, 80, kOneNoLists));
   const std::string toss = "0 grab particle 100\n1 move 1 2 3\n10 release\n";
-  expectIdentical(run(preset("crumple", {"cols=13", "rows=19"}), toss, 40, kThree),
-                  run(preset("crumple", {"cols=13", "rows=19"}), toss, 40, kOneNoLists));
+  expectIdentical(run(crumpleSheet({"cols=13", "rows=19"}), toss, 40, kThree),
+                  run(crumpleSheet({"cols=13", "rows=19"}), toss, 40, kOneNoLists));
   expectIdentical(run(cloth({"collision_factor=1.6", "wind=on"}), drag, 40, kTwo),
                   run(cloth({"collision_factor=1.6", "wind=on"}), drag, 40, kOneNoLists));
   expectIdentical(run(cloth({"cols=16", "rows=20", "collision_factor=2.5", "cell_size=0.9"}), "", 20, kTwo),

@@ -213,7 +213,7 @@ TEST_F(GpuBatchTest, BatchedContactSheetsRecordTheDispatchesOfOneSheet) {
   // passes armed by its own arguments (sheet by sheet:
   // ContactSheetsOnThePerColourPassesMatchTheirRunsAlone and
   // LargeSheetsRecordTheDispatchesOfOneSheetPerPassOrPerSheet). The same bits as alone.
-  const SimParams p = preset("crumple", {"cols=12", "rows=16"});
+  const SimParams p = crumpleSheet({"cols=12", "rows=16"});
   std::vector<FleetSheet> sheets;
   for (uint32_t i = 0; i < 4; ++i)
     sheets.push_back({p, script(("0 grab particle " + std::to_string(191 - 5 * i) + "\n1 move " +

@@ -18,7 +18,7 @@ using namespace tender::test;
 TEST_F(Parity, TheTenderPresetWithContactTearsTheSameOnTheGpu) {
   // The preset as it ships: wind, the particle repulsion and contact, a corner yanked until it
   // tears (the hand's pace runs more substeps while the grab drags)
-  SimParams p = preset("tender", {"cols=16", "rows=24"});
+  SimParams p = clothWithContact({"cols=16", "rows=24"});
   ASSERT_GT(p.contact_factor, 0.0f);
   for (bool fused : {true, false}) {
     auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 383\n1 move 3 -3 3\n", 16, fused);
@@ -54,7 +54,7 @@ TEST_F(Parity, TheHandCrumplesTheSameOnEveryPath) {
   // The middle of a sheet lying on the floor lifted (at the hand's pace: 32 substeps), the hand
   // half closed and closed around it, then moved (32 again) and let go, the sheet tossed at the
   // drag's speed and in contact throughout
-  const SimParams p = preset("crumple", {"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9"});
+  const SimParams p = crumpleSheet({"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9"});
   const char* text =
       "0 grab particle 102\n1 move 0 -8.8 -1.2\n3 squeeze 0.5\n6 squeeze 1\n9 move 1 -8 -1\n13 release\n";
   for (bool fused : {true, false}) {
@@ -69,8 +69,8 @@ TEST_F(Parity, ACrumpledSheetOnTheDevicesOwnPathHasTheCpuBits) {
   // device takes by itself. The fused tick with the settle in its workgroup ran past lavapipe's
   // loop count in tick 3 and parted from the CPU (FusedShape::contact): a CPU device runs a sheet
   // with contact on the per-colour passes, a GPU in the fused tick.
-  const SimParams p = preset("crumple", {"cols=32", "rows=48", "tilt=90", "pins=none", "wind=off", "floor_y=-3",
-                                         "top_y=-2.925", "contact_settle=12"});
+  const SimParams p = crumpleSheet(
+      {"cols=32", "rows=48", "tilt=90", "pins=none", "wind=off", "floor_y=-3", "top_y=-2.925", "contact_settle=12"});
   const char* text = "0 grab particle 1220\n1 move 0.075 -2.79167 -4.5\n1 squeeze 0.0666667\n"
                      "2 move 0.075 -2.65833 -4.5\n2 squeeze 0.133333\n3 move 0.075 -2.525 -4.5\n3 squeeze 0.2\n";
   auto [cpu, gpu] = runBoth(ctx(), p, text, 4, true, gpu::FusedShape{});
@@ -144,7 +144,7 @@ TEST_F(Parity, AStripHeldUnderAFoldIsPulledFreeOnEveryPath) {
   // (contact_pass) frees it with the same bits on the CPU and both GPU paths, to tick 60, while it
   // is being freed (stretched 9.08 there without the passing on, 1.80 with; the CPU test sees it
   // freed by tick 120)
-  const SimParams p = preset("tender", {"cols=8", "rows=12", "tear_factor=50"});
+  const SimParams p = clothWithContact({"cols=8", "rows=12", "tear_factor=50"});
   for (bool fused : {true, false}) {
     auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 95\n1 move 6 -5 6\n30 release\n", 60, fused);
     const float stretch = computeStats(cpu, p.substepDt()).max_stretch;
@@ -247,7 +247,7 @@ TEST_F(Parity, ATornSheetWithContactIsTheSameOnTheGpu) {
   // A yank that tears the sheet with contact on from the start: torn triangles stop colliding at
   // once. Both ways: the fused tick with contact's bodies in its workgroup (a GPU's), the per-colour
   // passes (a CPU device's).
-  const SimParams yank = preset("tender", {"cols=12", "rows=16", "wind=off", "contact_factor=0.5"});
+  const SimParams yank = clothWithContact({"cols=12", "rows=16", "wind=off"});
   for (bool fused : {true, false}) {
     const char* way = fused ? "fused tick" : "per-colour passes";
     gpu::GpuSolver gpu(ctx(), kContactInTheWorkgroup);
@@ -277,8 +277,8 @@ TEST_F(Parity, AFallingSheetWithContactIsTheSameOnTheGpu) {
   // out before the bound on every path, so it falls freely, with the CPU's bits; its substeps
   // changed mid-fall, the frame takes the first substep's rescale (contactFrameScale). A small sheet
   // at three times gravity and 4 substeps outruns three bounds a substep within 12 ticks.
-  const SimParams p = preset("paper", {"cols=6", "rows=16", "substeps=4", "gravity=30", "air=off", "tilt=90",
-                                       "floor_y=-100", "contact_factor=0.5"});
+  const SimParams p =
+      receiptWithContact({"cols=6", "rows=16", "substeps=4", "gravity=30", "air=off", "tilt=90", "floor_y=-100"});
   for (bool fused : {true, false}) {
     auto [cpu, gpu] = runBoth(ctx(), p, "6 set substeps 12\n9 set substeps 6\n", 12, fused);
     EXPECT_GT(computeStats(gpu, p.substepDt()).max_speed,
@@ -295,8 +295,7 @@ TEST_F(Parity, ContactListsStandWhileTheGpuPathsTakeTurns) {
   // passes take over lists the fused tick built (which name no queries: they are built again) and
   // the fused tick goes on from the passes' lists; the bits stay the CPU's, and the lists are not
   // built every substep.
-  const SimParams p = preset(
-      "crumple", {"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9", "contact_factor=0.5", "collision=off"});
+  const SimParams p = crumpleSheet({"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9", "collision=off"});
   const std::string text = "0 grab particle 102\n1 move 0 -8.8 -1.2\n4 squeeze 0.5\n12 squeeze 1\n";
   constexpr int kSettle = 60, kTurns = 30;
   CpuSolver cpu;
@@ -329,8 +328,8 @@ TEST_F(Parity, TheSettleIsTheSameOnTheGpu) {
   // steps' bounds with the CPU's bits on the per-colour passes and in the fused tick (whose
   // workgroup runs the settle after the contact's bodies there, a GPU's way). The sweeps do their
   // work here: the sheet ends elsewhere and less stretched than without them.
-  const SimParams p = preset("crumple", {"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9",
-                                         "contact_factor=0.5", "collision=off", "contact_settle=4"});
+  const SimParams p =
+      crumpleSheet({"cols=12", "rows=16", "tilt=90", "pins=none", "top_y=-9.9", "collision=off", "contact_settle=4"});
   const std::string text = "0 grab particle 102\n1 move 0 -8.8 -1.2\n4 squeeze 0.5\n12 squeeze 1\n";
   constexpr int kTicks = 14;
   auto cpuRun = [&](const SimParams& q) {
@@ -382,8 +381,7 @@ TEST_F(Parity, TheSettleIsTheSameOnTheGpu) {
     EXPECT_TRUE(fist[0] && fist[1]) << "the fist's last substep starts the settle";
     for (uint32_t k = 1; k < SIM_CONTACT_SETTLE_SLOTS; ++k)
       EXPECT_TRUE(!fist[k] || (fist[k - 1] && k <= p.contact_settle)) << "sweep " << k - 1;
-    const SimParams hanging =
-        preset("crumple", {"cols=12", "rows=16", "contact_factor=0.5", "collision=off", "contact_settle=4"});
+    const SimParams hanging = crumpleSheet({"cols=12", "rows=16", "collision=off", "contact_settle=4"});
     gpu::GpuSolver still(ctx(), gpu::FusedShape{0, 0, 0.0f, way.contact});
     still.setFusedPath(false);
     Simulation h(hanging, still);

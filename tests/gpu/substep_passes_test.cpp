@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "common/sim_helpers.h"
 #include "core/passes.h"
 #include "core/sheet.h"
 #include "gpu/substep_passes.h"
@@ -66,10 +67,9 @@ std::vector<std::string> kernels(const std::vector<Recorded>& passes) {
 
 /// The topology of a `cols` x `rows` tender sheet with hinges.
 SheetTopology tenderSheet(uint32_t cols, uint32_t rows) {
-  SimParams p = *presetParams("tender");
+  SimParams p = test::clothWithContact({"dihedral=on"});
   p.cols = cols;
   p.rows = rows;
-  p.dihedral = true;
   return buildSheet(p);
 }
 
