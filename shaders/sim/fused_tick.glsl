@@ -25,14 +25,16 @@ shared vec4 s_pos[kFusedCapacity];
 // Invocations of the workgroup (specialised)
 const uint kInvocations = gl_WorkGroupSize.x;
 
-// Everything written before it, to shared memory and to buffers, is seen by the whole workgroup.
 // The barriers this invocation has passed in this dispatch (Counters::phases, what tender-bench
 // counts: written once, at the end)
 uint g_phases = 0u;
 
+// Everything written before it, to shared memory and to buffers, is seen by the whole workgroup.
+// The fence is the workgroup's (groupMemoryBarrier), not the device's: no other workgroup reads
+// a sheet's arrays while it ticks (a fleet's workgroups tick a sheet each), and the next dispatch
+// sees them through the pipeline barrier between.
 void sync() {
-  memoryBarrierBuffer();
-  memoryBarrierShared();
+  groupMemoryBarrier();
   barrier();
   g_phases += 1u;
 }

@@ -18,7 +18,7 @@ void main() {
   uint last = min(uint(limit.last_ring), p.first + p.count - 1u);
   for (uint k = p.first; k <= last; ++k) {
     limitRing(roots, k, gl_LocalInvocationID.x, gl_WorkGroupSize.x);
-    memoryBarrierBuffer();
+    groupMemoryBarrier(); // at the workgroup's scope: no other workgroup reads this sheet's places
     barrier();
   }
 }
