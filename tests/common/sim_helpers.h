@@ -81,7 +81,7 @@ inline SimParams keyed(const std::string& keys, std::initializer_list<const char
 
 /// Contact as every preset has it (contact_factor) and the settle's sweeps of the paper's presets.
 inline constexpr const char* kContactKeys = "contact_factor=0.5";
-inline constexpr const char* kSettleKeys = "contact_factor=0.5 contact_settle=16";
+inline const std::string kSettleKeys = std::string(kContactKeys) + " contact_settle=16";
 
 /// The seeds' cloth with contact (the `tender` preset's scene, every key named), with `sets` over it.
 inline SimParams clothWithContact(std::initializer_list<const char*> sets = {}) { return keyed(kContactKeys, sets); }
