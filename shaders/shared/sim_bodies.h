@@ -44,7 +44,7 @@ SIM_INLINE void projectConstraint(Constraint c, uint iteration) {
   SIM_POSITION(c.b) = pb + vec4(d.db, 0.0f);
 }
 
-/// The crease of hinge k after the substep's projection (creaseReturn), unless it is torn or
+/// The crease of hinge k at the end of the substep, where the sheet went (creaseReturn), unless it is torn or
 /// degenerate.
 SIM_INLINE void creaseHinge(uint k) {
   HingeRange hinge = u.hinge;

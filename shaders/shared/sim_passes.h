@@ -102,9 +102,9 @@
   X(project, 4u, COLOUR, ALWAYS)                                                                                       \
   X(shorten, 5u, COLOUR, SHORTEN)                                                                                      \
   X(limit, 6u, ONCE, LIMIT)                                                                                            \
-  X(crease, 7u, ONCE, CREASE)                                                                                          \
-  X(floor, 8u, ONCE, ALWAYS)                                                                                           \
-  X(settle, 9u, ONCE, SETTLE)                                                                                          \
+  X(floor, 7u, ONCE, ALWAYS)                                                                                           \
+  X(settle, 8u, ONCE, SETTLE)                                                                                          \
+  X(crease, 9u, ONCE, CREASE)                                                                                          \
   X(tear, 10u, ONCE, ALWAYS)
 #define SIM_STAGE_COUNT 11u
 
@@ -168,7 +168,6 @@
   X(project, project, COLOUR, Threads, ALWAYS, Project)                                                                \
   X(shorten, shorten, COLOUR, Threads, ALWAYS, Project)                                                                \
   X(limit, limit, RINGS, Threads, ALWAYS, Project)                                                                     \
-  X(crease, crease, HINGES, Threads, ALWAYS, Project)                                                                  \
   X(floor, floor, PARTICLES, Threads, ALWAYS, Floor)                                                                   \
   X(floor, contact_pass, CONTACT_QUERIES, Named, CONTACT, Floor)                                                       \
   X(floor, contact_excess, CONTACT_QUERIES, Named, CONTACT, Floor)                                                     \
@@ -179,6 +178,7 @@
   X(settle, scan, CONTACT_HALF_CELLS, Threads, ALWAYS, Floor)                                                          \
   X(settle, contact_half_fill, CONTACT_QUERIES, Settle, ALWAYS, Floor)                                                 \
   X(settle, contact_settle, SWEEPS, Sweep, ALWAYS, Floor)                                                              \
+  X(crease, crease, HINGES, Threads, ALWAYS, Project)                                                                  \
   X(tear, tear_mark, CONSTRAINTS, Threads, ALWAYS, Tear)                                                               \
   X(tear, tear_unsupported, INDIRECT, Compaction, ALWAYS, Tear)                                                        \
   X(tear, tear_flags, INDIRECT, Compaction, ALWAYS, Tear)                                                              \

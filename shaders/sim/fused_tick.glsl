@@ -362,10 +362,6 @@ bool runSubsteps(uint n) {
       limitStage();
       if (stopsAfter(SIM_FIRST_PASS(limit))) return true;
     }
-    if (SIM_RUNS(crease)) {
-      creaseStage();
-      if (stopsAfter(SIM_FIRST_PASS(crease))) return true;
-    }
     bool contact = runsWhen(SIM_WHEN_CONTACT, when);
     floorStage(n, contact);
 #ifdef SIM_FUSED_CONTACT
@@ -376,6 +372,10 @@ bool runSubsteps(uint n) {
     if (stopsAfter(SIM_FIRST_PASS(floor))) return true;
 #endif
     if (SIM_RUNS(settle) && stopsAfter(SIM_FIRST_PASS(settle))) return true;
+    if (SIM_RUNS(crease)) {
+      creaseStage();
+      if (stopsAfter(SIM_FIRST_PASS(crease))) return true;
+    }
     if (tearing) tearStage();
     if (stopsAfter(SIM_FIRST_PASS(tear))) return true;
 #undef SIM_FIRST_PASS

@@ -43,16 +43,16 @@ TEST(Passes, OrderOfOneSubstep) {
   EXPECT_EQ(passAt(u, 13), (PassPoint{0, PassKind::shorten, 0, 0}));
   EXPECT_EQ(passAt(u, 22), (PassPoint{0, PassKind::shorten, 1, 4}));
   EXPECT_EQ(passAt(u, 23), (PassPoint{0, PassKind::limit}));
-  EXPECT_EQ(passAt(u, 24), (PassPoint{0, PassKind::crease}));
-  EXPECT_EQ(passAt(u, 25), (PassPoint{0, PassKind::floor}));
-  EXPECT_EQ(passAt(u, 26), (PassPoint{0, PassKind::settle}));
+  EXPECT_EQ(passAt(u, 24), (PassPoint{0, PassKind::floor}));
+  EXPECT_EQ(passAt(u, 25), (PassPoint{0, PassKind::settle}));
+  EXPECT_EQ(passAt(u, 26), (PassPoint{0, PassKind::crease}));
   EXPECT_EQ(passAt(u, 27), (PassPoint{0, PassKind::tear}));
   EXPECT_EQ(passAt(u, 28), (PassPoint{1, PassKind::contact}));
   EXPECT_EQ(describePass(passAt(u, 37)), "substep 1, project (iteration 1, colour 1)");
   EXPECT_EQ(describePass(passAt(u, 49)), "substep 1, shorten (iteration 1, colour 3)");
   EXPECT_EQ(describePass(passAt(u, 51)), "substep 1, limit");
-  EXPECT_EQ(describePass(passAt(u, 52)), "substep 1, crease");
-  EXPECT_EQ(describePass(passAt(u, 54)), "substep 1, settle");
+  EXPECT_EQ(describePass(passAt(u, 53)), "substep 1, settle");
+  EXPECT_EQ(describePass(passAt(u, 54)), "substep 1, crease");
 }
 
 TEST(Passes, AStageIsNumberedOnlyWhileItsConditionHolds) {
