@@ -117,9 +117,8 @@ constexpr float kHandPacking = 0.25f;
 ///   2.9 at 2; 6.4e-5 up to 1.4);
 /// - above 0.75 the stretch limit no longer holds in the hand's crumple (1.046 x rest at 1.0),
 ///   and its pairs grow with the square of the radius (583 ms a tick at 1.0 against 78 at 0.5);
-/// - below 0.25 the radius nears rounding: at 1e-33 no step survives the cut while the hinges
-///   crease from the steps it cut, and a denormal one (1e-38) reads as off on one path and on on
-///   another.
+/// - below 0.25 the radius nears rounding: at 1e-33 no step survives the cut, and a denormal one
+///   (1e-38) reads as off on one path and on on another.
 constexpr float kMinContactFactor = 0.25f;
 constexpr float kMaxContactFactor = 0.75f;
 
