@@ -243,10 +243,10 @@ TEST(Crease, WindCreasesNothing) {
 
 TEST(Crease, EveryCreaseComesFromWhereTheSheetWent) {
   TENDER_ONE_THREAD_TEST();
-  // The return map's promise, checked on the positions the sheet ends each tick at: no live hinge
-  // is bent further than its yield from its rest angle. The hand crumples a sheet with contact, whose
-  // cut takes back steps that the projection made; a crease made from such a step (the return map
-  // before the cut) leaves the rest angle where the sheet never went.
+  // The return map's promise, checked on the positions the sheet ends every fifth tick at: no live
+  // hinge is bent further than its yield from its rest angle. The hand crumples a sheet with contact,
+  // whose cut takes back steps that the projection made; a crease made from such a step (the return
+  // map before the cut) leaves the rest angle where the sheet never went.
   const SimParams p = flatSheet(crumpleSheet(), {"cols=20", "rows=30"});
   CpuSolver solver;
   Simulation sim(p, solver);
