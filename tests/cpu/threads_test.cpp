@@ -37,11 +37,10 @@ TEST(CpuThreads, HangingSheetIsIdenticalOnOneAndTwoThreads) {
 TEST(CpuThreads, TearingYankIsIdenticalOnOneAndTwoThreads) {
   // (it tears in its second tick; the last ticks run let go)
   const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n12 release\n";
-  SimState one = run(cloth(), yank, 20, kOne);
   SimState two = run(cloth(), yank, 20, kTwo);
-  EXPECT_GT(tornCount(one), 0u); // the run really tears and compacts
-  EXPECT_LT(one.triangle_count, 2914u);
-  expectIdentical(one, two);
+  EXPECT_GT(tornCount(two), 0u); // the run really tears and compacts
+  EXPECT_LT(two.triangle_count, 2914u);
+  if (kComparesThreadCounts) expectIdentical(run(cloth(), yank, 20, kOne), two);
 }
 
 TEST(CpuThreads, CrumpleTossAndAwkwardSizeAreIdentical) {
@@ -63,9 +62,9 @@ TEST(CpuThreads, FullAdjacencyAndFourThreadsAreIdentical) {
   // Bend and triangle bend together: 16 neighbours per inner particle, the most the collision
   // pass's adjacency test holds in registers; four workers split every loop and phase.
   const std::string yank = "0 grab particle 1535\n1 move 4 -4 6\n12 release\n";
-  SimState one = run(cloth({"tri_bend=on"}), yank, 20, kOne);
-  EXPECT_GT(tornCount(one), 0u);
-  expectIdentical(one, run(cloth({"tri_bend=on"}), yank, 20, CpuOptions{.threads = 4, .min_chunk = 1}));
+  SimState four = run(cloth({"tri_bend=on"}), yank, 20, CpuOptions{.threads = 4, .min_chunk = 1});
+  EXPECT_GT(tornCount(four), 0u);
+  if (kComparesThreadCounts) expectIdentical(run(cloth({"tri_bend=on"}), yank, 20, kOne), four);
 }
 
 TEST(CpuThreads, ResetAndNoCollisionAreIdentical) {
@@ -98,6 +97,7 @@ TEST(CpuCandidateLists, ListsAreUsedAndChangeNothing) {
     on_lists += solver.candidateState().x == 1u && solver.candidateState().y >= p.substeps ? 1u : 0u;
   }
   EXPECT_GT(on_lists, 30u);
+  if (!kComparesThreadCounts) return; // ThreadSanitizer judges the two threads' run
   solver.computeNormals();
   SimState with;
   solver.readback(with);
