@@ -106,7 +106,7 @@ TEST_F(Parity, FullPhysicsTender30Ticks) {
 TEST_F(Parity, FullPhysicsCrumple30Ticks) {
   // The crumple preset with wind, contact and the hand's pace, on the per-colour passes its own
   // sheet runs on a device with 32 KiB of shared memory (over fusedCapacity); at 16 x 24, a sixth of
-  // its particles (the fused tick's crumple: TheHandCrumplesTheSameOnEveryPath)
+  // its particles (the fused tick's crumple: TheHandCrumplesTheSameInTheFusedTick)
   SimParams p = crumpleSheet({"cols=16", "rows=24", "wind=on"});
   auto [cpu, gpu] = runBoth(ctx(), p, "0 grab particle 383\n1 move 4 -6 4\n15 release\n", 30, false);
   EXPECT_TRUE(sameState(cpu, gpu));
