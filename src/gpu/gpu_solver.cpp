@@ -68,9 +68,11 @@ void GpuSolver::createPipelines(FusedShape fused) {
   fused_substeps_ = shape.substeps_per_dispatch;
   fused_max_cell_spacings_ = shape.max_cell_spacings;
   fused_contact_ = shape.contact > 0;
-  // The per-colour passes, the fused tick and the picks, made together (contact's wait for contact)
-  std::vector<PipelineRequest> requests = passPipelineRequests(ctx_, pipes_, false);
-  requests.push_back({&pipes_.tick_fused, "tick_fused.comp", sizeof(FusedPush), 1, fused_workgroup, true});
+  // What every sheet runs, whatever its path: the reset, the normals and the picks. A path's own
+  // pipelines wait for its first tick (makePathPipelines), contact's for contact.
+  std::vector<PipelineRequest> requests;
+  for (const PipelineRequest& r : passPipelineRequests(ctx_, pipes_, false))
+    if (r.out == &pipes_.reset || r.out == &pipes_.normals) requests.push_back(r);
   for (uint32_t s = 0; s < 3; ++s) requests.push_back({&pipes_.pick[s], "pick.comp", sizeof(PickPush), 1, s, false});
   makeComputePipelines(ctx_, {layout_, "solver"}, float_rules_, math_, requests);
 
@@ -135,9 +137,7 @@ void GpuSolver::tick(const SimUniforms& u) {
     // The contact's buffers and pipelines, the first time contact is on
     if (!layout_sizes_.contact) sizeContact();
     addContactPipelines(ctx_, {layout_, "solver"}, float_rules_, math_,
-                        pipes_.tick_fused.pipeline && fused_contact_ ? std::optional<uint32_t>(fused_workgroup_)
-                                                                     : std::nullopt,
-                        pipes_);
+                        fused_contact_ ? std::optional<uint32_t>(fused_workgroup_) : std::nullopt, pipes_);
   }
   last_contact_ = contact;
   const uint32_t index = next_in_flight_;
@@ -163,13 +163,29 @@ void GpuSolver::tick(const SimUniforms& u) {
   }
   const RecordKey key{substepCount(u.substeps), usesFusedPath(u), substepPlan(u, stop_after_)};
   stop_after_ = SIM_NONE;
-  if (flight.recorded != key) recordTick(flight, index, key);
+  if (flight.recorded != key) {
+    makePathPipelines(key.fused);
+    recordTick(flight, index, key);
+  }
   ctx_.submit(flight.tick, flight.fence);
   flight.pending = true;
   flight.timed = true;
   last_tick_ = int(index);
   dispatches_per_tick_ = flight.dispatches;
   fused_tick_ = key.fused;
+}
+
+void GpuSolver::makePathPipelines(bool fused) {
+  // The fused tick, or every per-colour pass not made yet: lavapipe translates and optimises a
+  // shader at each vkCreateComputePipelines (its cache keeps only the compiled code), 1.2 s for a
+  // small sheet's 48 pipelines, and a sheet that stays on one path never runs the other's
+  std::vector<PipelineRequest> requests;
+  if (fused && !pipes_.tick_fused.pipeline)
+    requests.push_back({&pipes_.tick_fused, "tick_fused.comp", sizeof(FusedPush), 1, fused_workgroup_, true});
+  if (!fused)
+    for (const PipelineRequest& r : passPipelineRequests(ctx_, pipes_, false))
+      if (!r.out->pipeline) requests.push_back(r);
+  if (!requests.empty()) makeComputePipelines(ctx_, {layout_, "solver"}, float_rules_, math_, requests);
 }
 
 uint32_t GpuSolver::barrierPhasesPerTick() {
@@ -317,9 +333,7 @@ bool fusedTickTakes(const SimUniforms& u, float spacing, float max_cell_spacings
   return u.inv_cell * max_cell_spacings * spacing >= 1.0f;
 }
 
-bool GpuSolver::usesFusedPath() const {
-  return fused_allowed_ && pipes_.tick_fused.pipeline && fusedTickFits(topo_, fusedCapacity(ctx_));
-}
+bool GpuSolver::usesFusedPath() const { return fused_allowed_ && fusedTickFits(topo_, fusedCapacity(ctx_)); }
 
 bool GpuSolver::usesFusedPath(const SimUniforms& u) const {
   return usesFusedPath() && fusedTickTakes(u, spacing_, fused_max_cell_spacings_, fused_contact_);
