@@ -106,8 +106,6 @@ void GpuBatch::create(uint32_t sheets, BatchPasses passes, FusedShape fused) {
     VK_CHECK(vkCreatePipelineLayout(dev, &pli, nullptr, &sheet_layout_));
     if (per_sheet_) sheet_passes_ = makePassPipelines(ctx_, {sheet_layout_, "sheet"}, float_rules_, math_, false);
   }
-  tick_batch_ = makeComputePipeline(ctx_, "tick_batch.comp", {layout_, "batch"}, float_rules_, math_, sizeof(BatchPush),
-                                    1, shape.workgroup, true);
 
   VkFenceCreateInfo fci{};
   fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;

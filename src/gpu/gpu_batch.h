@@ -119,7 +119,7 @@ private:
   std::vector<std::unique_ptr<QueuedSolver>> queued_;
 
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  ComputePipeline tick_batch_;         ///< the fused tick of a batch (null: the device has too little shared memory)
+  ComputePipeline tick_batch_;         ///< the fused tick of a batch (null until a flush first runs it)
   ComputePipeline tick_batch_contact_; ///< ... with contact's bodies (made when a sheet first takes it)
   uint32_t fused_workgroup_ = 0;       ///< the fused tick's workgroup (FusedShape)
   bool fused_contact_ = false;         ///< sheets with contact take the fused tick (FusedShape::contact)

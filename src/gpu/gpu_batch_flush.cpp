@@ -24,7 +24,7 @@ std::vector<uint32_t> GpuBatch::FlushQueue::queue() const {
 GpuBatch::FlushQueue GpuBatch::takeQueued() {
   // Each sheet takes the path it takes alone: the fused tick or the per-colour passes
   FlushQueue f;
-  const bool fits_fused = fused_allowed_ && tick_batch_.pipeline && fusedTickFits(topo_, fusedCapacity(ctx_));
+  const bool fits_fused = fused_allowed_ && fusedTickFits(topo_, fusedCapacity(ctx_));
   f.uniforms_at = alignUp(4ull * size(), kSliceAlign);
   f.args_at = f.uniforms_at + stride_[SIM_BIND_UNIFORMS] * size();
   char* inputs = static_cast<char*>(inputs_.mapped);
@@ -204,6 +204,11 @@ void GpuBatch::flush() {
   const FlushQueue f = takeQueued();
   if (f.fused.empty() && f.fused_contact.empty() && f.passes.empty()) return;
   last_dispatches_ = 0;
+  // The fused ticks when a flush first runs a sheet in them (lavapipe translates a shader at every
+  // pipeline it makes; a fleet on one path never runs the other's)
+  if (!f.fused.empty() && !tick_batch_.pipeline)
+    tick_batch_ = makeComputePipeline(ctx_, "tick_batch.comp", {layout_, "batch"}, float_rules_, math_,
+                                      sizeof(BatchPush), 1, fused_workgroup_, true);
   if (!f.fused_contact.empty() && !tick_batch_contact_.pipeline)
     tick_batch_contact_ = makeComputePipeline(ctx_, "tick_batch_contact.comp", {layout_, "batch"}, float_rules_, math_,
                                               sizeof(BatchPush), 1, fused_workgroup_, true);
