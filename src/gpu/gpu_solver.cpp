@@ -63,8 +63,7 @@ void GpuSolver::createPipelines(FusedShape fused) {
   math_ = MathSwitches::fromEnvironment();
   // The fused tick keeps the positions in shared memory; its shape suits the device.
   const FusedShape shape = resolveFusedShape(ctx_, fused);
-  const uint32_t fused_workgroup = shape.workgroup;
-  fused_workgroup_ = fused_workgroup;
+  fused_workgroup_ = shape.workgroup;
   fused_substeps_ = shape.substeps_per_dispatch;
   fused_max_cell_spacings_ = shape.max_cell_spacings;
   fused_contact_ = shape.contact > 0;
