@@ -213,9 +213,9 @@ void GpuBatch::flush() {
     tick_batch_contact_ = makeComputePipeline(ctx_, "tick_batch_contact.comp", {layout_, "batch"}, float_rules_, math_,
                                               sizeof(BatchPush), 1, fused_workgroup_, true);
   if (runsWhen(SIM_WHEN_CONTACT, f.plan.when) && per_sheet_)
-    addContactPipelines(ctx_, {sheet_layout_, "sheet"}, float_rules_, math_, std::nullopt, sheet_passes_);
+    addContactPipelines(ctx_, {sheet_layout_, "sheet"}, float_rules_, math_, sheet_passes_);
   else if (runsWhen(SIM_WHEN_CONTACT, f.plan.when))
-    addContactPipelines(ctx_, {layout_, "batch"}, float_rules_, math_, std::nullopt, passes_, true);
+    addContactPipelines(ctx_, {layout_, "batch"}, float_rules_, math_, passes_, true);
 
   VkCommandBufferBeginInfo bi{};
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;

@@ -68,7 +68,7 @@ void GpuSolver::createPipelines(FusedShape fused) {
   fused_max_cell_spacings_ = shape.max_cell_spacings;
   fused_contact_ = shape.contact > 0;
   // What every sheet runs, whatever its path: the reset, the normals and the picks. A path's own
-  // pipelines wait for its first tick (makePathPipelines), contact's for contact.
+  // pipelines, contact's included, wait for its first tick (makePathPipelines).
   std::vector<PipelineRequest> requests;
   for (const PipelineRequest& r : passPipelineRequests(ctx_, pipes_, false))
     if (r.out == &pipes_.reset || r.out == &pipes_.normals) requests.push_back(r);
@@ -132,12 +132,8 @@ void GpuSolver::collectTimes(const InFlight& flight) const {
 
 void GpuSolver::tick(const SimUniforms& u) {
   const bool contact = u.contact.radius > 0.0f;
-  if (contact) {
-    // The contact's buffers and pipelines, the first time contact is on
-    if (!layout_sizes_.contact) sizeContact();
-    addContactPipelines(ctx_, {layout_, "solver"}, float_rules_, math_,
-                        fused_contact_ ? std::optional<uint32_t>(fused_workgroup_) : std::nullopt, pipes_);
-  }
+  // The contact's buffers, the first time contact is on (its pipelines: makePathPipelines)
+  if (contact && !layout_sizes_.contact) sizeContact();
   last_contact_ = contact;
   const uint32_t index = next_in_flight_;
   next_in_flight_ = (next_in_flight_ + 1) % kInFlight;
@@ -163,7 +159,7 @@ void GpuSolver::tick(const SimUniforms& u) {
   const RecordKey key{substepCount(u.substeps), usesFusedPath(u), substepPlan(u, stop_after_)};
   stop_after_ = SIM_NONE;
   if (flight.recorded != key) {
-    makePathPipelines(key.fused);
+    makePathPipelines(key.fused, runsWhen(SIM_WHEN_CONTACT, key.plan.when));
     recordTick(flight, index, key);
   }
   ctx_.submit(flight.tick, flight.fence);
@@ -174,15 +170,19 @@ void GpuSolver::tick(const SimUniforms& u) {
   fused_tick_ = key.fused;
 }
 
-void GpuSolver::makePathPipelines(bool fused) {
-  // The fused tick, or every per-colour pass not made yet: lavapipe translates and optimises a
-  // shader at each vkCreateComputePipelines (its cache keeps only the compiled code), 1.2 s for a
-  // small sheet's 48 pipelines, and a sheet that stays on one path never runs the other's
+void GpuSolver::makePathPipelines(bool fused, bool contact) {
+  // The fused tick (with contact or without), or every per-colour pass not made yet (contact's
+  // with contact): lavapipe translates and optimises a shader at each vkCreateComputePipelines (its
+  // cache keeps only the compiled code), 1.2 s for a small sheet's 48 pipelines, and a sheet that
+  // stays on one path never runs the other's
   std::vector<PipelineRequest> requests;
-  if (fused && !pipes_.tick_fused.pipeline)
+  if (fused && !contact && !pipes_.tick_fused.pipeline)
     requests.push_back({&pipes_.tick_fused, "tick_fused.comp", sizeof(FusedPush), 1, fused_workgroup_, true});
+  if (fused && contact && !pipes_.tick_fused_contact.pipeline)
+    requests.push_back(
+        {&pipes_.tick_fused_contact, "tick_fused_contact.comp", sizeof(FusedPush), 1, fused_workgroup_, true});
   if (!fused)
-    for (const PipelineRequest& r : passPipelineRequests(ctx_, pipes_, false))
+    for (const PipelineRequest& r : passPipelineRequests(ctx_, pipes_, false, contact))
       if (!r.out->pipeline) requests.push_back(r);
   if (!requests.empty()) makeComputePipelines(ctx_, {layout_, "solver"}, float_rules_, math_, requests);
 }

@@ -159,8 +159,9 @@ private:
   /// scratch they share, once contact is turned on.
   void sizeContact();
   void writeStaticUniforms();
-  /// Makes what the fused tick (`fused`) or the per-colour passes need that is not made yet.
-  void makePathPipelines(bool fused);
+  /// Makes what the fused tick (`fused`) or the per-colour passes need that is not made yet, with
+  /// `contact` or without.
+  void makePathPipelines(bool fused, bool contact);
   void recordTick(InFlight& flight, uint32_t index, const RecordKey& key);
   // PassSink: the passes of the per-colour path go to the tick being recorded (recording_)
   void pass(const ComputePipeline& p, Grid grid, uint32_t count, const void* push, uint32_t push_size, uint32_t substep,

@@ -197,11 +197,12 @@ uint32_t limitWorkgroup(const VulkanContext& ctx) {
       {uint32_t(SIM_WG_LIMIT_GPU), limits.maxComputeWorkGroupInvocations, limits.maxComputeWorkGroupSize[0]});
 }
 
-std::vector<PipelineRequest> passPipelineRequests(const VulkanContext& ctx, SimPipelines& pipes, bool batched) {
+std::vector<PipelineRequest> passPipelineRequests(const VulkanContext& ctx, SimPipelines& pipes, bool batched,
+                                                  bool contact) {
   using namespace shaderio;
   std::vector<PipelineRequest> requests;
   for (const PipelineSpec& spec : kPasses) {
-    if ((batched && !spec.batched) || isContactKernel(spec)) continue;
+    if ((batched && !spec.batched) || (isContactKernel(spec) && !contact)) continue;
     const std::string key = batched ? std::string(spec.key) + ".batch" : std::string(spec.key);
     // The stretch limit's workgroup is the device's (specialization constant 0)
     const std::optional<uint32_t> size =
@@ -221,17 +222,13 @@ SimPipelines makePassPipelines(VulkanContext& ctx, const SimLayout& layout, cons
 }
 
 void addContactPipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
-                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, bool batched) {
-  using namespace shaderio;
+                         SimPipelines& pipes, bool batched) {
   std::vector<PipelineRequest> requests;
   for (const PipelineSpec& spec : kPasses)
     if (isContactKernel(spec) && !(pipes.*spec.member).pipeline)
       requests.push_back({&(pipes.*spec.member), batched ? std::string(spec.key) + ".batch" : std::string(spec.key),
                           batched ? uint32_t(sizeof(BatchPassPush)) : spec.push_size, spec.per_invocation, std::nullopt,
                           false});
-  if (fused_workgroup && !pipes.tick_fused_contact.pipeline)
-    requests.push_back(
-        {&pipes.tick_fused_contact, "tick_fused_contact.comp", sizeof(FusedPush), 1, *fused_workgroup, true});
   makeComputePipelines(ctx, layout, rules, math, requests);
 }
 

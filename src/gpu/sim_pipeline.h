@@ -48,7 +48,7 @@ struct SimPipelines {
   SIM_KERNELS(SIM_KERNEL_MEMBER)
 #undef SIM_KERNEL_MEMBER
   ComputePipeline tick_fused;         ///< the fused tick of sheets up to fusedCapacity
-  ComputePipeline tick_fused_contact; ///< the fused tick with contact (addContactPipelines)
+  ComputePipeline tick_fused_contact; ///< the fused tick with contact
   std::array<ComputePipeline, 3> pick;
 };
 
@@ -102,15 +102,17 @@ uint32_t limitWorkgroup(const VulkanContext& ctx);
 SimPipelines makePassPipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
                                bool batched);
 
-/// What makePassPipelines makes, as requests into `pipes` (to make with others).
-std::vector<PipelineRequest> passPipelineRequests(const VulkanContext& ctx, SimPipelines& pipes, bool batched);
+/// What makePassPipelines makes, as requests into `pipes` (to make with others); with `contact`,
+/// the contact's kernels too.
+std::vector<PipelineRequest> passPipelineRequests(const VulkanContext& ctx, SimPipelines& pipes, bool batched,
+                                                  bool contact = false);
 
-/// Adds the contact's kernels (contact_*) to `pipes`, passes on `layout` as makePassPipelines
-/// makes them (`batched`: a fleet's), and, with `fused_workgroup` set, the fused tick with contact
-/// (tick_fused_contact): made when a sheet first has contact on, so that a solver without it does
-/// not compile them. Nothing when they are made.
+/// Adds the contact's kernels (contact_*) to a fleet's `pipes`, passes on `layout` as
+/// makePassPipelines makes them (`batched`: run once for the whole batch): made when its passes
+/// first run a sheet with contact, so that a fleet without it does not compile them. Nothing when
+/// they are made.
 void addContactPipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
-                         std::optional<uint32_t> fused_workgroup, SimPipelines& pipes, bool batched = false);
+                         SimPipelines& pipes, bool batched = false);
 
 /// One input of the device math check and its results (bits of floats).
 struct MathCase {
