@@ -178,7 +178,7 @@ constexpr PipelineSpec kPasses[] = {
 #undef SIM_KERNEL_SPEC
 };
 
-bool isContactKernel(const PipelineSpec& spec) { return std::string_view(spec.key).starts_with("contact_"); }
+bool isContactKey(std::string_view key) { return key.starts_with("contact_"); }
 
 } // namespace
 
@@ -202,7 +202,7 @@ std::vector<PipelineRequest> passPipelineRequests(const VulkanContext& ctx, SimP
   using namespace shaderio;
   std::vector<PipelineRequest> requests;
   for (const PipelineSpec& spec : kPasses) {
-    if ((batched && !spec.batched) || (isContactKernel(spec) && !contact)) continue;
+    if ((batched && !spec.batched) || (isContactKey(spec.key) && !contact)) continue;
     const std::string key = batched ? std::string(spec.key) + ".batch" : std::string(spec.key);
     // The stretch limit's workgroup is the device's (specialization constant 0)
     const std::optional<uint32_t> size =
@@ -224,11 +224,8 @@ SimPipelines makePassPipelines(VulkanContext& ctx, const SimLayout& layout, cons
 void addContactPipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
                          SimPipelines& pipes, bool batched) {
   std::vector<PipelineRequest> requests;
-  for (const PipelineSpec& spec : kPasses)
-    if (isContactKernel(spec) && !(pipes.*spec.member).pipeline)
-      requests.push_back({&(pipes.*spec.member), batched ? std::string(spec.key) + ".batch" : std::string(spec.key),
-                          batched ? uint32_t(sizeof(BatchPassPush)) : spec.push_size, spec.per_invocation, std::nullopt,
-                          false});
+  for (PipelineRequest& r : passPipelineRequests(ctx, pipes, batched, true))
+    if (isContactKey(r.key) && !r.out->pipeline) requests.push_back(std::move(r));
   makeComputePipelines(ctx, layout, rules, math, requests);
 }
 

@@ -95,7 +95,7 @@ uint32_t fusedCapacity(const VulkanContext& ctx);
 /// device, SIM_WG_LIMIT_GPU (or the device's most) on a GPU.
 uint32_t limitWorkgroup(const VulkanContext& ctx);
 
-/// The passes of the per-colour path (every SimPipelines member but tick_fused and pick) on
+/// The passes of the per-colour path (every SimPipelines member but the fused ticks and pick) on
 /// `layout`: a sheet's own, or a fleet's (`batched`: the SIM_BATCH_PASS builds, "<key>.batch",
 /// whose push constants are BatchPassPush; no normals pass). The contact's kernels (contact_*)
 /// wait for addContactPipelines.
