@@ -23,11 +23,18 @@
 /// Particle i's step in the substep less the frame and its push: what its half-spaces and ball hold.
 SIM_INLINE vec3 settleStep(uint i) { return vec3(SIM_POSITION(i)) - (settleStart(i) + settleFrame()) - settlePush(i); }
 
-/// True when particle i is free in substep s and the contact bounds it (a grab the hand places
-/// stays where the hand has it).
+/// True when the settle may move particle i in substep s: the contact bounds it (contactBounded),
+/// and the grab the hand holds only while the hand is closed (HandKeys::reach). A closed hand holds
+/// the ball, not the point: its grab follows the fist only as far as its edges let it, as it
+/// follows it only as far as its bound lets it, so that where a neighbour pressed in the ball
+/// cannot follow, the grab gives way within its own half-spaces and ball (the hand places it again
+/// at the next substep). Held in an open hand, the grab stays where the hand has it, and a pull
+/// the sheet cannot follow tears it. (A closed hand's grab that stayed put stretched its edges to
+/// their tear length: `bench/gestures/crumple-fast.txt` tore 21 constraints at the hand.)
 SIM_INLINE bool settleFree(uint i, uint s) {
   vec4 p = SIM_POSITION(i), target = u.grab_target[s]; // whole (contactSlideStep says why)
-  return p.w > 0.0f && contactBounded(p.w, i == u.grab_index, target.w);
+  HandKeys hand = u.hand;
+  return contactBounded(p.w, i == u.grab_index, target.w) && (p.w > 0.0f || hand.reach > 0.0f);
 }
 
 /// True when the settle may move particle i in substep s: free, and its half-spaces all listed.
