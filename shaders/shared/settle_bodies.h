@@ -24,13 +24,10 @@
 SIM_INLINE vec3 settleStep(uint i) { return vec3(SIM_POSITION(i)) - (settleStart(i) + settleFrame()) - settlePush(i); }
 
 /// True when the settle may move particle i in substep s: the contact bounds it (contactBounded),
-/// and the grab the hand holds only while the hand is closed (HandKeys::reach). A closed hand holds
-/// the ball, not the point: its grab follows the fist only as far as its edges let it, as it
-/// follows it only as far as its bound lets it, so that where a neighbour pressed in the ball
-/// cannot follow, the grab gives way within its own half-spaces and ball (the hand places it again
-/// at the next substep). Held in an open hand, the grab stays where the hand has it, and a pull
-/// the sheet cannot follow tears it. (A closed hand's grab that stayed put stretched its edges to
-/// their tear length: `bench/gestures/crumple-fast.txt` tore 21 constraints at the hand.)
+/// and the held grab only while the hand is closed (HandKeys::reach). A closed hand holds the ball,
+/// not the point: where a neighbour pressed in the ball cannot follow, the grab gives way within its
+/// own half-spaces and ball rather than stretch their edge to its tear length (the hand places it
+/// again at the next substep). An open hand's grab stays where the hand has it.
 SIM_INLINE bool settleFree(uint i, uint s) {
   vec4 p = SIM_POSITION(i), target = u.grab_target[s]; // whole (contactSlideStep says why)
   HandKeys hand = u.hand;

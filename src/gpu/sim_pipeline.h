@@ -98,7 +98,7 @@ uint32_t limitWorkgroup(const VulkanContext& ctx);
 /// The passes of the per-colour path (every SimPipelines member but the fused ticks and pick) on
 /// `layout`: a sheet's own, or a fleet's (`batched`: the SIM_BATCH_PASS builds, "<key>.batch",
 /// whose push constants are BatchPassPush; no normals pass). The contact's kernels (contact_*)
-/// wait for addContactPipelines.
+/// wait for a sheet's first tick with contact (passPipelineRequests) or a fleet's (addContactPipelines).
 SimPipelines makePassPipelines(VulkanContext& ctx, const SimLayout& layout, const FloatRules& rules, MathSwitches math,
                                bool batched);
 
