@@ -6,6 +6,8 @@
 #include <cstring>
 #include <iostream>
 
+#include <CLI/CLI.hpp>
+
 namespace tender {
 namespace {
 

@@ -5,9 +5,14 @@
 #include <optional>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
 #include "core/text.h" // printable()
+
+// CLI11's types, declared only: what parses a command line includes <CLI/CLI.hpp> itself, and the
+// commands, which only report errors, are spared compiling it (about 8 s a translation unit).
+namespace CLI {
+class App;
+class Validator;
+} // namespace CLI
 
 namespace tender {
 
