@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
+
 #include "commands.h"
 #include "core/output.h"
 #include "core/progress.h"

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <functional>
 
+#include <nlohmann/json.hpp>
+
 #include "commands.h"
 #include "core/fleet.h"
 #include "core/input_file.h"
