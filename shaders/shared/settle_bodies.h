@@ -23,11 +23,11 @@
 /// Particle i's step in the substep less the frame and its push: what its half-spaces and ball hold.
 SIM_INLINE vec3 settleStep(uint i) { return vec3(SIM_POSITION(i)) - (settleStart(i) + settleFrame()) - settlePush(i); }
 
-/// True when the settle may move particle i in substep s: the contact bounds it (contactBounded),
-/// and the held grab only while the hand is closed (HandKeys::reach). A closed hand holds the ball,
-/// not the point: where a neighbour pressed in the ball cannot follow, the grab gives way within its
-/// own half-spaces and ball rather than stretch their edge to its tear length (the hand places it
-/// again at the next substep). An open hand's grab stays where the hand has it.
+/// True when particle i is free to move in the settle in substep s: the contact bounds it
+/// (contactBounded), and the held grab only while the hand is closed (HandKeys::reach). A closed
+/// hand holds the ball, not the point: where a neighbour pressed in the ball cannot follow, the grab
+/// gives way within its own half-spaces and ball rather than stretch their edge to its tear length
+/// (the hand places it again at the next substep). An open hand's grab stays where the hand has it.
 SIM_INLINE bool settleFree(uint i, uint s) {
   vec4 p = SIM_POSITION(i), target = u.grab_target[s]; // whole (contactSlideStep says why)
   HandKeys hand = u.hand;
