@@ -109,6 +109,7 @@ void CpuContact::listEdges(const std::vector<uvec4>& triangles, uint32_t count) 
   std::sort(edges_.begin(), edges_.end(), [](uvec2 a, uvec2 b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
   edges_.erase(std::unique(edges_.begin(), edges_.end()), edges_.end());
   ownTriangles(triangles, count);
+  tree_.clear();
   edges_key_ = count;
   lists_ = false;
 }
@@ -300,14 +301,13 @@ void CpuContact::findCrossings(const std::vector<glm::vec4>& pos, const std::vec
     }
   };
   const uint32_t checked = uint32_t(checked_.size());
-  const float inv_cell = 1.0f / (1.01f * longest);
-  if (uint64_t(checked) * count > kBruteForceTests && std::isfinite(inv_cell) && longest < 1e30f) {
-    // Many: through a grid of the triangles' boxes
-    grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
+  if (uint64_t(checked) * count > kBruteForceTests && longest < 1e30f) {
+    // Many: through a tree of the triangles' boxes (finite ones: its groups compare their centres)
+    tree_.fit(lo_, hi_, pool_);
     pool_.parallelFor(checked, kGrainCollide, [&](uint32_t begin, uint32_t end) {
       for (uint32_t k = begin; k < end; ++k) {
         const uint32_t t = checked_[k];
-        visitBox(grid_, lo_[t], hi_[t], inv_cell, 0, [&](uint32_t o) { test(t, o); });
+        tree_.visit(lo_[t], hi_[t], [&](uint32_t o) { test(t, o); });
       }
     });
   } else {
@@ -331,11 +331,11 @@ uint64_t CpuContact::memoryBytes() const {
          capacityBytes(edges_) + capacityBytes(free_) + capacityBytes(was_free_) + capacityBytes(checked_) +
          capacityBytes(sums_) + capacityBytes(crossing_) + capacityBytes(vf_) + capacityBytes(ee_) +
          capacityBytes(base_) + capacityBytes(lo_) + capacityBytes(hi_) + capacityBytes(nearest2_) +
-         capacityBytes(grid_.start) + capacityBytes(grid_.entry) + capacityBytes(grid_.fill) +
-         capacityBytes(grid_.last) + capacityBytes(moved_) + capacityBytes(dirty_) + capacityBytes(travels_) +
+         tree_.memoryBytes() + capacityBytes(moved_) + capacityBytes(dirty_) + capacityBytes(travels_) +
          capacityBytes(travel_) + capacityBytes(cluster_members_) + capacityBytes(cluster_start_) +
-         capacityBytes(cluster_pairs_) + capacityBytes(cluster_box_) + capacityBytes(ball_) + capacityBytes(own_) +
-         capacityBytes(own_particles_) + capacityBytes(owned_) + capacityBytes(weighed_) + capacityBytes(near_);
+         capacityBytes(cluster_pairs_) + capacityBytes(cluster_box_) + capacityBytes(ball_) + capacityBytes(segment_) +
+         capacityBytes(own_) + capacityBytes(own_particles_) + capacityBytes(owned_) + capacityBytes(weighed_) +
+         capacityBytes(near_);
 }
 
 } // namespace tender

@@ -2,8 +2,8 @@
 /// Penetration-free self-contact of the CPU solver: the step bound of every particle at the start
 /// of a substep (contact.h: slideBound, from the nearest of the triangles and edges near it) and,
 /// after the floor, the cut of each step to its pairs' half-spaces (slide), from lists of the
-/// pairs near each other that a uniform grid of the triangles' boxes finds (each triangle against
-/// those near it, the pairs of the edges and particles they own), kept while the particles travel
+/// pairs near each other that a tree of the triangles' boxes finds (each two triangles near each
+/// other, the pairs of the edges and particles they own), kept while the particles travel
 /// little (once the sheet's turn is taken out, and where clusters of them next to each other
 /// travel alike) and repaired where a few travelled far. Each distance lowers
 /// the bounds of the particles of its pair by an atomic minimum, and each half-space their shares
@@ -16,6 +16,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "box_tree.h"
 #include "shaderio.h"
 
 namespace tender {
@@ -30,9 +31,7 @@ public:
     Kept,    ///< kept while they hold every pair that can touch (the travels, turned, clusters), then built whole
     Repaired ///< kept so, else repaired where a few particles travelled too far, else built whole
   };
-  /// `min_chunk`: CpuOptions::min_chunk (1 splits every grid build among the threads).
-  CpuContact(WorkerPool& pool, Lists lists, uint32_t min_chunk = 0)
-      : pool_(pool), lists_kept_(lists), grid_part_boxes_(min_chunk ? min_chunk : kGridPartBoxes) {}
+  CpuContact(WorkerPool& pool, Lists lists) : pool_(pool), lists_kept_(lists) {}
 
   /// The step bound of each particle at `pos` (xyz; w inverse mass; `prev` where each was a
   /// substep before) in substep `s`, of the sheet made of the first `count` triangles of
@@ -82,31 +81,11 @@ public:
     lists_ = false;
     free_.clear();
     tangles_ = false;
+    tree_.clear();
   }
   uint64_t memoryBytes() const;
 
 private:
-  /// A uniform grid of boxes hashed into a power-of-two table: a box is an entry of every cell it
-  /// overlaps, once in each bucket; the entries of bucket h at [start[h], start[h + 1]), rising.
-  /// Each entry holds a copy of its box and the cell of its lowest corner, so that a search reads a
-  /// bucket in one sweep of memory.
-  struct Slot {
-    glm::vec3 lo;
-    uint32_t id;
-    glm::vec3 hi;
-    glm::ivec3 cell;
-  };
-  struct Grid {
-    std::vector<uint32_t> start, fill, last;
-    std::vector<Slot> entry;
-    uint32_t mask = 0;
-    /// With up to kGridParts threads of `pool`, `part_boxes` boxes at least each.
-    void build(const std::vector<glm::vec3>& lo, const std::vector<glm::vec3>& hi, float inv_cell, WorkerPool& pool,
-               uint32_t part_boxes);
-  };
-  /// The most runs of boxes a grid is built in, one a thread (each holds a count and a mark a
-  /// bucket), and the fewest boxes a run
-  static constexpr uint32_t kGridParts = 4, kGridPartBoxes = 4096;
   /// Shares a worker takes of a list build's searches: a crumpled part of the sheet costs more than
   /// a flat one, and a triangle looks only at the triangles after it, so the first cost the most
   static constexpr uint32_t kSearchShares = 8;
@@ -153,7 +132,7 @@ private:
   std::optional<glm::vec3> markMoved(const std::vector<glm::vec4>& pos, float radius);
   /// Lists anew the pairs closer than `reach` with a moved particle into added_vf and added_ee.
   void searchMoved(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count,
-                   float reach, float inv_cell, std::vector<glm::uvec4>& added_vf, std::vector<glm::uvec4>& added_ee);
+                   float reach, std::vector<glm::uvec4>& added_vf, std::vector<glm::uvec4>& added_ee);
   /// Each particle's travel since its base in the frame of the sheet's turn since, into travel_:
   /// R^T (x - c) - (b - c') for the rotation R that best carries the bases (b, centroid c') onto
   /// the positions (x, centroid c), so that a sheet swinging about its pins travels as little as
@@ -168,21 +147,21 @@ private:
   /// each two clusters next to each other lie within two contactTravel, and the whole spread
   /// within cluster_far_.
   bool clustersHold(glm::vec3 lo, glm::vec3 hi, float radius);
-  /// The boxes of the first `count` triangles at `pos` into lo_ and hi_, their balls into ball_.
+  /// The boxes of the first `count` triangles at `pos` into lo_ and hi_, their balls into ball_,
+  /// and the edges' middles and sides into segment_.
   void boxTriangles(const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, uint32_t count);
   /// The pairs within `reach` between what triangles t and o own that `keep` takes (buildLists).
   template <class Keep>
   void pairsOfTriangles(uint32_t t, uint32_t o, const std::vector<glm::vec4>& pos,
                         const std::vector<glm::uvec4>& triangles, float reach, Keep&& keep, std::vector<glm::uvec4>& vf,
                         std::vector<glm::uvec4>& ee) const;
-  /// Particle v, which no triangle holds, against the triangles within `reach` (grid_ of them).
+  /// Particle v, which no triangle holds, against the triangles within `reach` (tree_ of them).
   void searchLoner(uint32_t v, const std::vector<glm::vec4>& pos, const std::vector<glm::uvec4>& triangles, float reach,
-                   float inv_cell, std::vector<glm::uvec4>& vf) const;
+                   std::vector<glm::uvec4>& vf) const;
   /// What each triangle owns for buildLists's search (own_, own_particles_, owned_).
   void ownTriangles(const std::vector<glm::uvec4>& triangles, uint32_t count);
-  /// The cells of the lists' grids for pairs within `reach` at `pos` (1 / their width), or 0 when
-  /// the positions have gone wrong.
-  float listCell(const std::vector<glm::vec4>& pos, float reach) const;
+  /// False when the positions have gone wrong: an edge's squared length is not finite.
+  bool searchable(const std::vector<glm::vec4>& pos) const;
 
   /// A cluster's width, in reaches and longest edges
   static constexpr float kClusterWidth = 4.0f;
@@ -191,22 +170,26 @@ private:
 
   WorkerPool& pool_;
   Lists lists_kept_;
-  uint32_t grid_part_boxes_;
-  std::vector<glm::uvec4> vf_;          ///< particle, then the triangle's three: pairs within radius + skin
-  std::vector<glm::ivec4> sums_;        ///< each particle's pushes in fixed point, and their count
-  std::vector<glm::uvec4> ee_;          ///< two edges' particles: pairs within radius + skin
-  std::vector<glm::vec4> base_;         ///< where the particles were when the lists were built
-  bool lists_ = false;                  ///< the lists are usable
-  std::vector<uint8_t> free_;           ///< particles of triangles crossing another: not bounded
-  std::vector<uint8_t> was_free_;       ///< free_ of the last call
-  std::vector<uint32_t> checked_;       ///< scratch: the triangles checked for crossing
-  std::vector<uint8_t> crossing_;       ///< scratch: the triangles crossing another
-  bool tangles_ = false;                ///< the sheet crossed itself at the last call
-  float list_radius_ = 0.0f;            ///< the contact radius they were built for
-  std::vector<glm::uvec2> edges_;       ///< the sheet's edges, each once (a < b)
-  uint64_t edges_key_ = ~0ull;          ///< the triangle count the edges were worked out for
-  std::vector<glm::vec3> lo_, hi_;      ///< scratch: the boxes of the triangles
-  std::vector<glm::vec4> ball_;         ///< scratch: the triangles' balls (centroid, farthest corner)
+  std::vector<glm::uvec4> vf_;     ///< particle, then the triangle's three: pairs within radius + skin
+  std::vector<glm::ivec4> sums_;   ///< each particle's pushes in fixed point, and their count
+  std::vector<glm::uvec4> ee_;     ///< two edges' particles: pairs within radius + skin
+  std::vector<glm::vec4> base_;    ///< where the particles were when the lists were built
+  bool lists_ = false;             ///< the lists are usable
+  std::vector<uint8_t> free_;      ///< particles of triangles crossing another: not bounded
+  std::vector<uint8_t> was_free_;  ///< free_ of the last call
+  std::vector<uint32_t> checked_;  ///< scratch: the triangles checked for crossing
+  std::vector<uint8_t> crossing_;  ///< scratch: the triangles crossing another
+  bool tangles_ = false;           ///< the sheet crossed itself at the last call
+  float list_radius_ = 0.0f;       ///< the contact radius they were built for
+  std::vector<glm::uvec2> edges_;  ///< the sheet's edges, each once (a < b)
+  uint64_t edges_key_ = ~0ull;     ///< the triangle count the edges were worked out for
+  std::vector<glm::vec3> lo_, hi_; ///< scratch: the boxes of the triangles
+  std::vector<glm::vec4> ball_;    ///< scratch: the triangles' balls (centroid, farthest corner)
+  /// An edge's middle and its side (second particle less first), for segmentsApart
+  struct Segment {
+    glm::vec3 middle, side;
+  };
+  std::vector<Segment> segment_;        ///< scratch: each edge's, by its number
   std::vector<glm::uvec4> own_;         ///< each triangle's own edges and counts (ownTriangles)
   std::vector<uint32_t> own_particles_; ///< each triangle's own particles, three slots a triangle
   std::vector<uint8_t> owned_;          ///< the particles some triangle holds
@@ -227,7 +210,7 @@ private:
   std::vector<glm::vec4> half_;      ///< the half-spaces (SlideHalf::h)
   std::vector<float> half_slack_;    ///< and their slack
   std::vector<uint32_t> half_fill_;  ///< scratch: where each particle's next half-space goes
-  Grid grid_;
+  BoxTree tree_;                     ///< the triangles' boxes at the last search
   uint64_t contacts_ = 0;
   uint32_t builds_ = 0;
   uint32_t repairs_done_ = 0;

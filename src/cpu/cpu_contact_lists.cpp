@@ -3,6 +3,7 @@
 // the particles travelled is cpu_contact_travel.cpp's.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
 
 #include <glm/gtc/quaternion.hpp>
@@ -22,60 +23,6 @@ using glm::uvec2;
 using glm::uvec4;
 using glm::vec3;
 
-void CpuContact::Grid::build(const std::vector<vec3>& lo, const std::vector<vec3>& hi, float inv_cell, WorkerPool& pool,
-                             uint32_t part_boxes) {
-  const uint32_t n = uint32_t(lo.size());
-  const uint32_t size = std::bit_ceil(std::max(2u * n, 16u));
-  mask = size - 1;
-  // The boxes in `parts` runs of consecutive ones, each counted and filled by one thread into its
-  // own share of each bucket, the runs' shares in their order: the entries rise in every bucket
-  // whatever the thread count
-  const uint32_t parts = std::max(1u, std::min({pool.size(), kGridParts, n / part_boxes}));
-  auto first = [&](uint32_t part) { return uint32_t(uint64_t(n) * part / parts); };
-  fill.assign(size_t(parts) * size, 0);
-  last.assign(size_t(parts) * size, ~0u);
-  // Calls f(h) for the bucket of each cell box i spans, each bucket once (two cells of a box may
-  // share one): `seen` holds the box that last went into each bucket
-  auto buckets = [&](uint32_t i, uint32_t* seen, auto&& f) {
-    const ivec3 a = gridCell(lo[i], inv_cell), b = gridCell(hi[i], inv_cell);
-    for (int z = a.z; z <= b.z; ++z)
-      for (int y = a.y; y <= b.y; ++y)
-        for (int x = a.x; x <= b.x; ++x) {
-          const uint32_t h = hashCell(ivec3(x, y, z), mask);
-          if (seen[h] == i) continue;
-          seen[h] = i;
-          f(h);
-        }
-  };
-  auto each = [&](auto&& visit) {
-    pool.parallelFor(parts, 1, [&](uint32_t begin, uint32_t end) {
-      for (uint32_t part = begin; part < end; ++part) {
-        uint32_t *count = fill.data() + size_t(part) * size, *seen = last.data() + size_t(part) * size;
-        for (uint32_t i = first(part); i < first(part + 1); ++i) visit(i, seen, count);
-      }
-    });
-  };
-  each([&](uint32_t i, uint32_t* seen, uint32_t* count) { buckets(i, seen, [&](uint32_t h) { ++count[h]; }); });
-  // Each part's first slot in each bucket, after the parts before it
-  start.resize(size + 1);
-  uint32_t total = 0;
-  for (uint32_t h = 0; h < size; ++h) {
-    start[h] = total;
-    for (uint32_t part = 0; part < parts; ++part) {
-      const uint32_t k = fill[size_t(part) * size + h];
-      fill[size_t(part) * size + h] = total;
-      total += k;
-    }
-  }
-  start[size] = total;
-  entry.resize(total);
-  std::fill(last.begin(), last.end(), ~0u);
-  each([&](uint32_t i, uint32_t* seen, uint32_t* slot) {
-    const Slot box{lo[i], i, hi[i], gridCell(lo[i], inv_cell)};
-    buckets(i, seen, [&](uint32_t h) { entry[slot[h]++] = box; });
-  });
-}
-
 // What triangles t and o own (ownTriangles) within `reach` of each other, the pairs `keep` takes:
 // their edges' pairs into ee (the lower edge first, as segmentDistance2 weighs them), each one's
 // particles against the other triangle into vf. Balls around the triangles and two separating axes
@@ -93,9 +40,10 @@ void CpuContact::pairsOfTriangles(uint32_t t, uint32_t o, const std::vector<glm:
       const uint32_t k = mine[int(i)], l = theirs[int(j)];
       const uvec2 e = edges_[std::min(k, l)], f = edges_[std::max(k, l)];
       if (f.x == e.x || f.x == e.y || f.y == e.x || f.y == e.y || !keep(uvec4(e, f))) continue;
-      const vec3 a = at(e.x), b = at(e.y), c = at(f.x), d = at(f.y);
-      if (segmentsApart((a + b) * 0.5f, b - a, (c + d) * 0.5f, d - c, reach)) continue;
-      if (segmentDistance2(a, b, c, d) < reach2) ee.push_back(uvec4(e, f));
+      const Segment& se = segment_[std::min(k, l)];
+      const Segment& sf = segment_[std::max(k, l)];
+      if (segmentsApart(se.middle, se.side, sf.middle, sf.side, reach)) continue;
+      if (segmentDistance2(at(e.x), at(e.y), at(f.x), at(f.y)) < reach2) ee.push_back(uvec4(e, f));
     }
   // A particle farther than the reach from a triangle's ball is farther from the triangle
   auto against = [&](uint32_t owner, uint32_t count, uint32_t other) {
@@ -114,9 +62,9 @@ void CpuContact::pairsOfTriangles(uint32_t t, uint32_t o, const std::vector<glm:
 
 // Particle v, which no triangle holds, against every triangle within `reach` of it.
 void CpuContact::searchLoner(uint32_t v, const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles,
-                             float reach, float inv_cell, std::vector<uvec4>& vf) const {
+                             float reach, std::vector<uvec4>& vf) const {
   const vec3 p = vec3(pos[v]);
-  visitBox(grid_, p - vec3(reach), p + vec3(reach), inv_cell, 0, [&](uint32_t t) {
+  tree_.visit(p - vec3(reach), p + vec3(reach), [&](uint32_t t) {
     const uvec4 tri = triangles[t];
     const vec3 a = vec3(pos[tri.x]), b = vec3(pos[tri.y]), c = vec3(pos[tri.z]);
     if (pointTriangleDistance2(p, a, b, c) < reach * reach) vf.push_back(uvec4(v, tri.x, tri.y, tri.z));
@@ -130,33 +78,33 @@ void CpuContact::buildLists(const std::vector<glm::vec4>& pos, const std::vector
   vf_.clear();
   ee_.clear();
   lists_ = false;
-  const float inv_cell = listCell(pos, reach);
-  if (!(inv_cell > 0.0f)) return;
-  // One search finds both kinds of pair: the triangles' boxes in the grid, each triangle against
-  // those after it whose boxes come within the reach. Each edge and each particle belongs to the
-  // first triangle that holds it (ownTriangles), and two triangles weigh the pairs of what they
-  // own: an edge-edge pair within the reach lies in two triangles within it, and a particle
-  // within the reach of a triangle lies in one; a pair of triangles is met once, so every pair is.
-  // Particles no triangle holds (torn free) look for their triangles on their own.
+  if (!searchable(pos)) return;
+  // One search finds both kinds of pair: the triangles' boxes in a tree, each pair of triangles
+  // whose boxes come within the reach met once. Each edge and each particle belongs to the first
+  // triangle that holds it (ownTriangles), and two triangles weigh the pairs of what they own: an
+  // edge-edge pair within the reach lies in two triangles within it, and a particle within the
+  // reach of a triangle lies in one; a pair of triangles is met once, so every pair is. Particles
+  // no triangle holds (torn free) look for their triangles on their own.
   boxTriangles(pos, triangles, count);
-  grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
+  tree_.fit(lo_, hi_, pool_);
+  const std::vector<BoxTree::Task> tasks = tree_.pairTasks(reach);
   auto all = [](uvec4) { return true; };
   std::mutex merge;
   pool_.parallelFor(
-      count, kGrainCollide,
+      uint32_t(tasks.size()), 1,
       [&](uint32_t begin, uint32_t end) {
         std::vector<uvec4> vf, ee;
-        for (uint32_t t = begin; t < end; ++t)
-          visitBox(grid_, lo_[t] - vec3(reach), hi_[t] + vec3(reach), inv_cell, t + 1,
-                   [&](uint32_t o) { pairsOfTriangles(t, o, pos, triangles, reach, all, vf, ee); });
+        for (uint32_t k = begin; k < end; ++k)
+          tree_.visitPairs(tasks[k], reach,
+                           [&](uint32_t t, uint32_t o) { pairsOfTriangles(t, o, pos, triangles, reach, all, vf, ee); });
         const std::lock_guard<std::mutex> lock(merge);
         vf_.insert(vf_.end(), vf.begin(), vf.end());
         ee_.insert(ee_.end(), ee.begin(), ee.end());
       },
       kSearchShares);
   for (uint32_t v = 0; v < n; ++v)
-    if (v >= owned_.size() || !owned_[v]) searchLoner(v, pos, triangles, reach, inv_cell, vf_);
-  // The same lists whatever the threads' order (visitBox meets each pair once)
+    if (v >= owned_.size() || !owned_[v]) searchLoner(v, pos, triangles, reach, vf_);
+  // The same lists whatever the threads' order (the tree meets each pair once)
   std::sort(vf_.begin(), vf_.end(), less4);
   std::sort(ee_.begin(), ee_.end(), less4);
   base_ = pos;
@@ -211,21 +159,18 @@ void CpuContact::boxTriangles(const std::vector<glm::vec4>& pos, const std::vect
     const vec3 m = (a + b + c) * (1.0f / 3.0f);
     ball_[t] = glm::vec4(m, std::sqrt(std::max({length2(a - m), length2(b - m), length2(c - m)})));
   }
+  segment_.resize(edges_.size());
+  for (size_t k = 0; k < edges_.size(); ++k) {
+    const vec3 a = vec3(pos[edges_[k].x]), b = vec3(pos[edges_[k].y]);
+    segment_[k] = {(a + b) * 0.5f, b - a};
+  }
 }
 
-float CpuContact::listCell(const std::vector<glm::vec4>& pos, float reach) const {
-  // Cells as wide as the reach and the mean edge, and at least an eighth of the longest edge, so
-  // that no box spans more than a few cells
-  double sum = 0.0;
-  float longest = 0.0f;
-  for (const uvec2 e : edges_) {
-    const float l = std::sqrt(length2(vec3(pos[e.y]) - vec3(pos[e.x])));
-    sum += double(l);
-    longest = std::max(longest, l);
-  }
-  const float mean = edges_.empty() ? 0.0f : float(sum / double(edges_.size()));
-  const float inv_cell = 1.0f / std::max(reach + mean, (reach + longest) * 0.125f);
-  return std::isfinite(inv_cell) && inv_cell > 0.0f && longest < 1e30f ? inv_cell : 0.0f;
+bool CpuContact::searchable(const std::vector<glm::vec4>& pos) const {
+  // Every edge's squared length finite, so that every box is
+  for (const uvec2 e : edges_)
+    if (!(length2(vec3(pos[e.y]) - vec3(pos[e.x])) <= std::numeric_limits<float>::max())) return false;
+  return true;
 }
 
 bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
@@ -244,13 +189,13 @@ bool CpuContact::repairLists(const std::vector<glm::vec4>& pos, const std::vecto
   // keep stays until one of its particles goes beyond T, when a repair drops it and looks again.
   const std::optional<vec3> middle = markMoved(pos, radius);
   if (!middle) return false;
-  const float reach = contactRepairReach(radius), inv_cell = listCell(pos, reach);
-  if (!(inv_cell > 0.0f)) return false;
+  const float reach = contactRepairReach(radius);
+  if (!searchable(pos)) return false;
   auto touched = [&](uvec4 q) { return (moved_[q.x] | moved_[q.y] | moved_[q.z] | moved_[q.w]) != 0; };
   vf_.erase(std::remove_if(vf_.begin(), vf_.end(), touched), vf_.end());
   ee_.erase(std::remove_if(ee_.begin(), ee_.end(), touched), ee_.end());
   std::vector<uvec4> added_vf, added_ee;
-  searchMoved(pos, triangles, count, reach, inv_cell, added_vf, added_ee);
+  searchMoved(pos, triangles, count, reach, added_vf, added_ee);
   // The same lists whatever the threads' order
   std::sort(added_vf.begin(), added_vf.end(), less4);
   std::sort(added_ee.begin(), added_ee.end(), less4);
@@ -292,13 +237,13 @@ std::optional<vec3> CpuContact::markMoved(const std::vector<glm::vec4>& pos, flo
 }
 
 void CpuContact::searchMoved(const std::vector<glm::vec4>& pos, const std::vector<uvec4>& triangles, uint32_t count,
-                             float reach, float inv_cell, std::vector<uvec4>& added_vf, std::vector<uvec4>& added_ee) {
+                             float reach, std::vector<uvec4>& added_vf, std::vector<uvec4>& added_ee) {
   // The pairs with a particle that moved, as buildLists finds them: each triangle that holds one
   // against every triangle near it (two such, from the first of them), what they own (only the
   // pairs with a particle that moved); the moved particles no triangle holds on their own
   auto touched = [&](uvec4 q) { return (moved_[q.x] | moved_[q.y] | moved_[q.z] | moved_[q.w]) != 0; };
   boxTriangles(pos, triangles, count);
-  grid_.build(lo_, hi_, inv_cell, pool_, grid_part_boxes_);
+  tree_.fit(lo_, hi_, pool_);
   dirty_.clear();
   for (uint32_t t = 0; t < count; ++t)
     if (touched(uvec4(triangles[t].x, triangles[t].y, triangles[t].z, triangles[t].x))) dirty_.push_back(t);
@@ -307,7 +252,7 @@ void CpuContact::searchMoved(const std::vector<glm::vec4>& pos, const std::vecto
     std::vector<uvec4> vf, ee;
     for (uint32_t k = begin; k < end; ++k) {
       const uint32_t t = dirty_[k];
-      visitBox(grid_, lo_[t] - vec3(reach), hi_[t] + vec3(reach), inv_cell, 0, [&](uint32_t o) {
+      tree_.visit(lo_[t] - vec3(reach), hi_[t] + vec3(reach), [&](uint32_t o) {
         const uvec4 other = triangles[o];
         if (o == t || (o < t && touched(uvec4(other.x, other.y, other.z, other.x)))) return;
         pairsOfTriangles(t, o, pos, triangles, reach, touched, vf, ee);
@@ -318,7 +263,7 @@ void CpuContact::searchMoved(const std::vector<glm::vec4>& pos, const std::vecto
     added_ee.insert(added_ee.end(), ee.begin(), ee.end());
   });
   for (uint32_t v = 0; v < uint32_t(pos.size()); ++v)
-    if (moved_[v] && (v >= owned_.size() || !owned_[v])) searchLoner(v, pos, triangles, reach, inv_cell, added_vf);
+    if (moved_[v] && (v >= owned_.size() || !owned_[v])) searchLoner(v, pos, triangles, reach, added_vf);
 }
 
 } // namespace tender

@@ -1,7 +1,6 @@
 #pragma once
-/// The searches of the CPU contact's pair lists (cpu_contact_lists.cpp) and crossing check
-/// (cpu_contact.cpp): the grid's cells, a walk over the entries whose boxes meet a box, each once,
-/// and the separating axes that part most neighbours before their exact distance.
+/// The tests of the CPU contact's pair lists (cpu_contact_lists.cpp) and crossing check
+/// (cpu_contact.cpp): the separating axes that part most neighbours before their exact distance.
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -13,47 +12,7 @@
 namespace tender::contact_search {
 
 using shaderio::dot3;
-using shaderio::hashCell;
 using shaderio::orderedFloat;
-
-/// The cell of the contact grids that holds p: floor(p x inv_cell), clamped, with a floor of
-/// integer conversions (floorf is a call without SSE 4.1). Any cell function that rises with its
-/// point would do: which cells hold a box decides where the search looks, not what it finds.
-inline int gridCoordinate(float x) {
-  constexpr float kMost = 536870912.0f;
-  x = x > -kMost ? (x < kMost ? x : kMost) : -kMost; // NaN to the lowest
-  const int i = int(x);
-  return i - (x < float(i) ? 1 : 0);
-}
-inline ivec3 gridCell(vec3 p, float inv_cell) {
-  return ivec3(gridCoordinate(p.x * inv_cell), gridCoordinate(p.y * inv_cell), gridCoordinate(p.z * inv_cell));
-}
-
-/// Calls f(entry) once for each entry of `grid` from `first` on whose box overlaps the box [lo,
-/// hi]: in the cell that holds the lowest corner of the two boxes' overlap (both boxes are in that
-/// cell; a bucket holds an entry once, so no entry is met twice). That cell is the larger of the
-/// two lowest corners' cells, component by component (gridCell rises with its point). A bucket's
-/// entries rise (Grid::build), so it is read from its end down to `first`.
-template <typename Grid, typename F>
-void visitBox(const Grid& grid, vec3 lo, vec3 hi, float inv_cell, uint32_t first, F&& f) {
-  const ivec3 a = gridCell(lo, inv_cell), b = gridCell(hi, inv_cell);
-  for (int z = a.z; z <= b.z; ++z)
-    for (int y = a.y; y <= b.y; ++y)
-      for (int x = a.x; x <= b.x; ++x) {
-        const ivec3 cell(x, y, z);
-        const uint32_t h = hashCell(cell, grid.mask);
-        for (uint32_t k = grid.start[h + 1]; k-- > grid.start[h];) {
-          const auto& slot = grid.entry[k];
-          if (slot.id < first) break;
-          const vec3 elo = slot.lo, ehi = slot.hi;
-          // Without branches between the axes: most entries part on one, which one is a coin toss
-          const bool meet =
-              (lo.x <= ehi.x) & (elo.x <= hi.x) & (lo.y <= ehi.y) & (elo.y <= hi.y) & (lo.z <= ehi.z) & (elo.z <= hi.z);
-          if (!meet) continue;
-          if (glm::max(a, slot.cell) == cell) f(slot.id);
-        }
-      }
-}
 
 inline float length2(glm::vec3 a) { return dot3(a, a); }
 

@@ -1,0 +1,141 @@
+#pragma once
+/// A tree of boxes (a bounding volume hierarchy) for the CPU contact's searches. A build splits a
+/// node's boxes in two halves at the median of their centres along the widest side of the
+/// centres' box, down to leaves of at most kLeaf boxes; later searches keep those groups and fit
+/// their boxes anew (fit). A search descends only into the nodes whose boxes meet what it looks
+/// for, so what it finds is the same whatever the groups: the boxes that meet a box (visit), or
+/// every pair of boxes within a reach of each other on each axis, met once (pairTasks, then
+/// visitPairs for each task, from any thread).
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace tender {
+
+class WorkerPool;
+
+class BoxTree {
+public:
+  /// A share of the pair search: the pairs within node `a` (a == b) or between nodes a and b.
+  using Task = glm::uvec2;
+
+  /// The tree of boxes [lo[i], hi[i]]; with the pool's threads below its first levels.
+  void build(const std::vector<glm::vec3>& lo, const std::vector<glm::vec3>& hi, WorkerPool& pool);
+  /// The tree of boxes [lo[i], hi[i]] in the last build's groups, their boxes fitted anew (built
+  /// when the count of boxes changed). The groups need not be good for the searches to be right;
+  /// they stay good while each moves as one, as a sheet's patches do while its edges barely stretch.
+  void fit(const std::vector<glm::vec3>& lo, const std::vector<glm::vec3>& hi, WorkerPool& pool);
+  /// Forgets the groups: the next fit builds.
+  void clear() {
+    node_.clear();
+    id_.clear();
+  }
+
+  /// Calls f(i) for each box i that meets [lo, hi].
+  template <class F>
+  void visit(glm::vec3 lo, glm::vec3 hi, F&& f) const {
+    if (node_.empty()) return;
+    uint32_t stack[64], top = 0;
+    stack[top++] = 0;
+    while (top) {
+      const uint32_t k = stack[--top];
+      const Node& n = node_[k];
+      if (!meet(lo, hi, n.lo, n.hi, 0.0f)) continue;
+      if (leaf(n)) {
+        for (uint32_t e = n.begin; e < n.end; ++e)
+          if (meet(lo, hi, lo_[e], hi_[e], 0.0f)) f(id_[e]);
+        continue;
+      }
+      stack[top++] = k + 1;
+      stack[top++] = right_[k];
+    }
+  }
+
+  /// Shares of the search for every pair of boxes within `reach` of each other (each in one of
+  /// them), of at most about kTaskBoxes boxes each.
+  std::vector<Task> pairTasks(float reach) const;
+
+  /// Calls f(i, j) for each pair of boxes of `task` within `reach` of each other on each axis
+  /// (i and j in no fixed order; over all the tasks of pairTasks, each pair once).
+  template <class F>
+  void visitPairs(Task task, float reach, F&& f) const {
+    pairs(task.x, task.y, reach, f);
+  }
+
+  /// The bytes its arrays hold.
+  uint64_t memoryBytes() const {
+    return node_.capacity() * sizeof(Node) + (right_.capacity() + id_.capacity()) * sizeof(uint32_t) +
+           (lo_.capacity() + hi_.capacity() + centre_.capacity()) * sizeof(glm::vec3);
+  }
+
+private:
+  struct Node {
+    glm::vec3 lo;
+    uint32_t begin; ///< its boxes: the entries [begin, end) of lo_, hi_ and id_
+    glm::vec3 hi;
+    uint32_t end;
+  };
+  /// The most boxes a leaf holds, and about the most a task of pairTasks does
+  static constexpr uint32_t kLeaf = 4, kTaskBoxes = 512;
+
+  static bool leaf(const Node& n) { return n.end - n.begin <= kLeaf; }
+  /// True when the boxes [alo, ahi] and [blo, bhi] come within `reach` of each other on each axis.
+  static bool meet(glm::vec3 alo, glm::vec3 ahi, glm::vec3 blo, glm::vec3 bhi, float reach) {
+    return (alo.x - reach <= bhi.x) & (blo.x <= ahi.x + reach) & (alo.y - reach <= bhi.y) & (blo.y <= ahi.y + reach) &
+           (alo.z - reach <= bhi.z) & (blo.z <= ahi.z + reach);
+  }
+  /// The nodes of a subtree of `boxes` boxes.
+  static uint32_t nodeCount(uint32_t boxes) {
+    return boxes <= kLeaf ? 1u : 1u + nodeCount(boxes / 2) + nodeCount(boxes - boxes / 2);
+  }
+  /// Sets node k to the entries [begin, end) and its second child, and splits them in two halves
+  /// there (id_ reordered); gives where the second begins.
+  uint32_t split(uint32_t k, uint32_t begin, uint32_t end);
+  /// Builds node k over the entries [begin, end) (id_ set, in any order).
+  void buildNode(uint32_t k, uint32_t begin, uint32_t end, const std::vector<glm::vec3>& lo,
+                 const std::vector<glm::vec3>& hi);
+  /// The node's box from its children's, or its leaf's boxes'.
+  void fitNode(uint32_t k);
+  void gather(uint32_t a, uint32_t b, float reach, std::vector<Task>& tasks) const;
+
+  template <class F>
+  void pairs(uint32_t a, uint32_t b, float reach, F& f) const {
+    const Node& na = node_[a];
+    if (a == b) {
+      if (leaf(na)) {
+        for (uint32_t i = na.begin; i < na.end; ++i)
+          for (uint32_t j = i + 1; j < na.end; ++j)
+            if (meet(lo_[i], hi_[i], lo_[j], hi_[j], reach)) f(id_[i], id_[j]);
+        return;
+      }
+      pairs(a + 1, a + 1, reach, f);
+      pairs(right_[a], right_[a], reach, f);
+      pairs(a + 1, right_[a], reach, f);
+      return;
+    }
+    const Node& nb = node_[b];
+    if (!meet(na.lo, na.hi, nb.lo, nb.hi, reach)) return;
+    if (leaf(na) && leaf(nb)) {
+      for (uint32_t i = na.begin; i < na.end; ++i) {
+        if (!meet(lo_[i], hi_[i], nb.lo, nb.hi, reach)) continue;
+        for (uint32_t j = nb.begin; j < nb.end; ++j)
+          if (meet(lo_[i], hi_[i], lo_[j], hi_[j], reach)) f(id_[i], id_[j]);
+      }
+    } else if (leaf(nb) || (!leaf(na) && na.end - na.begin >= nb.end - nb.begin)) {
+      pairs(a + 1, b, reach, f);
+      pairs(right_[a], b, reach, f);
+    } else {
+      pairs(a, b + 1, reach, f);
+      pairs(a, right_[b], reach, f);
+    }
+  }
+
+  std::vector<Node> node_;         ///< depth first: node k's children are k + 1 and right_[k]
+  std::vector<uint32_t> right_;    ///< each inner node's second child
+  std::vector<uint32_t> id_;       ///< the boxes in the leaves' order
+  std::vector<glm::vec3> lo_, hi_; ///< their corners, in that order
+  std::vector<glm::vec3> centre_;  ///< scratch: each box's centre (twice it), by its number
+};
+
+} // namespace tender
