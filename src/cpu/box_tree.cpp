@@ -130,17 +130,7 @@ void BoxTree::gather(uint32_t a, uint32_t b, float reach, std::vector<Task>& tas
     tasks.push_back(Task(a, b));
     return;
   }
-  if (a == b) {
-    gather(a + 1, a + 1, reach, tasks);
-    gather(right_[a], right_[a], reach, tasks);
-    gather(a + 1, right_[a], reach, tasks);
-  } else if (leaf(nb) || (!leaf(na) && na.end - na.begin >= nb.end - nb.begin)) {
-    gather(a + 1, b, reach, tasks);
-    gather(right_[a], b, reach, tasks);
-  } else {
-    gather(a, b + 1, reach, tasks);
-    gather(a, right_[b], reach, tasks);
-  }
+  halves(a, b, [&](uint32_t c, uint32_t d) { gather(c, d, reach, tasks); });
 }
 
 } // namespace tender

@@ -97,37 +97,38 @@ private:
                  const std::vector<glm::vec3>& hi);
   /// The node's box from its children's, or its leaf's boxes'.
   void fitNode(uint32_t k);
+  /// The tasks of pairTasks for the pair of nodes (a, b), or for node a alone (a == b).
   void gather(uint32_t a, uint32_t b, float reach, std::vector<Task>& tasks) const;
+
+  /// Calls go(c, d) for each pair of nodes that the pair (a, b) of nodes, not both leaves, splits
+  /// into: a's halves, each alone and with the other (a == b), else the larger node's halves with
+  /// the other node.
+  template <class Go>
+  void halves(uint32_t a, uint32_t b, Go&& go) const {
+    const Node &na = node_[a], &nb = node_[b];
+    if (a == b) {
+      go(a + 1, a + 1);
+      go(right_[a], right_[a]);
+      go(a + 1, right_[a]);
+    } else if (leaf(nb) || (!leaf(na) && na.end - na.begin >= nb.end - nb.begin)) {
+      go(a + 1, b);
+      go(right_[a], b);
+    } else {
+      go(a, b + 1);
+      go(a, right_[b]);
+    }
+  }
 
   template <class F>
   void pairs(uint32_t a, uint32_t b, float reach, F& f) const {
-    const Node& na = node_[a];
-    if (a == b) {
-      if (leaf(na)) {
-        for (uint32_t i = na.begin; i < na.end; ++i)
-          for (uint32_t j = i + 1; j < na.end; ++j)
-            if (meet(lo_[i], hi_[i], lo_[j], hi_[j], reach)) f(id_[i], id_[j]);
-        return;
-      }
-      pairs(a + 1, a + 1, reach, f);
-      pairs(right_[a], right_[a], reach, f);
-      pairs(a + 1, right_[a], reach, f);
-      return;
-    }
-    const Node& nb = node_[b];
-    if (!meet(na.lo, na.hi, nb.lo, nb.hi, reach)) return;
-    if (leaf(na) && leaf(nb)) {
-      for (uint32_t i = na.begin; i < na.end; ++i) {
-        if (!meet(lo_[i], hi_[i], nb.lo, nb.hi, reach)) continue;
-        for (uint32_t j = nb.begin; j < nb.end; ++j)
-          if (meet(lo_[i], hi_[i], lo_[j], hi_[j], reach)) f(id_[i], id_[j]);
-      }
-    } else if (leaf(nb) || (!leaf(na) && na.end - na.begin >= nb.end - nb.begin)) {
-      pairs(a + 1, b, reach, f);
-      pairs(right_[a], b, reach, f);
-    } else {
-      pairs(a, b + 1, reach, f);
-      pairs(a, right_[b], reach, f);
+    const Node &na = node_[a], &nb = node_[b];
+    if (a != b && !meet(na.lo, na.hi, nb.lo, nb.hi, reach)) return;
+    if (!leaf(na) || !leaf(nb)) return halves(a, b, [&](uint32_t c, uint32_t d) { pairs(c, d, reach, f); });
+    // A leaf with itself (each pair once) or with another leaf
+    for (uint32_t i = na.begin; i < na.end; ++i) {
+      if (a != b && !meet(lo_[i], hi_[i], nb.lo, nb.hi, reach)) continue;
+      for (uint32_t j = a == b ? i + 1 : nb.begin; j < nb.end; ++j)
+        if (meet(lo_[i], hi_[i], lo_[j], hi_[j], reach)) f(id_[i], id_[j]);
     }
   }
 

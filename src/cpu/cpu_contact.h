@@ -86,8 +86,8 @@ public:
   uint64_t memoryBytes() const;
 
 private:
-  /// Shares a worker takes of a list build's searches: a crumpled part of the sheet costs more than
-  /// a flat one, and a triangle looks only at the triangles after it, so the first cost the most
+  /// Shares a worker takes of a list build's search tasks (BoxTree::pairTasks): a crumpled part of
+  /// the sheet costs more than a flat one
   static constexpr uint32_t kSearchShares = 8;
 
   /// Calls visit(pair, NearestPoints, edge, j, SlideHalf) for each half-space the pairs closer than
