@@ -138,8 +138,7 @@ void CpuContact::keepLists(const std::vector<glm::vec4>& pos, const std::vector<
   // (while they hold no more than twice the pairs of the last build and an eighth of the particles:
   // a repair lists its particles' pairs from farther, contactRepairReach, and they stay until a
   // build; on a flat sheet that is every particle's nearest diagonal)
-  const bool repairable = usable && lists_kept_ == Lists::Repaired && finite &&
-                          vf_.size() + ee_.size() <= 2 * built_pairs_ + n / kRepairShare;
+  const bool repairable = usable && finite && vf_.size() + ee_.size() <= 2 * built_pairs_ + n / kRepairShare;
   if (!fresh && !(repairable && repairLists(pos, triangles, count, radius))) buildLists(pos, triangles, count, radius);
 }
 

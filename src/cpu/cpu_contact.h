@@ -25,11 +25,11 @@ class WorkerPool;
 
 class CpuContact {
 public:
-  /// How the pair lists are kept; the bounds and pushes are the same bits every way.
+  /// How the pair lists are kept; the bounds and pushes are the same bits either way.
   enum class Lists {
-    Rebuilt, ///< built whole at every call
-    Kept,    ///< kept while they hold every pair that can touch (the travels, turned, clusters), then built whole
-    Repaired ///< kept so, else repaired where a few particles travelled too far, else built whole
+    Rebuilt, ///< built whole at every call (the tests' reference)
+    Repaired ///< kept while they hold every pair that can touch (the travels, turned, clusters), else
+             ///< repaired where a few particles travelled too far, else built whole
   };
   CpuContact(WorkerPool& pool, Lists lists) : pool_(pool), lists_kept_(lists) {}
 

@@ -32,9 +32,6 @@ struct CpuOptions {
   /// whose particles have not travelled too far since the lists were built sums its repulsion
   /// from them instead of building the hash. The results are the same either way.
   bool candidate_lists = true;
-  /// Repair the contact's pair lists where a few particles travelled too far (CpuContact: their
-  /// pairs looked for again) instead of building them whole. The results are the same either way.
-  bool contact_repairs = true;
   /// Run the SIMD kernels (simd_kernels.h: SSE, and AVX where the CPU has it) for the projection,
   /// the tear test and the collision gather; off runs the scalar reference alone. The results are
   /// bitwise the same either way.
