@@ -10,16 +10,29 @@ namespace tender {
 
 using glm::vec3;
 
+template <class F>
+void BoxTree::eachPart(WorkerPool& pool, F&& f) const {
+  const uint32_t parts = uint32_t(parts_.size());
+  if (id_.size() >= shared_boxes_)
+    pool.run(parts, f);
+  else
+    for (uint32_t c = 0; c < parts; ++c) f(c);
+}
+
 void BoxTree::fit(const std::vector<vec3>& lo, const std::vector<vec3>& hi, WorkerPool& pool) {
   const uint32_t n = uint32_t(lo.size());
   if (n != id_.size() || node_.empty()) return build(lo, hi, pool);
-  // The same groups, their boxes anew: the leaves' in their order, then each node's from its
-  // children's, the deepest first (a child comes after its parent)
-  for (uint32_t e = 0; e < n; ++e) {
-    lo_[e] = lo[id_[e]];
-    hi_[e] = hi[id_[e]];
-  }
-  for (uint32_t k = uint32_t(node_.size()); k-- > 0;) fitNode(k);
+  // The same groups, their boxes anew: each part's leaves' in their order, then each node's from
+  // its children's, the deepest first (a subtree's nodes follow its root); then the nodes above
+  eachPart(pool, [&](uint32_t c) {
+    const Part p = parts_[c];
+    for (uint32_t e = p.begin; e < p.end; ++e) {
+      lo_[e] = lo[id_[e]];
+      hi_[e] = hi[id_[e]];
+    }
+    for (uint32_t k = p.nodes; k-- > p.node;) fitNode(k);
+  });
+  for (auto k = above_.rbegin(); k != above_.rend(); ++k) fitNode(*k);
 }
 
 void BoxTree::build(const std::vector<vec3>& lo, const std::vector<vec3>& hi, WorkerPool& pool) {
@@ -38,28 +51,27 @@ void BoxTree::build(const std::vector<vec3>& lo, const std::vector<vec3>& hi, Wo
   hi_.resize(n);
   // The first two levels here, then their four subtrees (each a range of nodes and entries that
   // nodeCount fixes) from the pool's threads; the tree is the same whatever the thread count
-  struct Part {
-    uint32_t node, begin, end;
-  };
-  std::vector<Part> parts{{0, 0, n}}, next;
-  std::vector<uint32_t> above;
+  parts_.assign(1, Part{0, 0, n, 0});
+  above_.clear();
+  std::vector<Part> next;
   for (int level = 0; level < 2; ++level) {
     next.clear();
-    for (const Part p : parts) {
+    for (const Part p : parts_) {
       if (p.end - p.begin <= kLeaf) {
         next.push_back(p);
         continue;
       }
       const uint32_t mid = split(p.node, p.begin, p.end);
-      above.push_back(p.node);
-      next.push_back({p.node + 1, p.begin, mid});
-      next.push_back({right_[p.node], mid, p.end});
+      above_.push_back(p.node);
+      next.push_back({p.node + 1, p.begin, mid, 0});
+      next.push_back({right_[p.node], mid, p.end, 0});
     }
-    parts.swap(next);
+    parts_.swap(next);
   }
-  pool.run(uint32_t(parts.size()), [&](uint32_t c) { buildNode(parts[c].node, parts[c].begin, parts[c].end, lo, hi); });
+  for (Part& p : parts_) p.nodes = p.node + nodeCount(p.end - p.begin);
+  eachPart(pool, [&](uint32_t c) { buildNode(parts_[c].node, parts_[c].begin, parts_[c].end, lo, hi); });
   // The nodes above them from their children's boxes, the deepest first
-  for (auto k = above.rbegin(); k != above.rend(); ++k) fitNode(*k);
+  for (auto k = above_.rbegin(); k != above_.rend(); ++k) fitNode(*k);
 }
 
 uint32_t BoxTree::split(uint32_t k, uint32_t begin, uint32_t end) {

@@ -20,7 +20,10 @@ public:
   /// A share of the pair search: the pairs within node `a` (a == b) or between nodes a and b.
   using Task = glm::uvec2;
 
-  /// The tree of boxes [lo[i], hi[i]]; with the pool's threads below its first levels.
+  /// `min_chunk`: CpuOptions::min_chunk (1 builds and fits every tree from the pool's threads).
+  explicit BoxTree(uint32_t min_chunk = 0) : shared_boxes_(min_chunk ? min_chunk : kSharedBoxes) {}
+
+  /// The tree of boxes [lo[i], hi[i]]; with the pool's threads below its first two levels.
   void build(const std::vector<glm::vec3>& lo, const std::vector<glm::vec3>& hi, WorkerPool& pool);
   /// The tree of boxes [lo[i], hi[i]] in the last build's groups, their boxes fitted anew (built
   /// when the count of boxes changed). The groups need not be good for the searches to be right;
@@ -65,7 +68,8 @@ public:
 
   /// The bytes its arrays hold.
   uint64_t memoryBytes() const {
-    return node_.capacity() * sizeof(Node) + (right_.capacity() + id_.capacity()) * sizeof(uint32_t) +
+    return node_.capacity() * sizeof(Node) + parts_.capacity() * sizeof(Part) +
+           (right_.capacity() + id_.capacity() + above_.capacity()) * sizeof(uint32_t) +
            (lo_.capacity() + hi_.capacity() + centre_.capacity()) * sizeof(glm::vec3);
   }
 
@@ -78,6 +82,13 @@ private:
   };
   /// The most boxes a leaf holds, and about the most a task of pairTasks does
   static constexpr uint32_t kLeaf = 4, kTaskBoxes = 512;
+  /// The fewest boxes whose subtrees the pool's threads build and fit (below, a fit takes tens of
+  /// microseconds, about what handing it out costs)
+  static constexpr uint32_t kSharedBoxes = 16384;
+  /// Calls f(c) for each part c: from the pool's threads on a tree of shared_boxes_ boxes or
+  /// more, else on the caller.
+  template <class F>
+  void eachPart(WorkerPool& pool, F&& f) const;
 
   static bool leaf(const Node& n) { return n.end - n.begin <= kLeaf; }
   /// True when the boxes [alo, ahi] and [blo, bhi] come within `reach` of each other on each axis.
@@ -132,6 +143,14 @@ private:
     }
   }
 
+  /// A subtree below the first two levels: its root, its entries [begin, end), and the end of its
+  /// nodes [node, nodes) (set once it is split off)
+  struct Part {
+    uint32_t node, begin, end, nodes = 0;
+  };
+  uint32_t shared_boxes_;
+  std::vector<Part> parts_;        ///< the subtrees the pool's threads build and fit, one each
+  std::vector<uint32_t> above_;    ///< the nodes above them, each before its children
   std::vector<Node> node_;         ///< depth first: node k's children are k + 1 and right_[k]
   std::vector<uint32_t> right_;    ///< each inner node's second child
   std::vector<uint32_t> id_;       ///< the boxes in the leaves' order

@@ -31,7 +31,9 @@ public:
     Repaired ///< kept while they hold every pair that can touch (the travels, turned, clusters), else
              ///< repaired where a few particles travelled too far, else built whole
   };
-  CpuContact(WorkerPool& pool, Lists lists) : pool_(pool), lists_kept_(lists) {}
+  /// `min_chunk`: CpuOptions::min_chunk (1 splits every search tree's build among the threads).
+  CpuContact(WorkerPool& pool, Lists lists, uint32_t min_chunk = 0)
+      : pool_(pool), lists_kept_(lists), tree_(min_chunk) {}
 
   /// The step bound of each particle at `pos` (xyz; w inverse mass; `prev` where each was a
   /// substep before) in substep `s`, of the sheet made of the first `count` triangles of

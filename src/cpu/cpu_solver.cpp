@@ -17,7 +17,8 @@ using namespace shaderio;
 CpuSolver::CpuSolver(CpuOptions options)
     : options_(options), simd_(options.simd && simd::kBuilt),
       pool_(std::make_unique<WorkerPool>(options.threads, true)),
-      collision_(*pool_, options.simd, options.candidate_lists), contact_(*pool_, CpuContact::Lists::Repaired) {}
+      collision_(*pool_, options.simd, options.candidate_lists),
+      contact_(*pool_, CpuContact::Lists::Repaired, options.min_chunk) {}
 
 // The constraints of each colour, reordered by their first particle, into one array per field
 // (the SIMD kernels load them four or eight at a time). Constraints of one colour share no
