@@ -11,11 +11,13 @@
 // Workgroup size for tear marking and compaction (one thread per constraint or triangle)
 #define SIM_WG_TEAR 64
 // Workgroup size of the stretch limit: one workgroup a sheet walks its rings (limit.comp;
-// specialization constant 0). On a CPU device few invocations, as it pays for each at every
-// barrier; on a GPU as many as a ring of a 1024-wide sheet has slots (limitSlots: 2 x the shorter
-// side), so that a ring is one round of loads and stores: with 64, each of a 512 x 768 sheet's 16
-// rounds a ring waits on device memory (an H100: 395 ms a tick of the crumple preset)
-#define SIM_WG_LIMIT 64
+// specialization constant 0). On a CPU device one subgroup (lavapipe's: 8 lanes of AVX2), as it
+// runs each further subgroup of a workgroup as a coroutine that every barrier switches through
+// (with 64, the rings were a third of the project passes' time on lavapipe); on a GPU as many as a
+// ring of a 1024-wide sheet has slots (limitSlots: 2 x the shorter side), so that a ring is one
+// round of loads and stores: with 64, each of a 512 x 768 sheet's 16 rounds a ring waits on device
+// memory (an H100: 395 ms a tick of the crumple preset)
+#define SIM_WG_LIMIT 8
 #define SIM_WG_LIMIT_GPU 1024
 // Loop iterations one invocation of the stretch limit runs in a dispatch at most (rings, and the
 // slots of each): lavapipe ends every loop of a shader after 65535 in all (LP_MAX_TGSI_LOOP_ITERATIONS,
