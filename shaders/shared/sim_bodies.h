@@ -28,20 +28,31 @@ SIM_INLINE void projectHinge(uint k) {
   SIM_POSITION(q.w) = pb + vec4(d.db, 0.0f);
 }
 
-/// Projects constraint c in iteration `iteration` of the substep (one colour's constraints share
-/// no particle, so no races): a hinge by projectHinge, any other both ends by solveDistance,
-/// weighted by inverse mass.
-SIM_INLINE void projectConstraint(Constraint c, uint iteration) {
-  if (!projectsInIteration(c.kind_id, iteration)) return;
-  if ((c.kind_id & SIM_KIND_MASK) == SIM_KIND_HINGE) {
-    HingeRange hinge = u.hinge;
-    projectHinge((c.kind_id >> SIM_KIND_BITS) - hinge.first);
-    return;
-  }
+/// Projects distance constraint c (not a hinge): both ends by solveDistance, weighted by inverse
+/// mass.
+SIM_INLINE void projectDistance(Constraint c) {
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b); // a != b: each end is read once
   PairDelta d = solveDistance(pa, pb, c.rest, u.stiffness[c.kind_id & SIM_KIND_MASK]);
   SIM_POSITION(c.a) = pa + vec4(d.da, 0.0f);
   SIM_POSITION(c.b) = pb + vec4(d.db, 0.0f);
+}
+
+/// Projects hinge constraint c by projectHinge.
+SIM_INLINE void projectHingeConstraint(Constraint c) {
+  HingeRange hinge = u.hinge;
+  projectHinge((c.kind_id >> SIM_KIND_BITS) - hinge.first);
+}
+
+/// Projects constraint c in iteration `iteration` of the substep (one colour's constraints share
+/// no particle, so no races), when it projects in that iteration: a hinge by
+/// projectHingeConstraint, any other by projectDistance. (A colour is one kind, so the per-colour
+/// passes run one of the two in a kernel of its own.)
+SIM_INLINE void projectConstraint(Constraint c, uint iteration) {
+  if (!projectsInIteration(c.kind_id, iteration)) return;
+  if ((c.kind_id & SIM_KIND_MASK) == SIM_KIND_HINGE)
+    projectHingeConstraint(c);
+  else
+    projectDistance(c);
 }
 
 /// The crease of hinge k at the end of the substep, where the sheet went (creaseReturn), unless it is torn or

@@ -49,6 +49,7 @@
   X(candidates_finish, SIM, 1, 1)                                                                                      \
   X(repel, SIM, 1, 1)                                                                                                  \
   X(project, SIM, 1, 1)                                                                                                \
+  X(project_hinge, SIM, 1, 1)                                                                                          \
   X(shorten, SIM, 1, 1)                                                                                                \
   X(limit, SIM, 1, 1)                                                                                                  \
   X(crease, SIM, 1, 1)                                                                                                 \
@@ -113,7 +114,8 @@
 // X(stage, kernel, elements, grid, when, category)
 //   stage     its row in SIM_STAGES
 //   kernel    its row in SIM_KERNELS (scan: a scan of several blocks adds scan and scan_add)
-//   elements  what it covers and its push constants: PARTICLES, COLOUR (the stage's colour),
+//   elements  what it covers and its push constants: PARTICLES, COLOUR (the stage's colour, unless
+//             it holds hinges), HINGE_COLOUR (the stage's colour when it holds hinges),
 //             HINGES, CONSTRAINTS, ONE (one invocation), HASH_ARGS (one invocation, the hash's
 //             arguments), RINGS (one workgroup a sheet, a dispatch for each limitRingsPerDispatch
 //             rings of the stretch limit), HASH_CELLS and TEAR_SLOTS (a scan of the hash's cells or of the
@@ -166,6 +168,7 @@
   X(collide, candidates_finish, ONE, Threads, ALWAYS, Collide)                                                         \
   X(collide, repel, PARTICLES, Threads, ALWAYS, Collide)                                                               \
   X(project, project, COLOUR, Threads, ALWAYS, Project)                                                                \
+  X(project, project_hinge, HINGE_COLOUR, Threads, ALWAYS, Project)                                                    \
   X(shorten, shorten, COLOUR, Threads, ALWAYS, Project)                                                                \
   X(limit, limit, RINGS, Threads, ALWAYS, Project)                                                                     \
   X(floor, floor, PARTICLES, Threads, ALWAYS, Floor)                                                                   \

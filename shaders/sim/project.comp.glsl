@@ -1,6 +1,6 @@
 #version 460
-// Projects the live constraints of one colour (no two share a particle, so no races) in iteration
-// p.first of the substep.
+// Projects the live distance constraints of one colour (no two share a particle, so no races) in
+// iteration p.first of the substep; project_hinge takes the hinge colours.
 // Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
 #define SIM_LOCAL_SIZE SIM_WG_PROJECT
 #define SIM_PUSH_TYPE SimPush
@@ -11,5 +11,5 @@ void main() {
   uint t = threadIndex();
   uvec2 range = color_range[p.color];
   if (t >= range.y) return; // beyond the live count of this colour
-  projectConstraint(constraints[range.x + t], p.first);
+  projectDistance(constraints[range.x + t]);
 }

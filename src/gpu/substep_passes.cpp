@@ -88,6 +88,7 @@ namespace {
 enum class Elements : uint8_t {
   PARTICLES,
   COLOUR,
+  HINGE_COLOUR,
   HINGES,
   CONSTRAINTS,
   ONE,
@@ -154,7 +155,7 @@ constexpr uint32_t liveGate(const Dispatch& d) {
   case Grid::Sweep:
     return SIM_LIVE_SWEEP;
   default:
-    return d.elements == Elements::COLOUR ? SIM_LIVE_ITERATION : SIM_LIVE_NONE;
+    return d.elements == Elements::COLOUR || d.elements == Elements::HINGE_COLOUR ? SIM_LIVE_ITERATION : SIM_LIVE_NONE;
   }
 }
 static_assert(std::is_sorted(std::begin(kDispatches), std::end(kDispatches),
@@ -244,6 +245,8 @@ bool recordColour(PassSink& sink, const ComputePipeline& p, const SheetTopology&
   const ColorRange& range = topo.colors[c];
   if (range.count == 0) return false;
   const uint32_t kind = topo.constraints[range.first].kind_id;
+  // A colour is one kind: its hinges' row or the other row records it
+  if (((kind & SIM_KIND_MASK) == SIM_KIND_HINGE) != (d.elements == Elements::HINGE_COLOUR)) return false;
   if (d.stage == SIM_STAGE_shorten ? !shortensColour(kind) : !projectsInIteration(kind, iteration)) return false;
   gate.arg = iteration;
   record(sink, p, d.grid, range.count, SimPush{iteration, range.count, s, c}, s, gate);
@@ -267,6 +270,7 @@ void recordDispatch(PassSink& sink, const SimPipelines& pipes, const SheetTopolo
   }
   switch (d.elements) {
   case Elements::COLOUR:
+  case Elements::HINGE_COLOUR:
     if (!recordColour(sink, p, topo, d, s, k, gate)) return;
     break;
   case Elements::ONE:

@@ -102,17 +102,20 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
                         "collide", "candidates_finish", "repel"})
     expected.push_back(k);
   std::vector<uint32_t> iterations;
-  // Every colour with constraints in the first iteration; in the second, all but the hinges'
+  // Every colour with constraints in the first iteration; in the second, all but the hinges'. A
+  // hinge colour has a kernel of its own.
   uint32_t hinge_colors = 0;
   for (const ColorRange& range : topo.colors)
     hinge_colors += range.count > 0 && constraintKind(topo.constraints[range.first]) == SIM_KIND_HINGE ? 1 : 0;
   EXPECT_GT(hinge_colors, 0u);
   for (uint32_t it = 0; it < 2; ++it)
-    for (const ColorRange& range : topo.colors)
-      if (range.count > 0 && (it == 0 || constraintKind(topo.constraints[range.first]) != SIM_KIND_HINGE)) {
-        expected.push_back("project");
+    for (const ColorRange& range : topo.colors) {
+      const bool hinges = constraintKind(topo.constraints[range.first]) == SIM_KIND_HINGE;
+      if (range.count > 0 && (it == 0 || !hinges)) {
+        expected.push_back(hinges ? "project_hinge" : "project");
         iterations.push_back(it);
       }
+    }
   // The shorten stage: in each iteration every colour that holds edges (they come first)
   std::vector<uint32_t> shorten_iterations;
   for (uint32_t it = 0; it < 2; ++it)
@@ -138,7 +141,7 @@ TEST(SubstepPasses, RecordsTheStagesInOrderWithATimestampPerCategory) {
   for (const char* k : {"tear_mark", "tear_unsupported", "tear_flags", "scan", "tear_compact"}) expected.push_back(k);
   EXPECT_EQ(kernels(sink.passes), expected);
   for (size_t k = 0, project = 0, shorten = 0; k < sink.passes.size(); ++k)
-    if (sink.passes[k].kernel == "project") {
+    if (sink.passes[k].kernel == "project" || sink.passes[k].kernel == "project_hinge") {
       EXPECT_EQ(sink.passes[k].gate.when, SIM_WHEN_ALWAYS);
       EXPECT_EQ(sink.passes[k].gate.live, SIM_LIVE_ITERATION);
       EXPECT_EQ(sink.passes[k].gate.arg, iterations[project++]);
@@ -176,7 +179,7 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
       return "air";
     case PassKind::integrate:
       return "integrate";
-    case PassKind::project:
+    case PassKind::project: // a hinge colour's: project_hinge
       return "project";
     case PassKind::shorten:
       return "shorten";
@@ -213,10 +216,12 @@ TEST(SubstepPasses, ATickCutShortRecordsThePassesUpToItsLast) {
       EXPECT_EQ(shortens, edge_colours) << describePass(at);
       if (constraintKind(topo.constraints[topo.colors[at.color].first]) != SIM_KIND_STRUCTURAL) continue;
     }
-    EXPECT_EQ(sink.passes.back().kernel, lastOf(at.kind)) << describePass(at);
+    const bool hinges = constraintKind(topo.constraints[topo.colors[at.color].first]) == SIM_KIND_HINGE;
+    EXPECT_EQ(sink.passes.back().kernel, at.kind == PassKind::project && hinges ? "project_hinge" : lastOf(at.kind))
+        << describePass(at);
     if (at.kind == PassKind::project) {
       size_t projects = 0;
-      for (const Recorded& r : sink.passes) projects += r.kernel == "project";
+      for (const Recorded& r : sink.passes) projects += r.kernel == "project" || r.kernel == "project_hinge";
       EXPECT_EQ(projects, at.color + 1) << describePass(at); // every colour of this sheet has constraints
     }
   }

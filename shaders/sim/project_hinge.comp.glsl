@@ -1,0 +1,16 @@
+#version 460
+// Projects the live hinges of one colour (no two share a particle, so no races) in iteration
+// p.first of the substep (the first: projectsInIteration); project takes the distance colours.
+// Workgroup size (sim_common.glsl declares it and threadIndex() uses it)
+#define SIM_LOCAL_SIZE SIM_WG_PROJECT
+#define SIM_PUSH_TYPE SimPush
+#include "sim_common.glsl"
+#include "sim_elements.glsl"
+
+void main() {
+  uint t = threadIndex();
+  uvec2 range = color_range[p.color];
+  if (t >= range.y) return; // beyond the live count of this colour
+  Constraint c = constraints[range.x + t];
+  if (projectsInIteration(c.kind_id, p.first)) projectHingeConstraint(c);
+}
