@@ -253,12 +253,13 @@ bool colourStage(bool shorten, uint first) {
       uvec2 range = color_range[c];
       uint kind = range.y > 0u ? constraints[range.x].kind_id : 0u;
       if (range.y > 0u && (shorten ? shortensColour(kind) : projectsInIteration(kind, it))) {
-        for (uint t = lid; t < range.y; t += kInvocations) {
-          if (shorten)
-            shortenConstraint(constraints[range.x + t]);
-          else
-            projectConstraint(constraints[range.x + t], it);
-        }
+        // A colour is one kind: each kind's loop holds its body alone (project.comp, project_hinge.comp)
+        if (shorten)
+          for (uint t = lid; t < range.y; t += kInvocations) shortenConstraint(constraints[range.x + t]);
+        else if ((kind & SIM_KIND_MASK) == SIM_KIND_HINGE)
+          for (uint t = lid; t < range.y; t += kInvocations) projectHingeConstraint(constraints[range.x + t]);
+        else
+          for (uint t = lid; t < range.y; t += kInvocations) projectDistance(constraints[range.x + t]);
         sync();
       }
       if (stopsAfter(first + it * u.color_count + c)) return true;
