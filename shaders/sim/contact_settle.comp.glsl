@@ -11,9 +11,8 @@
 
 void main() {
   if (p.first >= contactChecks().sweeps || !settleSweeps(p.first)) return; // the same branch for every invocation
-  uint t = threadIndex();
-  uvec2 range = color_range[p.color];
-  if (t >= range.y) return; // beyond the live count of this colour
-  if (contactSettle(constraints[range.x + t], p.first, p.substep) && p.first + 1u < contactChecks().sweeps)
+  uint k = colourSlot(p.color, threadIndex());
+  if (k == SIM_NONE) return;
+  if (contactSettle(constraints[k], p.first, p.substep) && p.first + 1u < contactChecks().sweeps)
     armSettle(p.first + 2u); // the next sweep
 }

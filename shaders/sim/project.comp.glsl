@@ -8,8 +8,6 @@
 #include "sim_elements.glsl"
 
 void main() {
-  uint t = threadIndex();
-  uvec2 range = color_range[p.color];
-  if (t >= range.y) return; // beyond the live count of this colour
-  projectDistance(constraints[range.x + t]);
+  uint k = colourSlot(p.color, threadIndex());
+  if (k != SIM_NONE) projectDistance(constraints[k]);
 }

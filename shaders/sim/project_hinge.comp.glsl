@@ -8,9 +8,8 @@
 #include "sim_elements.glsl"
 
 void main() {
-  uint t = threadIndex();
-  uvec2 range = color_range[p.color];
-  if (t >= range.y) return; // beyond the live count of this colour
-  Constraint c = constraints[range.x + t];
+  uint k = colourSlot(p.color, threadIndex());
+  if (k == SIM_NONE) return;
+  Constraint c = constraints[k]; // read whole (SpirvRules: a fleet's kernels read by address)
   if (projectsInIteration(c.kind_id, p.first)) projectHingeConstraint(c);
 }

@@ -10,8 +10,6 @@
 
 void main() {
   if (!stageRuns(SIM_STAGE_shorten, conditionsNow())) return; // the same branch for every invocation
-  uint t = threadIndex();
-  uvec2 range = color_range[p.color];
-  if (t >= range.y) return; // beyond the live count of this colour
-  shortenConstraint(constraints[range.x + t]);
+  uint k = colourSlot(p.color, threadIndex());
+  if (k != SIM_NONE) shortenConstraint(constraints[k]);
 }

@@ -227,6 +227,13 @@ uint threadIndex() {
 // Linear index of this workgroup.
 uint groupIndex() { return gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x; }
 
+// Slot of the constraint that invocation t takes in a pass over `colour` (one invocation a
+// constraint), or SIM_NONE beyond the colour's live count.
+uint colourSlot(uint colour, uint t) {
+  uvec2 range = color_range[colour];
+  return t < range.y ? range.x + t : SIM_NONE;
+}
+
 // Colour of constraint slot k: the last colour whose (fixed) first slot is <= k.
 uint colorOf(uint k) {
   uint lo = 0u, hi = u.color_count; // answer in [lo, hi)
