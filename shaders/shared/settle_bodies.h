@@ -45,9 +45,10 @@ SIM_INLINE bool settleMovable(uint i, uint s) {
 SIM_INLINE bool settleOver(Constraint c, uint s) {
   if ((c.kind_id & SIM_KIND_MASK) != SIM_KIND_STRUCTURAL) return false;
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b);
-  if (shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return false;
   vec3 d = vec3(pb) - vec3(pa);
-  return dot3(d, d) > u.limit.reach * u.limit.reach && (settleFree(c.a, s) || settleFree(c.b, s));
+  return dot3(d, d) > u.limit.reach * u.limit.reach &&
+         !shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds) &&
+         (settleFree(c.a, s) || settleFree(c.b, s));
 }
 
 /// Moves particle i by up to `want` along the unit `dir`, as far as its ball and half-spaces let
@@ -82,10 +83,11 @@ SIM_INLINE bool settleConstraint(Constraint c, uint s) {
   if ((c.kind_id & SIM_KIND_MASK) != SIM_KIND_STRUCTURAL) return false;
   LimitKeys limit = u.limit;
   vec4 pa = SIM_POSITION(c.a), pb = SIM_POSITION(c.b);
-  if (shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return false;
   vec3 d = vec3(pb) - vec3(pa);
   float len2 = dot3(d, d);
+  // Most edges are within the limit: that test first, the tear's square root after
   if (!(len2 > limit.reach * limit.reach)) return false;
+  if (shouldTear(pa, pb, c.rest, SIM_KIND_STRUCTURAL, u.tear_factor, u.tear_kinds)) return false;
   bool ma = settleMovable(c.a, s), mb = settleMovable(c.b, s);
   if (!ma && !mb) return false;
   float len = simSqrt(len2), over = len - limit.reach;
