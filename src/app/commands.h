@@ -32,6 +32,7 @@ struct CommonOptions {
   int device = -1;               ///< Vulkan device index, -1 = best
   bool validation = false;       ///< VK_LAYER_KHRONOS_validation
   std::string script;            ///< input script to replay
+  bool kernel_times = false;     ///< `sim --kernel-times`: the GPU's time by kernel in the stats
   SimParams params;              ///< resolved preset + overrides
 
   /// The backend these options ask for (threads from the parameters).

@@ -92,6 +92,9 @@ void addSim(CLI::App& app, CommandLine& c) {
   cmd->add_option("--ticks", c.sim_ticks, "ticks to run (decimal, at most 100000000)")->capture_default_str();
   cmd->add_option("--script", c.common.script, "input script to replay");
   cmd->add_option("--stats", c.sim.stats, "write stats JSON here");
+  cmd->add_flag("--kernel-times", c.common.kernel_times,
+                "GPU: time each kernel apart, gpu_ms_per_kernel in the stats (a timestamp after every dispatch "
+                "of the per-colour passes, so the kernels do not overlap)");
   cmd->add_option("--out", c.sim.out, "write the final state here: FILE.ply, FILE.glb or FILE.gltf (glTF 2.0)");
   cmd->add_option("--frames-every", c.frames_every,
                   "a frame every K ticks: --out DIR/ writes frame_000000.glb..., --out FILE.glb one animation");

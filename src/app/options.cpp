@@ -7,6 +7,7 @@ BackendOptions CommonOptions::backendOptions() const {
   BackendOptions b = backendOptionsFor(backend, params);
   b.device = device;
   b.validation = validation;
+  b.time_kernels = kernel_times;
   return b;
 }
 

@@ -57,6 +57,7 @@ bool vulkanBuilt() {
 std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) {
   out = Backend{};
   if (o.backend == "cpu") {
+    if (o.time_kernels) return std::string("kernel times are a GPU backend's (the cpu backend runs no kernels)");
     CpuOptions co;
     co.threads = o.threads;
     co.min_chunk = o.min_chunk;
@@ -80,6 +81,7 @@ std::optional<std::string> createBackend(const BackendOptions& o, Backend& out) 
       solver = std::make_unique<gpu::GpuSolver>(std::move(ctx), fusedShapeOf(o));
     }
     if (o.backend == "gpu-percolor") solver->setFusedPath(false);
+    solver->timeKernels(o.time_kernels);
     out.gpu = solver.get();
     out.solver = std::move(solver);
   } catch (const std::exception& e) {

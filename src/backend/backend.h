@@ -34,6 +34,8 @@ struct BackendOptions {
   /// the device's limit (FusedShape::workgroup); 0 = the device kind's (`tender-bench
   /// --fused-workgroup`)
   uint32_t fused_workgroup = 0;
+  /// GPU solver: time each dispatch apart (GpuSolver::timeKernels; `tender sim --kernel-times`)
+  bool time_kernels = false;
   /// Run the GPU solver on this context (the renderer's) instead of creating one; it must outlive
   /// the backend.
   gpu::VulkanContext* context = nullptr;

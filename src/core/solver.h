@@ -24,6 +24,9 @@ struct SimState {
 /// Per-pass GPU times of the last measured tick, in milliseconds.
 struct PassTimes {
   std::vector<std::pair<std::string, double>> ms;
+  /// The same tick by kernel, where the solver times its dispatches apart (GpuSolver::timeKernels;
+  /// the per-colour passes), else empty: each kernel that ran, and the sum of its dispatches.
+  std::vector<std::pair<std::string, double>> kernels;
 };
 
 /// How a backend's float arithmetic runs (the stats JSON and `tender diff` report it).

@@ -119,6 +119,11 @@ nlohmann::json runStatsJson(const SheetStats& s, const Solver& solver, RunRecord
   nlohmann::json passes = nlohmann::json::object();
   for (auto& [name, t] : solver.passTimes().ms) passes[name] = t;
   if (gpu) j["gpu_ms_per_pass"] = passes;
+  if (!solver.passTimes().kernels.empty()) {
+    nlohmann::json kernels = nlohmann::json::object();
+    for (auto& [name, t] : solver.passTimes().kernels) kernels[name] = t;
+    j["gpu_ms_per_kernel"] = kernels;
+  }
   return j;
 }
 

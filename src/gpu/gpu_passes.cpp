@@ -34,6 +34,9 @@ void GpuSolver::pass(const ComputePipeline& p, Grid grid, uint32_t count, const 
                      uint32_t, const PassGate& gate) {
   // One sheet: it runs every pass recorded for it
   dispatch(recording_->tick, p, grid, count, push, push_size, gate.arg);
+  if (!time_kernels_) return;
+  const uint32_t k = kernelOf(p.pipeline);
+  if (k != SIM_NONE) timestamp(recording_->tick, *recording_, PassCategory(kCategoryCount + k));
 }
 
 void GpuSolver::barrier() { computeToCompute(recording_->tick); }

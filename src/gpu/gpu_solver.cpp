@@ -76,25 +76,54 @@ void GpuSolver::createPipelines(FusedShape fused) {
   makeComputePipelines(ctx_, {layout_, "solver"}, float_rules_, math_, requests);
 
   // Per tick in flight: fences and timestamp pools (chain of timestamps at pass boundaries).
-  query_capacity_ = 2 + marksPerSubstep() * SIM_MAX_SUBSTEPS;
   VkFenceCreateInfo fci{};
   fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  for (InFlight& s : in_flight_) VK_CHECK(vkCreateFence(dev, &fci, nullptr, &s.fence));
+  makeQueryPools();
   VkQueryPoolCreateInfo qci{};
   qci.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
   qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
-  for (InFlight& s : in_flight_) {
-    VK_CHECK(vkCreateFence(dev, &fci, nullptr, &s.fence));
-    if (ctx_.timestampsSupported()) {
-      qci.queryCount = query_capacity_;
-      VK_CHECK(vkCreateQueryPool(dev, &qci, nullptr, &s.queries));
-    }
-  }
   VK_CHECK(vkCreateFence(dev, &fci, nullptr, &normals_fence_));
   if (ctx_.timestampsSupported()) {
     qci.queryCount = 2;
     VK_CHECK(vkCreateQueryPool(dev, &qci, nullptr, &normals_queries_));
   }
   small_readback_ = ctx_.createHostBuffer(256, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+}
+
+void GpuSolver::makeQueryPools() {
+  // The timestamps of a tick: the chain at the categories' boundaries, and with timeKernels one
+  // after every dispatch (a tick of the per-colour passes records a few hundred a substep)
+  query_capacity_ = 2 + marksPerSubstep() * SIM_MAX_SUBSTEPS + (time_kernels_ ? kKernelTimestamps : 0u);
+  VkDevice dev = ctx_.device();
+  VkQueryPoolCreateInfo qci{};
+  qci.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+  qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  qci.queryCount = query_capacity_;
+  for (InFlight& s : in_flight_) {
+    if (s.queries) vkDestroyQueryPool(dev, s.queries, nullptr);
+    s.queries = VK_NULL_HANDLE;
+    if (ctx_.timestampsSupported()) VK_CHECK(vkCreateQueryPool(dev, &qci, nullptr, &s.queries));
+  }
+}
+
+uint32_t GpuSolver::kernelOf(VkPipeline p) const {
+  uint32_t k = 0;
+#define SIM_KERNEL_OF(name, push, per_invocation, batched)                                                             \
+  if (pipes_.name.pipeline == p) return k;                                                                             \
+  ++k;
+  SIM_KERNELS(SIM_KERNEL_OF)
+#undef SIM_KERNEL_OF
+  return SIM_NONE;
+}
+
+void GpuSolver::timeKernels(bool on) {
+  if (on == time_kernels_) return;
+  time_kernels_ = on;
+  last_kernel_ms_.clear();
+  for (InFlight& s : in_flight_) waitFor(s);
+  makeQueryPools();
+  for (InFlight& s : in_flight_) s.recorded.reset(); // recorded again, with or without the timestamps
 }
 
 void GpuSolver::writeStaticUniforms() {
@@ -124,8 +153,20 @@ void GpuSolver::collectTimes(const InFlight& flight) const {
   VK_CHECK(vkGetQueryPoolResults(ctx_.device(), flight.queries, 0, uint32_t(ts.size()), ts.size() * sizeof(uint64_t),
                                  ts.data(), sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
   std::array<double, kCategoryCount> ms{};
-  for (size_t k = 0; k < flight.categories.size(); ++k)
-    ms[flight.categories[k]] += double(ts[k + 1] - ts[k]) * ctx_.timestampPeriod() * 1e-6;
+  last_kernel_ms_.assign(time_kernels_ ? std::size(kKernelNames) : 0u, {0.0, 0u});
+  double dispatches = 0.0; // the dispatches timed apart since the last category's mark, which it takes
+  for (size_t k = 0; k < flight.categories.size(); ++k) {
+    const double t = double(ts[k + 1] - ts[k]) * ctx_.timestampPeriod() * 1e-6;
+    const uint32_t c = flight.categories[k];
+    if (c < kCategoryCount) {
+      ms[c] += dispatches + t;
+      dispatches = 0.0;
+    } else if (c - kCategoryCount < last_kernel_ms_.size()) { // a dispatch timed apart (timeKernels)
+      last_kernel_ms_[c - kCategoryCount].first += t;
+      ++last_kernel_ms_[c - kCategoryCount].second;
+      dispatches += t;
+    }
+  }
   ms[kNormals] = last_ms_[kNormals];
   last_ms_ = ms;
 }
@@ -287,6 +328,8 @@ PassTimes GpuSolver::passTimes() const {
                                                "floor",   "tear",      "normals", "fused_tick"};
   PassTimes t;
   for (int c = 0; c < kCategoryCount; ++c) t.ms.emplace_back(kNames[c], last_ms_[size_t(c)]);
+  for (size_t k = 0; k < last_kernel_ms_.size(); ++k)
+    if (last_kernel_ms_[k].second > 0) t.kernels.emplace_back(kKernelNames[k], last_kernel_ms_[k].first);
   return t;
 }
 

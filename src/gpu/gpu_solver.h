@@ -5,6 +5,7 @@
 /// collision flag change; nothing is read back in the steady-state loop. Two ticks may be in
 /// flight: each has its own uniforms, command buffer, fence and timestamp pool.
 #include <array>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -86,6 +87,10 @@ public:
   Arithmetic arithmetic() const override;
   void stopNextTickAfter(uint32_t last_pass) override { stop_after_ = last_pass; }
   void readDeltas(std::vector<glm::vec4>& out) override;
+
+  /// Times each dispatch of the per-colour passes apart, for passTimes().kernels: a timestamp
+  /// after every one, which keeps the device from overlapping them (a profile, not a benchmark).
+  void timeKernels(bool on);
 
   /// The context the solver runs on.
   VulkanContext& context() { return ctx_; }
@@ -182,6 +187,10 @@ private:
     dispatch(cmd, p, grid, count, &push, uint32_t(sizeof(Push)));
   }
   void timestamp(VkCommandBuffer cmd, InFlight& flight, PassCategory c);
+  /// The query pools of the ticks in flight, sized for timeKernels when it is on
+  void makeQueryPools();
+  /// Pipeline p's kernel in SIM_KERNELS' order, or SIM_NONE for another pipeline
+  uint32_t kernelOf(VkPipeline p) const;
   void waitFor(InFlight& flight) const;
   void collectTimes(const InFlight& flight) const;
 
@@ -231,6 +240,18 @@ private:
   glm::uvec4 sweep_grid_uploaded_{0u};                         ///< ... and of a settle sweep
   uint32_t stop_after_ = SIM_NONE;                             ///< stopNextTickAfter
   mutable std::array<double, kCategoryCount> last_ms_{};
+  bool time_kernels_ = false;
+  /// Room for timeKernels' timestamps, one a dispatch
+  static constexpr uint32_t kKernelTimestamps = 8192;
+  /// The kernels' names in SIM_KERNELS' order; timeKernels' timestamps carry kCategoryCount + the index
+  static constexpr const char* kKernelNames[] = {
+#define SIM_KERNEL_NAME(name, push, per_invocation, batched) #name,
+      SIM_KERNELS(SIM_KERNEL_NAME)
+#undef SIM_KERNEL_NAME
+  };
+  static_assert(kCategoryCount + std::size(kKernelNames) <= 256, "a timestamp's category is a byte");
+  /// The last timed tick's milliseconds and dispatches by kernel (SIM_KERNELS' order)
+  mutable std::vector<std::pair<double, uint32_t>> last_kernel_ms_;
 };
 
 } // namespace tender::gpu

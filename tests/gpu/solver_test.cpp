@@ -1,6 +1,8 @@
 // The behaviour every solver shares (tests/common/solver_cases.h) on both GPU paths: the fused
-// small-sheet tick and the per-colour passes, built as every program builds them; and the fused
-// tick's count of its barriers.
+// small-sheet tick and the per-colour passes, built as every program builds them; the fused
+// tick's count of its barriers; and the kernels timed apart.
+#include <map>
+
 #include "backend/backend.h"
 #include "common/solver_cases.h"
 #include "gpu/gpu_solver.h"
@@ -54,4 +56,32 @@ TEST_F(GpuTest, TheFusedTickCountsABarrierForEachColourOfEachIteration) {
   EXPECT_GT(four, 2u * 4u * colours);
   EXPECT_EQ(five - four, 2u * colours);
   EXPECT_EQ(phases({"iterations=4", "substeps=2"}, false).first, 0u);
+}
+
+TEST_F(GpuTest, KernelsTimedApartAddUpToTheirPassesAndChangeNoBit) {
+  // timeKernels (`tender sim --kernel-times`): a timestamp after every dispatch of the per-colour
+  // passes names each kernel that ran with its time, which its passes' times hold, and the bits
+  // stay the CPU's; turned off, the kernels go unnamed again
+  const SimParams p = clothWithContact({"cols=8", "rows=12", "wind=off"});
+  CpuSolver cpu;
+  Simulation a(p, cpu);
+  const SimState cpu_end = run(a, 3);
+  gpu::GpuSolver gpu(ctx());
+  gpu.setFusedPath(false);
+  gpu.timeKernels(true);
+  Simulation g(p, gpu);
+  EXPECT_TRUE(sameState(cpu_end, run(g, 3)));
+  const PassTimes t = gpu.passTimes();
+  const std::map<std::string, double> kernels(t.kernels.begin(), t.kernels.end());
+  double in_kernels = 0.0, in_passes = 0.0;
+  for (const auto& [name, ms] : t.kernels) in_kernels += ms;
+  for (const auto& [name, ms] : t.ms) in_passes += name == "normals" ? 0.0 : ms;
+  std::printf("%zu kernels: %.3f ms of the passes' %.3f\n", kernels.size(), in_kernels, in_passes);
+  for (const char* name : {"integrate", "project", "contact_near", "contact_step"})
+    EXPECT_EQ(kernels.count(name), 1u) << name;
+  EXPECT_GT(in_kernels, 0.0);
+  EXPECT_LE(in_kernels, in_passes * (1.0 + 1e-9));
+  gpu.timeKernels(false);
+  g.tick();
+  EXPECT_TRUE(gpu.passTimes().kernels.empty());
 }
