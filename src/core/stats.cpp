@@ -116,12 +116,13 @@ nlohmann::json runStatsJson(const SheetStats& s, const Solver& solver, RunRecord
   const Arithmetic arith = solver.arithmetic();
   j["arithmetic"] = {{"rounding", arith.rounding}, {"denormals", arith.denormals}, {"corrected", arith.corrected}};
   j["inexact_math_emulated"] = arith.inexact_math_emulated;
+  const PassTimes times = solver.passTimes(); // a GPU's collects its last finished tick once
   nlohmann::json passes = nlohmann::json::object();
-  for (auto& [name, t] : solver.passTimes().ms) passes[name] = t;
+  for (auto& [name, t] : times.ms) passes[name] = t;
   if (gpu) j["gpu_ms_per_pass"] = passes;
-  if (!solver.passTimes().kernels.empty()) {
+  if (!times.kernels.empty()) {
     nlohmann::json kernels = nlohmann::json::object();
-    for (auto& [name, t] : solver.passTimes().kernels) kernels[name] = t;
+    for (auto& [name, t] : times.kernels) kernels[name] = t;
     j["gpu_ms_per_kernel"] = kernels;
   }
   return j;
