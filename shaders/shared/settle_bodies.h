@@ -1,9 +1,9 @@
 // The settle stage's per-edge body, shared by GLSL and C++ (settle_elements.h beside it includes it
 // inside a struct whose members bear the buffers' names): after the contact's cut and push, each
 // structural edge longer than the stretch limit is shortened from both ends within what the
-// contact lets each end's step go. It reads u (SimUniforms), the positions through SIM_POSITION(j),
-// and through functions each side defines: for particle i where it started the substep
-// (settleStart), its push (settlePush), its ball (settleBound), its half-spaces (halfSpace(k) for
+// contact lets each end's step go. It reads u (SimUniforms), the positions through SIM_POSITION(j)
+// and the previous positions `prev` (it writes both), and through functions each side defines: for particle i where it
+// started the substep (settleStart), its push (settlePush), its ball (settleBound), its half-spaces (halfSpace(k) for
 // k from halfFirst(i) to halfEnd(i)), and the substep's frame (settleFrame, contactFrame). The
 // half-spaces are listed by particle, counted, scanned and filled (SIM_CONTACT_HALF_CAPACITY a
 // particle on average); a particle whose list ends past them is not moved.
@@ -52,14 +52,19 @@ SIM_INLINE bool settleOver(Constraint c, uint s) {
 }
 
 /// Moves particle i by up to `want` along the unit `dir`, as far as its ball and half-spaces let
-/// its step go; how far it moved.
+/// its step go; how far it moved. Its previous position moves by as much, so the move adds no
+/// speed, as the stretch limit's places add none: taken as a step, each substep's shortening sped
+/// the ends of the edges it held together, and a `crumple` sheet hanging with soft edges
+/// (`stiffness` 0, the limit and the settle holding them every substep) was pumped to 9 units/s.
 SIM_INLINE float settleMove(uint i, vec3 dir, float want) {
   if (!(want > 0.0f)) return 0.0f;
   vec3 s = settleStep(i), d = dir * want;
   float s_len = simSqrt(dot3(s, s)), d_len = simSqrt(dot3(d, d));
   float t = ballRoom(s, d, settleBound(i));
   for (uint k = halfFirst(i); k < halfEnd(i); ++k) t = min(t, halfSpaceRoom(halfSpace(k), s, s_len, d, d_len));
-  SIM_POSITION(i) = SIM_POSITION(i) + vec4(dir * (want * t), 0.0f);
+  vec4 moved = vec4(dir * (want * t), 0.0f);
+  SIM_POSITION(i) = SIM_POSITION(i) + moved;
+  prev[i] = prev[i] + moved;
   return want * t;
 }
 

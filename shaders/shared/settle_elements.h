@@ -9,6 +9,7 @@ namespace shaderio {
 struct SettleElements {
   const SimUniforms& u;
   vec4* pos;
+  vec4* prev;
   const vec4* start;
   const vec4* push;
   const float* bound;

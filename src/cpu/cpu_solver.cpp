@@ -302,8 +302,8 @@ void CpuSolver::settlePass(const SimUniforms& u, uint32_t s) {
   const float* rest = con_rest_.data();
   const std::vector<uint32_t>& edges = countColourEdges();
   auto at = [&](uint32_t k) { return Constraint{ca[k], cb[k], rest[k], (id[k] << SIM_KIND_BITS) | kind[k]}; };
-  SettleElements e{u,       pos_.data(), start_.data(), push_.data(),    bound_.data(),
-                   nullptr, nullptr,     nullptr,       contact_.frame()};
+  SettleElements e{u,       pos_.data(), prev_.data(), start_.data(),   push_.data(), bound_.data(),
+                   nullptr, nullptr,     nullptr,      contact_.frame()};
   // Sweeps the colours' edges with `body` in one job, a phase a colour with edges (shared on a small
   // sheet too: a sweep costs about a projection iteration); true when it returned true for one
   settle_colours_.clear();
