@@ -105,7 +105,8 @@ if "$T" devices >/dev/null 2>&1; then
     <(lines "$tmp/tear" | sed 's/"arithmetic": {[^}]*}, "backend": "[a-z]*", //') ||
     fail "gpu and cpu sweeps differ"
   # With the crumple preset's contact: the same stats, its count of particles in contact included
-  paper=(--preset crumple --set cols=8 --set rows=12 --script "$tmp/yank.txt" --vary damping=0.98,0.99 --ticks 20)
+  # (15 ticks: the yanked sheet at damping 0.98 still has particles in contact then)
+  paper=(--preset crumple --set cols=8 --set rows=12 --script "$tmp/yank.txt" --vary damping=0.98,0.99 --ticks 15)
   sweep --backend gpu "${paper[@]}" --batch 2 --out "$tmp/gpu_contact"
   sweep --backend cpu "${paper[@]}" --out "$tmp/cpu_contact"
   grep -q '"contacts":[1-9]' "$tmp/cpu_contact/sheets.jsonl" || fail "no contact in the crumple sweep"
