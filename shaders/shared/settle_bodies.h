@@ -2,9 +2,10 @@
 // inside a struct whose members bear the buffers' names): after the contact's cut and push, each
 // structural edge longer than the stretch limit is shortened from both ends within what the
 // contact lets each end's step go. It reads u (SimUniforms), the positions through SIM_POSITION(j)
-// and the previous positions `prev` (it writes both), and through functions each side defines: for particle i where it
-// started the substep (settleStart), its push (settlePush), its ball (settleBound), its half-spaces (halfSpace(k) for
-// k from halfFirst(i) to halfEnd(i)), and the substep's frame (settleFrame, contactFrame). The
+// and the previous positions `prev` (it writes both), and through functions each side defines: for
+// particle i where it started the substep (settleStart), its push (settlePush), its ball
+// (settleBound), its half-spaces (halfSpace(k) for k from halfFirst(i) to halfEnd(i)), and the
+// substep's frame (settleFrame, contactFrame). The
 // half-spaces are listed by particle, counted, scanned and filled (SIM_CONTACT_HALF_CAPACITY a
 // particle on average); a particle whose list ends past them is not moved.
 //

@@ -129,8 +129,8 @@ TEST(Stretch, TheSettleShortensEdgesWithoutSpeedingUpTheSheet) {
   // The `crumple` sheet hanging from its corners with no stiffness in its edges, so that the
   // stretch limit and the settle hold them alone, every substep. The settle's moves shorten edges
   // without speeding up their ends, as the limit's places do: in the half second after the first,
-  // no particle moves faster than a second's free fall would make it (gravity alone gives 0.24
-  // units/s). Taken as steps, the moves pumped the sheet to 7.5 units/s then, and 9.1 by 5 s.
+  // no particle moves faster than a second's free fall would make it (the sheet sags at 0.24
+  // units/s at most). Taken as steps, the moves pumped the sheet to 7.5 units/s then, 9.1 by 5 s.
   const SimParams p = crumpleSheet({"stiffness=0"});
   CpuSolver solver;
   Simulation sim(p, solver);
