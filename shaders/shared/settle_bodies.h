@@ -5,9 +5,9 @@
 // and the previous positions `prev` (it writes both), and through functions each side defines: for
 // particle i where it started the substep (settleStart), its push (settlePush), its ball
 // (settleBound), its half-spaces (halfSpace(k) for k from halfFirst(i) to halfEnd(i)), and the
-// substep's frame (settleFrame, contactFrame). The
-// half-spaces are listed by particle, counted, scanned and filled (SIM_CONTACT_HALF_CAPACITY a
-// particle on average); a particle whose list ends past them is not moved.
+// substep's frame (settleFrame, contactFrame). The half-spaces are listed by particle, counted,
+// scanned and filled (SIM_CONTACT_HALF_CAPACITY a particle on average); a particle whose list ends
+// past them is not moved.
 //
 // Why the contact's guarantee stands: a particle's half-spaces and ball (the cut's, slideStep) are
 // convex and hold the zero step, and the particle's step after the cut keeps them; each move here
